@@ -1,0 +1,101 @@
+# photosplat: build, test and run.
+#
+#   make run    install missing Debian packages, build, run the preview on the default scene
+#   make test   install missing Debian packages, build, run every test (plain and ASan+UBSan)
+#   make        build bin/ only (expects the packages to be there)
+#
+# Layout: every .c/.cpp under src/ except src/app/*_main.c goes into one static
+# library, libphotosplat.a (the GL-free core); each src/app/NAME_main.c is a thin
+# program bin/photosplat-NAME. Tests are tests/test_*.c, one per module.
+# Two build variants share the sources: build/release (what bin/ holds) and
+# build/asan (AddressSanitizer + UndefinedBehaviorSanitizer, tests only).
+
+.DEFAULT_GOAL := all
+SHELL := /bin/bash
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+
+CC := gcc
+CXX := g++
+CSTD := -std=c11 -D_POSIX_C_SOURCE=200809L
+WARN := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wpointer-arith -Wvla -Wformat=2
+CXXWARN := -Wall -Wextra -Wshadow
+# Package flags are read when this Makefile is parsed; the `test` and `run`
+# targets install the packages first and then re-enter make, so they are there.
+PKGS := libpng tinyobjloader
+PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+TEST_CFLAGS := $(shell pkg-config --cflags cmocka 2>/dev/null)
+TEST_LIBS := $(shell pkg-config --libs cmocka 2>/dev/null)
+LIBS := $(PKG_LIBS) -lstdc++ -lm -lpthread
+
+OPT_release := -O2 -g
+OPT_asan := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+LDOPT_release :=
+LDOPT_asan := -fsanitize=address,undefined
+
+LIB_C := $(filter-out src/app/%_main.c,$(wildcard src/*/*.c))
+LIB_CXX := $(wildcard src/*/*.cpp)
+MAINS := $(wildcard src/app/*_main.c)
+PROGS := $(patsubst src/app/%_main.c,photosplat-%,$(MAINS))
+TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c))
+
+# variant-rules(VARIANT): objects, library, programs and tests of one variant.
+define variant-rules
+B_$(1) := build/$(1)
+OBJ_$(1) := $$(patsubst src/%.c,build/$(1)/obj/%.o,$$(LIB_C)) $$(patsubst src/%.cpp,build/$(1)/obj/%.o,$$(LIB_CXX))
+LIB_$(1) := build/$(1)/libphotosplat.a
+build/$(1)/obj/%.o: src/%.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc $$(PKG_CFLAGS) -MMD -MP -c $$< -o $$@
+build/$(1)/obj/%.o: src/%.cpp
+	@mkdir -p $$(@D)
+	$$(CXX) -std=c++11 $$(CXXWARN) $$(OPT_$(1)) -Isrc $$(PKG_CFLAGS) -MMD -MP -c $$< -o $$@
+$$(LIB_$(1)): $$(OBJ_$(1))
+	@rm -f $$@
+	ar rcs $$@ $$^
+build/$(1)/bin/photosplat-%: build/$(1)/obj/app/%_main.o $$(LIB_$(1))
+	@mkdir -p $$(@D)
+	$$(CC) $$(LDOPT_$(1)) $$^ -o $$@ $$(LIBS)
+build/$(1)/tests/%: tests/%.c $$(LIB_$(1))
+	@mkdir -p $$(@D)
+	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc -Itests $$(TEST_CFLAGS) -MMD -MP $$< -o $$@ $$(LDOPT_$(1)) $$(LIB_$(1)) $$(TEST_LIBS) $$(LIBS)
+-include $$(OBJ_$(1):.o=.d) $$(patsubst %,build/$(1)/tests/%.d,$$(TESTS))
+endef
+$(eval $(call variant-rules,release))
+$(eval $(call variant-rules,asan))
+# Programs' objects are not in the library; keep them when make would call them intermediate.
+.SECONDARY:
+
+bin/%: build/release/bin/%
+	@mkdir -p bin
+	cp $< $@
+
+.PHONY: all deps test check run run-built bench clean build-tests
+all: $(addprefix bin/,$(PROGS))
+
+build-tests: all $(addprefix build/release/tests/,$(TESTS)) \
+             $(addprefix build/asan/tests/,$(TESTS)) $(addprefix build/asan/bin/,$(PROGS))
+
+deps:
+	@scripts/install-deps.sh
+
+# The public entry points install packages, then re-enter make so that the
+# pkg-config flags above are read with the packages present.
+test: deps
+	@$(MAKE) --no-print-directory -j$(JOBS) build-tests
+	@$(MAKE) --no-print-directory check
+
+check:
+	@tests/run-tests.sh
+
+run: deps
+	@$(MAKE) --no-print-directory -j$(JOBS) all
+	@$(MAKE) --no-print-directory run-built
+
+SCENE ?= data/scenes/cornell-caustic.scn
+# Until the preview window exists this prints what the default scene holds.
+run-built:
+	bin/photosplat-info $(SCENE)
+
+clean:
+	rm -rf build bin

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# install-deps.sh: install the Debian 12 packages photosplat needs, skipping
+# what is already there (checked with pkg-config or the command itself).
+# Called by `make test` and `make run`; needs root or sudo only when something
+# is missing.
+set -euo pipefail
+
+missing=()
+need_cmd() { command -v "$1" >/dev/null 2>&1 || missing+=("$2"); }
+need_pc() { pkg-config --exists "$1" 2>/dev/null || missing+=("$2"); }
+
+need_cmd gcc gcc
+need_cmd g++ g++
+need_cmd make make
+need_cmd pkg-config pkg-config
+# Without pkg-config every pkg-config check below would fail; that is fine,
+# their packages are then simply installed (apt skips what is present).
+need_pc libpng libpng-dev
+need_pc tinyobjloader libtinyobjloader-dev
+need_pc cmocka libcmocka-dev
+# The sanitizer runtimes come with gcc on Debian but may be trimmed from images.
+[ -e "$(gcc -print-file-name=libasan.so 2>/dev/null)" ] && gcc -print-file-name=libasan.so | grep -q / || missing+=(libasan8)
+[ -e "$(gcc -print-file-name=libubsan.so 2>/dev/null)" ] && gcc -print-file-name=libubsan.so | grep -q / || missing+=(libubsan1)
+
+if [ ${#missing[@]} -eq 0 ]; then
+    exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}" >&2
+SUDO=()
+if [ "$(id -u)" -ne 0 ]; then
+    if command -v sudo >/dev/null 2>&1; then
+        SUDO=(sudo)
+    else
+        echo "install-deps: need root or sudo to install: ${missing[*]}" >&2
+        exit 2
+    fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+# Try without refreshing the lists first (fast when they are current), then refresh.
+if ! "${SUDO[@]}" apt-get install -y --no-install-recommends "${missing[@]}" >/dev/null 2>&1; then
+    "${SUDO[@]}" apt-get update -qq
+    "${SUDO[@]}" apt-get install -y --no-install-recommends "${missing[@]}"
+fi

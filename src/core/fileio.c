@@ -1,0 +1,162 @@
+/* fileio.c: atomic output files and input file checks. */
+#include "core/fileio.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+struct ps_outfile {
+    FILE *fp;
+    char *path;
+    char *tmp;
+};
+
+ps_outfile *ps_outfile_open(const char *path, ps_error *err)
+{
+    static const char suffix[] = ".tmp.XXXXXX";
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        ps_error_set(err, PS_ERR_IO, "%s: is a directory, cannot write an image there", path);
+        return NULL;
+    }
+    ps_outfile *f = calloc(1, sizeof *f);
+    size_t n = strlen(path);
+    if (!f || !(f->path = malloc(n + 1)) || !(f->tmp = malloc(n + sizeof suffix))) {
+        ps_outfile_abort(f);
+        ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
+        return NULL;
+    }
+    memcpy(f->path, path, n + 1);
+    memcpy(f->tmp, path, n);
+    memcpy(f->tmp + n, suffix, sizeof suffix);
+    int fd = mkstemp(f->tmp);
+    if (fd < 0) {
+        ps_error_set(err, PS_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+        free(f->tmp);
+        f->tmp = NULL;
+        ps_outfile_abort(f);
+        return NULL;
+    }
+    /* mkstemp creates 0600; give the result the permissions a plain fopen would. */
+    mode_t mask = umask(0);
+    umask(mask);
+    (void)fchmod(fd, 0666 & ~mask);
+    f->fp = fdopen(fd, "wb");
+    if (!f->fp) {
+        close(fd);
+        ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+        ps_outfile_abort(f);
+        return NULL;
+    }
+    return f;
+}
+
+FILE *ps_outfile_stream(ps_outfile *f) { return f->fp; }
+
+ps_status ps_outfile_commit(ps_outfile *f, ps_error *err)
+{
+    int failed = ferror(f->fp) != 0;
+    failed |= fflush(f->fp) != 0;
+    int saved = errno;
+    failed |= fclose(f->fp) != 0;
+    f->fp = NULL;
+    if (failed) {
+        ps_error_set(err, PS_ERR_IO, "%s: write failed: %s", f->path, strerror(saved ? saved : errno));
+        ps_outfile_abort(f);
+        return PS_ERR_IO;
+    }
+    if (rename(f->tmp, f->path) != 0) {
+        ps_error_set(err, PS_ERR_IO, "%s: cannot rename into place: %s", f->path, strerror(errno));
+        ps_outfile_abort(f);
+        return PS_ERR_IO;
+    }
+    free(f->tmp);
+    f->tmp = NULL; /* renamed: nothing left to remove */
+    ps_outfile_abort(f);
+    return PS_OK;
+}
+
+void ps_outfile_abort(ps_outfile *f)
+{
+    if (!f)
+        return;
+    if (f->fp)
+        fclose(f->fp);
+    if (f->tmp) {
+        remove(f->tmp);
+        free(f->tmp);
+    }
+    free(f->path);
+    free(f);
+}
+
+ps_status ps_check_input_file(const char *path, ps_error *err)
+{
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    if (S_ISDIR(st.st_mode))
+        return ps_error_set(err, PS_ERR_IO, "%s: is a directory, not a file", path);
+    if (!S_ISREG(st.st_mode))
+        return ps_error_set(err, PS_ERR_IO, "%s: not a regular file", path);
+    if (access(path, R_OK) != 0)
+        return ps_error_set(err, PS_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
+    return PS_OK;
+}
+
+ps_status ps_read_file(const char *path, size_t max_bytes, char **out, size_t *out_len, ps_error *err)
+{
+    *out = NULL;
+    if (out_len)
+        *out_len = 0;
+    ps_status st = ps_check_input_file(path, err);
+    if (st != PS_OK)
+        return st;
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    if (!buf) {
+        fclose(fp);
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
+    }
+    for (;;) {
+        if (len + 1 >= cap) {
+            if (cap > max_bytes) {
+                free(buf);
+                fclose(fp);
+                return ps_error_set(err, PS_ERR_LIMIT, "%s: file larger than %zu bytes", path, max_bytes);
+            }
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                fclose(fp);
+                return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
+            }
+            buf = nb;
+            cap *= 2;
+        }
+        size_t got = fread(buf + len, 1, cap - 1 - len, fp);
+        len += got;
+        if (got == 0)
+            break;
+    }
+    int bad = ferror(fp);
+    fclose(fp);
+    if (bad) {
+        free(buf);
+        return ps_error_set(err, PS_ERR_IO, "%s: read failed", path);
+    }
+    if (len > max_bytes) {
+        free(buf);
+        return ps_error_set(err, PS_ERR_LIMIT, "%s: file larger than %zu bytes", path, max_bytes);
+    }
+    buf[len] = '\0';
+    *out = buf;
+    if (out_len)
+        *out_len = len;
+    return PS_OK;
+}

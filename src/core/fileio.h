@@ -1,0 +1,33 @@
+/* fileio.h: output files that appear whole or not at all, and input checks. */
+#ifndef PS_CORE_FILEIO_H
+#define PS_CORE_FILEIO_H
+
+#include <stdio.h>
+
+#include "core/status.h"
+
+/* An output file under construction. Everything is written to a temporary file
+ * beside the target (same directory, so the final rename is atomic); only
+ * ps_outfile_commit renames it into place. An interrupted or failed run
+ * therefore never leaves a truncated file under the requested name. */
+typedef struct ps_outfile ps_outfile;
+
+/* Opens a temporary file for `path`. On failure returns NULL and sets err. */
+ps_outfile *ps_outfile_open(const char *path, ps_error *err);
+/* The stream to write to (binary mode). */
+FILE *ps_outfile_stream(ps_outfile *f);
+/* Flushes, checks every write succeeded, closes and renames into place, then
+ * frees f. On failure removes the temporary file, sets err and frees f. */
+ps_status ps_outfile_commit(ps_outfile *f, ps_error *err);
+/* Discards the temporary file and frees f (f may be NULL). */
+void ps_outfile_abort(ps_outfile *f);
+
+/* Checks that `path` names a readable regular file (not a directory, device or
+ * FIFO, which would make a reader hang or fail obscurely). */
+ps_status ps_check_input_file(const char *path, ps_error *err);
+
+/* Reads a whole regular file into a NUL-terminated buffer the caller frees.
+ * Refuses files larger than max_bytes with PS_ERR_LIMIT. */
+ps_status ps_read_file(const char *path, size_t max_bytes, char **out, size_t *out_len, ps_error *err);
+
+#endif
