@@ -1,0 +1,397 @@
+/* obj.c: OBJ/MTL pre-scan (strict checks with line numbers), then tinyobjloader. */
+#include "scene/obj.h"
+
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/array.h"
+#include "core/fileio.h"
+#include "core/number.h"
+
+/* Larger files are refused before reading: 1 GiB of OBJ text is ~20 M triangles,
+ * far past what the interactive preview is for. */
+#define OBJ_MAX_BYTES ((size_t)1 << 30)
+#define MTL_MAX_BYTES ((size_t)64 << 20)
+/* tinyobjloader stores a face's vertex count in an unsigned char. */
+#define OBJ_MAX_FACE_VERTICES 255
+#define OBJ_MAX_TOKENS 300
+#define OBJ_MAX_MTLLIBS 16
+
+/* Per MTL material: what tinyobjloader cannot tell us (whether Ns/Ni were given). */
+typedef struct mtl_info {
+    char name[PS_OBJ_NAME_MAX];
+    int has_ns, has_ni;
+} mtl_info;
+
+typedef struct prescan {
+    const char *path;
+    const ps_warn_sink *warn;
+    ps_error *err;
+    size_t v, vn, vt; /* counts so far: negative indices are relative to them */
+    size_t faces;     /* faces with >= 3 vertices */
+    mtl_info *mtls;
+    size_t mtl_count, mtl_cap;
+    char *mtl_text; /* every MTL library found, concatenated */
+    size_t mtl_len, mtl_cap_bytes;
+    char libs[OBJ_MAX_MTLLIBS][256]; /* names already loaded */
+    int lib_count;
+} prescan;
+
+/* Splits a line (modified in place) into whitespace-separated tokens. A
+ * backslash escapes the next character (tinyobjloader allows "\ " in names).
+ * Returns the count, or -1 when there are more than max. */
+static int split(char *s, char **tok, int max)
+{
+    int n = 0;
+    for (;;) {
+        while (*s == ' ' || *s == '\t' || *s == '\r')
+            s++;
+        if (!*s)
+            return n;
+        if (n == max)
+            return -1;
+        tok[n++] = s;
+        char *w = s;
+        while (*s && *s != ' ' && *s != '\t' && *s != '\r') {
+            if (*s == '\\' && s[1])
+                s++;
+            *w++ = *s++;
+        }
+        if (*s)
+            s++;
+        *w = '\0';
+    }
+}
+
+/* Copies line `at` of buf (up to the newline) into dst; returns the start of the
+ * next line, or NULL at the end. */
+static const char *next_line(const char *at, char *dst, size_t dst_size, bool *too_long)
+{
+    const char *nl = strchr(at, '\n');
+    size_t n = nl ? (size_t)(nl - at) : strlen(at);
+    *too_long = n >= dst_size;
+    if (*too_long)
+        n = dst_size - 1;
+    memcpy(dst, at, n);
+    dst[n] = '\0';
+    return nl ? nl + 1 : (*at ? at + strlen(at) : NULL);
+}
+
+static ps_status check_numbers(const char *path, int line, char **tok, int ntok, int min, int max,
+                               ps_error *err)
+{
+    int n = ntok - 1;
+    if (n < min || n > max) {
+        if (min == max)
+            return ps_error_set(err, PS_ERR_PARSE, "%s:%d: '%s' needs %d numbers, got %d", path, line, tok[0], min, n);
+        return ps_error_set(err, PS_ERR_PARSE, "%s:%d: '%s' needs %d to %d numbers, got %d", path, line, tok[0], min,
+                            max, n);
+    }
+    for (int k = 1; k < ntok; k++) {
+        double v;
+        if (!ps_parse_double(tok[k], &v))
+            return ps_error_set(err, PS_ERR_PARSE, "%s:%d: '%s': '%s' is not a finite number", path, line, tok[0],
+                                tok[k]);
+    }
+    return PS_OK;
+}
+
+/* One index of a face corner: non-zero integer, resolved against count. */
+static ps_status check_index(prescan *ps, int line, const char *text, size_t count, const char *what)
+{
+    int64_t v;
+    if (!ps_parse_int64(text, &v) || v == 0)
+        return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: face %s index '%s' is not a non-zero integer", ps->path,
+                            line, what, text);
+    if ((v > 0 && (uint64_t)v > count) || (v < 0 && (uint64_t)(-v) > count))
+        return ps_error_set(ps->err, PS_ERR_RANGE, "%s:%d: face %s index %s is out of range (%zu defined so far)",
+                            ps->path, line, what, text, count);
+    return PS_OK;
+}
+
+static ps_status check_face(prescan *ps, int line, char **tok, int ntok)
+{
+    int corners = ntok - 1;
+    if (corners > OBJ_MAX_FACE_VERTICES)
+        return ps_error_set(ps->err, PS_ERR_LIMIT, "%s:%d: face has %d vertices, at most %d are supported", ps->path,
+                            line, corners, OBJ_MAX_FACE_VERTICES);
+    for (int k = 1; k < ntok; k++) {
+        /* v, v/vt, v//vn or v/vt/vn */
+        char *parts[3] = {tok[k], NULL, NULL};
+        char *s1 = strchr(tok[k], '/');
+        if (s1) {
+            *s1 = '\0';
+            parts[1] = s1 + 1;
+            char *s2 = strchr(parts[1], '/');
+            if (s2) {
+                *s2 = '\0';
+                parts[2] = s2 + 1;
+                if (strchr(parts[2], '/'))
+                    return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: malformed face corner", ps->path, line);
+            }
+        }
+        ps_status st = check_index(ps, line, parts[0], ps->v, "vertex");
+        if (st == PS_OK && parts[1] && parts[1][0])
+            st = check_index(ps, line, parts[1], ps->vt, "texture");
+        if (st == PS_OK && parts[2])
+            st = check_index(ps, line, parts[2], ps->vn, "normal");
+        if (st != PS_OK)
+            return st;
+    }
+    if (corners < 3)
+        ps_warn(ps->warn, "%s:%d: face with %d vertices ignored", ps->path, line, corners);
+    else
+        ps->faces++;
+    return PS_OK;
+}
+
+/* The directory part of path, with its slash ("" for none). */
+static void dir_of(const char *path, char *dst, size_t n)
+{
+    const char *slash = strrchr(path, '/');
+    size_t len = slash ? (size_t)(slash - path + 1) : 0;
+    if (len >= n)
+        len = 0;
+    memcpy(dst, path, len);
+    dst[len] = '\0';
+}
+
+static ps_status scan_mtl_text(prescan *ps, const char *mpath, const char *text)
+{
+    char buf[4096];
+    char *tok[OBJ_MAX_TOKENS];
+    int line = 0;
+    bool too_long;
+    for (const char *at = text; at && *at;) {
+        at = next_line(at, buf, sizeof buf, &too_long);
+        line++;
+        if (too_long)
+            return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: line too long", mpath, line);
+        int ntok = split(buf, tok, OBJ_MAX_TOKENS);
+        if (ntok < 0)
+            return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: too many values on one line", mpath, line);
+        if (ntok == 0 || tok[0][0] == '#')
+            continue;
+        const char *k = tok[0];
+        ps_status st = PS_OK;
+        if (strcmp(k, "newmtl") == 0) {
+            if (ntok < 2)
+                return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: newmtl without a name", mpath, line);
+            if (!PS_RESERVE(ps->mtls, ps->mtl_cap, ps->mtl_count + 1))
+                return ps_error_set(ps->err, PS_ERR_NOMEM, "%s: out of memory", mpath);
+            mtl_info *m = &ps->mtls[ps->mtl_count++];
+            memset(m, 0, sizeof *m);
+            snprintf(m->name, sizeof m->name, "%s", tok[1]);
+        } else if (!strcmp(k, "Kd") || !strcmp(k, "Ks") || !strcmp(k, "Ke") || !strcmp(k, "Ka") || !strcmp(k, "Tf")) {
+            if (ntok > 1 && (!strcmp(tok[1], "spectral") || !strcmp(tok[1], "xyz")))
+                return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: '%s %s' colours are not supported, use r g b", mpath,
+                                    line, k, tok[1]);
+            st = check_numbers(mpath, line, tok, ntok, 3, 3, ps->err);
+            for (int c = 1; st == PS_OK && c < 4; c++) {
+                double v;
+                ps_parse_double(tok[c], &v);
+                if (v < 0.0)
+                    st = ps_error_set(ps->err, PS_ERR_RANGE, "%s:%d: '%s' components must not be negative", mpath, line,
+                                      k);
+            }
+        } else if (!strcmp(k, "Ns") || !strcmp(k, "Ni") || !strcmp(k, "d") || !strcmp(k, "Tr")) {
+            st = check_numbers(mpath, line, tok, ntok, 1, 1, ps->err);
+            if (st == PS_OK && ps->mtl_count) {
+                if (k[1] == 's')
+                    ps->mtls[ps->mtl_count - 1].has_ns = 1;
+                if (k[1] == 'i')
+                    ps->mtls[ps->mtl_count - 1].has_ni = 1;
+            }
+        } else if (!strcmp(k, "illum")) {
+            int64_t v;
+            if (ntok != 2 || !ps_parse_int64(tok[1], &v) || v < 0 || v > 10)
+                st = ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: illum needs one integer from 0 to 10", mpath, line);
+        }
+        /* Texture maps and other statements are ignored: photosplat has no textures. */
+        if (st != PS_OK)
+            return st;
+    }
+    return PS_OK;
+}
+
+static ps_status load_mtllib(prescan *ps, int line, char **tok, int ntok)
+{
+    char dir[1024], mpath[2048];
+    dir_of(ps->path, dir, sizeof dir);
+    if (ntok < 2) {
+        ps_warn(ps->warn, "%s:%d: mtllib without a file name; faces use the default material", ps->path, line);
+        return PS_OK;
+    }
+    for (int k = 1; k < ntok; k++) {
+        bool seen = false;
+        for (int i = 0; i < ps->lib_count; i++)
+            seen |= strcmp(ps->libs[i], tok[k]) == 0;
+        if (seen)
+            continue;
+        if (ps->lib_count == OBJ_MAX_MTLLIBS)
+            return ps_error_set(ps->err, PS_ERR_LIMIT, "%s:%d: more than %d material libraries", ps->path, line,
+                                OBJ_MAX_MTLLIBS);
+        snprintf(ps->libs[ps->lib_count++], sizeof ps->libs[0], "%s", tok[k]);
+        snprintf(mpath, sizeof mpath, "%s%s", dir, tok[k]);
+        char *text = NULL;
+        size_t len = 0;
+        ps_error merr;
+        ps_status st = ps_read_file(mpath, MTL_MAX_BYTES, &text, &len, &merr);
+        if (st == PS_ERR_IO) {
+            ps_warn(ps->warn, "%s:%d: material library '%s' not found; its materials fall back to the default", ps->path,
+                    line, tok[k]);
+            continue;
+        }
+        if (st != PS_OK) {
+            *ps->err = merr;
+            return st;
+        }
+        if (memchr(text, '\0', len)) {
+            free(text);
+            return ps_error_set(ps->err, PS_ERR_PARSE, "%s: binary data, not an MTL file", mpath);
+        }
+        st = scan_mtl_text(ps, mpath, text);
+        if (st == PS_OK) {
+            if (!PS_RESERVE(ps->mtl_text, ps->mtl_cap_bytes, ps->mtl_len + len + 2)) {
+                free(text);
+                return ps_error_set(ps->err, PS_ERR_NOMEM, "%s: out of memory", mpath);
+            }
+            memcpy(ps->mtl_text + ps->mtl_len, text, len);
+            ps->mtl_len += len;
+            ps->mtl_text[ps->mtl_len++] = '\n';
+            ps->mtl_text[ps->mtl_len] = '\0';
+        }
+        free(text);
+        if (st != PS_OK)
+            return st;
+    }
+    return PS_OK;
+}
+
+static ps_status scan_obj(prescan *ps, const char *text)
+{
+    /* Long enough for any sane face; longer lines are refused, not split. */
+    static const size_t line_max = 65536;
+    char *buf = malloc(line_max);
+    char **tok = malloc(sizeof *tok * (OBJ_MAX_FACE_VERTICES + 2));
+    if (!buf || !tok) {
+        free(buf);
+        free(tok);
+        return ps_error_set(ps->err, PS_ERR_NOMEM, "%s: out of memory", ps->path);
+    }
+    ps_status st = PS_OK;
+    int line = 0;
+    bool too_long;
+    for (const char *at = text; st == PS_OK && at && *at;) {
+        at = next_line(at, buf, line_max, &too_long);
+        line++;
+        if (too_long) {
+            st = ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: line too long", ps->path, line);
+            break;
+        }
+        int ntok = split(buf, tok, OBJ_MAX_FACE_VERTICES + 2);
+        if (ntok < 0) {
+            st = ps_error_set(ps->err, PS_ERR_LIMIT, "%s:%d: more than %d values on one line", ps->path, line,
+                              OBJ_MAX_FACE_VERTICES + 1);
+            break;
+        }
+        if (ntok == 0 || tok[0][0] == '#')
+            continue;
+        const char *k = tok[0];
+        if (!strcmp(k, "v")) {
+            /* x y z, optionally w or an r g b vertex colour */
+            st = check_numbers(ps->path, line, tok, ntok, 3, 6, ps->err);
+            ps->v++;
+        } else if (!strcmp(k, "vn")) {
+            st = check_numbers(ps->path, line, tok, ntok, 3, 3, ps->err);
+            ps->vn++;
+        } else if (!strcmp(k, "vt")) {
+            st = check_numbers(ps->path, line, tok, ntok, 1, 3, ps->err);
+            ps->vt++;
+        } else if (!strcmp(k, "f")) {
+            st = check_face(ps, line, tok, ntok);
+        } else if (!strcmp(k, "mtllib")) {
+            st = load_mtllib(ps, line, tok, ntok);
+        } else if (!strcmp(k, "usemtl")) {
+            bool found = false;
+            for (size_t i = 0; ntok > 1 && i < ps->mtl_count; i++)
+                found |= strcmp(ps->mtls[i].name, tok[1]) == 0;
+            if (!found)
+                ps_warn(ps->warn, "%s:%d: usemtl '%s' is not defined in any material library; default material",
+                        ps->path, line, ntok > 1 ? tok[1] : "");
+        }
+        /* o, g, s, l, p and unknown statements are ignored, as tinyobjloader does. */
+    }
+    free(buf);
+    free(tok);
+    return st;
+}
+
+void ps_obj_free(ps_obj_mesh *m)
+{
+    if (!m)
+        return;
+    free(m->positions);
+    free(m->normals);
+    free(m->tri_v);
+    free(m->tri_n);
+    free(m->tri_mat);
+    free(m->materials);
+    memset(m, 0, sizeof *m);
+}
+
+ps_status ps_obj_load(const char *path, ps_obj_mesh *out, const ps_warn_sink *warn, ps_error *err)
+{
+    memset(out, 0, sizeof *out);
+    char *text = NULL;
+    size_t len = 0;
+    ps_status st = ps_read_file(path, OBJ_MAX_BYTES, &text, &len, err);
+    if (st != PS_OK)
+        return st;
+    prescan ps;
+    memset(&ps, 0, sizeof ps);
+    ps.path = path;
+    ps.warn = warn;
+    ps.err = err;
+    if (memchr(text, '\0', len))
+        st = ps_error_set(err, PS_ERR_PARSE, "%s: binary data, not an OBJ file", path);
+    if (st == PS_OK)
+        st = scan_obj(&ps, text);
+    if (st == PS_OK && ps.faces == 0)
+        st = ps_error_set(err, PS_ERR_PARSE, "%s: no faces: not a mesh (empty file, or not an OBJ file?)", path);
+    if (st == PS_OK) {
+        char msg[512];
+        if (ps_tinyobj_parse(text, len, ps.mtl_text ? ps.mtl_text : "", ps.mtl_len, out, msg, sizeof msg) != 0)
+            st = ps_error_set(err, strstr(msg, "memory") ? PS_ERR_NOMEM : PS_ERR_PARSE, "%s: %s", path, msg);
+    }
+    /* The pre-scan guarantees these; check again so that a difference of
+     * opinion with tinyobjloader can never index out of bounds. */
+    for (size_t t = 0; st == PS_OK && t < out->triangle_count; t++) {
+        for (int c = 0; c < 3; c++) {
+            int32_t v = out->tri_v[t * 3 + c], n = out->tri_n[t * 3 + c];
+            if (v < 0 || (size_t)v >= out->position_count || n < -1 || (n >= 0 && (size_t)n >= out->normal_count))
+                st = ps_error_set(err, PS_ERR_RANGE, "%s: triangle %zu has an index out of range", path, t);
+        }
+        int32_t m = out->tri_mat[t];
+        if (st == PS_OK && (m < -1 || (m >= 0 && (size_t)m >= out->material_count)))
+            st = ps_error_set(err, PS_ERR_RANGE, "%s: triangle %zu has a material out of range", path, t);
+    }
+    if (st == PS_OK && out->triangle_count == 0)
+        st = ps_error_set(err, PS_ERR_PARSE, "%s: no triangles", path);
+    for (size_t i = 0; st == PS_OK && i < out->material_count; i++) {
+        for (size_t j = 0; j < ps.mtl_count; j++) {
+            if (strcmp(ps.mtls[j].name, out->materials[i].name) == 0) {
+                out->materials[i].has_ns = ps.mtls[j].has_ns;
+                out->materials[i].has_ni = ps.mtls[j].has_ni;
+            }
+        }
+    }
+    if (st != PS_OK)
+        ps_obj_free(out);
+    free(ps.mtls);
+    free(ps.mtl_text);
+    free(text);
+    return st;
+}

@@ -1,0 +1,158 @@
+/* scene.h: the scene model: camera, materials, geometry, lights and defaults,
+ * as read from a .scn file (../shared/contract.md, docs/scene-format.md).
+ *
+ * A ps_scene is opaque: its arrays keep invariants (every index in range, every
+ * number finite, light flux consistent with its geometry) that only the loader
+ * establishes. Readers get const views; the arrays stay valid until destroy. */
+#ifndef PS_SCENE_SCENE_H
+#define PS_SCENE_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/status.h"
+#include "core/vec.h"
+
+#define PS_NAME_MAX 64
+
+/* Limits that keep absurd input from exhausting memory; each is refused with
+ * PS_ERR_LIMIT and a message, never by a failed allocation midway. */
+#define PS_SCENE_MAX_LIGHTS 100000
+#define PS_SCENE_MAX_MATERIALS 65536
+#define PS_SCENE_MAX_OBJECTS 1000000
+#define PS_SCENE_MAX_TRIANGLES 50000000
+#define PS_SCENE_MAX_IMAGE_SIDE 16384
+#define PS_SCENE_MAX_PHOTONS 1000000000LL
+
+typedef struct ps_camera {
+    ps_vec3 eye, target, up; /* up need not be orthogonal to the view direction */
+    double fov_deg;          /* vertical field of view, degrees, in (0, 180) */
+} ps_camera;
+
+typedef enum ps_material_type {
+    PS_MAT_DIFFUSE,   /* Lambertian: albedo */
+    PS_MAT_GLOSSY,    /* Lambertian albedo + normalised Phong lobe (specular, exponent) */
+    PS_MAT_MIRROR,    /* perfect reflection scaled by reflectance */
+    PS_MAT_DIELECTRIC /* smooth glass: Fresnel reflection + refraction with ior */
+} ps_material_type;
+
+typedef struct ps_material {
+    char name[PS_NAME_MAX];
+    ps_material_type type;
+    ps_rgb albedo;        /* diffuse reflectance (diffuse, glossy); albedo + specular <= 1 */
+    ps_rgb specular;      /* Phong reflectance (glossy) */
+    double exponent;      /* Phong exponent (glossy) */
+    ps_rgb reflectance;   /* mirror */
+    double ior;           /* dielectric: index of refraction inside, air outside */
+    ps_rgb transmittance; /* dielectric: colour of refracted light (1 = clear) */
+    ps_rgb emission;      /* emitted radiance (MTL Ke), zero for non-emitters */
+} ps_material;
+
+/* Mirrors and dielectrics: what caustic photons are aimed at. */
+static inline int ps_material_is_specular(const ps_material *m)
+{
+    return m->type == PS_MAT_MIRROR || m->type == PS_MAT_DIELECTRIC;
+}
+
+/* A triangle of the scene's one triangle soup. Vertices are per object (never
+ * shared between objects), so moving an object moves only its own. */
+typedef struct ps_triangle {
+    uint32_t v[3];   /* indices into ps_scene_positions */
+    int32_t n[3];    /* indices into ps_scene_normals, or -1: use the face normal */
+    uint32_t material;
+    uint32_t object;
+} ps_triangle;
+
+typedef enum ps_object_type {
+    PS_OBJ_MESH,   /* triangles from an OBJ file */
+    PS_OBJ_QUAD,   /* two triangles */
+    PS_OBJ_SPHERE  /* analytic: no triangles; ps_sphere_tessellate for OpenGL */
+} ps_object_type;
+
+typedef struct ps_object {
+    ps_object_type type;
+    int line;          /* the scene line that made it, for messages */
+    uint32_t first_triangle, triangle_count; /* mesh, quad */
+    uint32_t material;                       /* quad, sphere; mesh: its override or its first face's */
+    ps_vec3 center;                          /* sphere */
+    double radius;                           /* sphere */
+    ps_aabb bounds;
+    int specular;      /* any of its surfaces is a mirror or dielectric */
+} ps_object;
+
+typedef enum ps_light_type {
+    PS_LIGHT_POINT,
+    PS_LIGHT_SPOT,
+    PS_LIGHT_QUAD,
+    PS_LIGHT_SPHERE,
+    PS_LIGHT_DISC,
+    PS_LIGHT_MESH /* the faces of one mesh with one emissive MTL material (Ke > 0) */
+} ps_light_type;
+
+typedef struct ps_light {
+    ps_light_type type;
+    int line;            /* the scene line that made it */
+    ps_rgb power;        /* total emitted flux, W per channel */
+    ps_vec3 position;    /* point, spot: position; quad: corner; sphere, disc: centre */
+    ps_vec3 direction;   /* unit: spot axis; quad and disc normal (the emitting side) */
+    ps_vec3 edge1, edge2;/* quad */
+    double radius;       /* sphere, disc */
+    double angle_deg;    /* spot: half-angle of the cone, in (0, 90] */
+    double cos_angle;    /* spot: cos(angle_deg) */
+    double area;         /* emitting area (area lights; 0 for point and spot) */
+    ps_rgb radiance;     /* area lights: emitted radiance, power / (pi * area) */
+    uint32_t first_emitter, emitter_count; /* mesh: range in ps_scene_emitters */
+    uint32_t object;     /* mesh: the object whose faces emit */
+} ps_light;
+
+/* What programs use unless their options say otherwise (statements `image`,
+ * `photons`, `radius`). Radii default to fractions of the scene's size. */
+typedef struct ps_scene_defaults {
+    int width, height;
+    int64_t caustic_photons, global_photons;
+    double caustic_radius, global_radius;
+} ps_scene_defaults;
+
+typedef struct ps_scene ps_scene;
+
+typedef struct ps_scene_load_options {
+    ps_warn_sink warn; /* where warnings go ({NULL, NULL}: stderr) */
+} ps_scene_load_options;
+
+/* Reads a .scn file and everything it refers to. On error returns the status,
+ * sets err to "file:line: problem" and *out to NULL. opts may be NULL. */
+ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_scene **out, ps_error *err);
+
+/* The same from text in memory; `name` stands for the file in messages and
+ * paths in the text are relative to `base_dir` ("" for the current one). */
+ps_status ps_scene_load_text(const char *text, const char *name, const char *base_dir,
+                             const ps_scene_load_options *opts, ps_scene **out, ps_error *err);
+
+void ps_scene_destroy(ps_scene *s); /* accepts NULL */
+
+const char *ps_scene_path(const ps_scene *s);
+const ps_camera *ps_scene_camera(const ps_scene *s);
+const ps_scene_defaults *ps_scene_get_defaults(const ps_scene *s);
+/* The box around all geometry and lights; what scene-scaled epsilons scale with. */
+ps_aabb ps_scene_bounds(const ps_scene *s);
+
+const ps_material *ps_scene_materials(const ps_scene *s, size_t *count);
+const ps_vec3 *ps_scene_positions(const ps_scene *s, size_t *count);
+const ps_vec3 *ps_scene_normals(const ps_scene *s, size_t *count); /* unit length */
+const ps_triangle *ps_scene_triangles(const ps_scene *s, size_t *count);
+const ps_object *ps_scene_objects(const ps_scene *s, size_t *count);
+const ps_light *ps_scene_lights(const ps_scene *s, size_t *count);
+/* Triangle indices of the faces of PS_LIGHT_MESH lights. */
+const uint32_t *ps_scene_emitters(const ps_scene *s, size_t *count);
+
+/* Total emitted flux of all lights, per channel. */
+ps_rgb ps_scene_total_power(const ps_scene *s);
+/* Area of triangle t. */
+double ps_scene_triangle_area(const ps_scene *s, uint32_t t);
+/* Unit geometric normal of triangle t (from its winding: (v1-v0) x (v2-v0)). */
+ps_vec3 ps_scene_triangle_normal(const ps_scene *s, uint32_t t);
+
+const char *ps_material_type_name(ps_material_type t);
+const char *ps_light_type_name(ps_light_type t);
+
+#endif
