@@ -539,12 +539,15 @@ static ps_status add_mesh_geometry(parser *p, const ps_obj_mesh *om, const ps_xf
 }
 
 /* One PS_LIGHT_MESH per emissive material of the mesh: its faces, their area.
- * mats/nmats: the scene materials the mesh's faces may use (see parse_mesh). */
+ * mats/nmats: the scene materials of the mesh's faces, UINT32_MAX for unused
+ * slots (see parse_mesh). */
 static ps_status add_mesh_lights(parser *p, const ps_object *o, uint32_t object, const uint32_t *mats, size_t nmats)
 {
     ps_scene *s = p->s;
     for (size_t k = 0; k < nmats; k++) {
         uint32_t m = mats[k];
+        if (m == UINT32_MAX)
+            continue;
         const ps_material *mat = &s->materials.items[m];
         bool repeat = false;
         for (size_t j = 0; j < k; j++)
@@ -652,8 +655,17 @@ static ps_status parse_mesh(parser *p)
     ps_obj_mesh om;
     ps_error oerr;
     st = ps_obj_load(path, &om, p->warn, &oerr);
-    if (st != PS_OK)
-        return ps_error_set(p->err, st, "%s (mesh at %s:%d)", oerr.msg, p->name, p->line);
+    if (st != PS_OK) {
+        /* An OBJ/MTL problem with a line of its own names that line first; one
+         * without (a missing file) is the scene line's problem. */
+        const char *colon = strchr(oerr.msg, ':');
+        bool has_line = colon && colon[1] >= '0' && colon[1] <= '9';
+        for (const char *c = oerr.msg; has_line && c < colon; c++)
+            has_line = *c != ' ';
+        if (has_line)
+            return ps_error_set(p->err, st, "%s (mesh at %s:%d)", oerr.msg, p->name, p->line);
+        return ps_error_set(p->err, st, "%s:%d: mesh: %s", p->name, p->line, oerr.msg);
+    }
 
     /* mats[k + 1]: scene material of OBJ material k; mats[0]: faces with none. */
     uint32_t *mats = calloc(om.material_count + 1, sizeof *mats);
@@ -661,8 +673,15 @@ static ps_status parse_mesh(parser *p)
         ps_obj_free(&om);
         return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
     }
+    /* Only the materials that faces use become scene materials (a library may
+     * hold many more, and tinyobjloader adds an empty-named one of its own). */
     const char *base = strrchr(file, '/') ? strrchr(file, '/') + 1 : file;
-    for (size_t k = 0; st == PS_OK && k <= om.material_count; k++) {
+    for (size_t k = 0; k <= om.material_count; k++)
+        mats[k] = UINT32_MAX;
+    for (size_t t = 0; st == PS_OK && t < om.triangle_count; t++) {
+        size_t k = (size_t)(om.tri_mat[t] + 1);
+        if (mats[k] != UINT32_MAX)
+            continue;
         if (override_mat >= 0) {
             mats[k] = (uint32_t)override_mat;
         } else if (k == 0) {
@@ -925,10 +944,11 @@ static void apply_defaults(parser *p)
     ps_scene_defaults *d = &p->s->defaults;
     if (!p->has_image)
         d->width = d->height = DEFAULT_IMAGE_SIDE;
-    if (!p->has_photons) {
+    /* Each value a statement leaves out keeps its default. */
+    if (d->caustic_photons < 0)
         d->caustic_photons = DEFAULT_CAUSTIC_PHOTONS;
+    if (d->global_photons < 0)
         d->global_photons = DEFAULT_GLOBAL_PHOTONS;
-    }
     double diag = ps_v3_len(ps_aabb_diag(p->s->bounds));
     if (!(diag > 0.0))
         diag = 1.0; /* a lone point light: no size to scale with */
@@ -938,10 +958,21 @@ static void apply_defaults(parser *p)
         d->global_radius = DEFAULT_GLOBAL_RADIUS_FRACTION * diag;
 }
 
+/* The line holding the first NUL byte, or 0 when there is none. */
+static int nul_line(const char *text, size_t len)
+{
+    const char *nul = memchr(text, '\0', len);
+    if (!nul)
+        return 0;
+    int line = 1;
+    for (const char *c = text; c < nul; c++)
+        line += *c == '\n';
+    return line;
+}
+
 static ps_status parse_text(parser *p, const char *text, size_t len)
 {
-    if (memchr(text, '\0', len))
-        return ps_error_set(p->err, PS_ERR_PARSE, "%s: binary data, not a scene file", p->name);
+    (void)len; /* NUL-free (checked by the caller), so the text ends at its NUL */
     char *buf = malloc(SCN_LINE_MAX);
     if (!buf)
         return ps_error_set(p->err, PS_ERR_NOMEM, "%s: out of memory", p->name);
@@ -978,8 +1009,9 @@ static ps_status parse_text(parser *p, const char *text, size_t len)
     return PS_OK;
 }
 
-ps_status ps_scene_load_text(const char *text, const char *name, const char *base_dir,
-                             const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
+/* Shared by both entry points; text has len bytes and a NUL after them. */
+static ps_status load_text(const char *text, size_t len, const char *name, const char *base_dir,
+                           const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
 {
     *out = NULL;
     ps_error local;
@@ -1001,13 +1033,22 @@ ps_status ps_scene_load_text(const char *text, const char *name, const char *bas
     p.warn = opts ? &opts->warn : &to_stderr;
     p.err = err;
     p.default_material = -1;
-    ps_status st = parse_text(&p, text, strlen(text));
+    p.s->defaults.caustic_photons = p.s->defaults.global_photons = -1; /* unset */
+    int bin = nul_line(text, len);
+    ps_status st = bin ? ps_error_set(err, PS_ERR_PARSE, "%s:%d: binary data (a NUL byte), not a scene file", name, bin)
+                       : parse_text(&p, text, len);
     if (st != PS_OK) {
         ps_scene_destroy(p.s);
         return st;
     }
     *out = p.s;
     return PS_OK;
+}
+
+ps_status ps_scene_load_text(const char *text, const char *name, const char *base_dir,
+                             const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
+{
+    return load_text(text, strlen(text), name, base_dir, opts, out, err);
 }
 
 ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
@@ -1018,10 +1059,6 @@ ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_
     ps_status st = ps_read_file(path, SCN_MAX_BYTES, &text, &len, err);
     if (st != PS_OK)
         return st;
-    if (memchr(text, '\0', len)) {
-        free(text);
-        return ps_error_set(err, PS_ERR_PARSE, "%s: binary data, not a scene file", path);
-    }
     char dir[4096];
     const char *slash = strrchr(path, '/');
     size_t dlen = slash ? (size_t)(slash - path) : 0;
@@ -1031,7 +1068,7 @@ ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_
         dlen = 0;
     memcpy(dir, path, dlen);
     dir[dlen] = '\0';
-    st = ps_scene_load_text(text, path, dir, opts, out, err);
+    st = load_text(text, len, path, dir, opts, out, err);
     free(text);
     return st;
 }
