@@ -54,7 +54,10 @@ for variant in release asan; do
         case "$t" in *.d) continue ;; esac
         run_one "$variant" "$(basename "$t")" "$t"
     done
-    run_one "$variant" cli tests/cli.sh "build/$variant/bin"
+    for c in tests/cli_*.sh; do
+        [ "$c" = tests/cli_lib.sh ] && continue
+        run_one "$variant" "$(basename "$c" .sh)" "$c" "build/$variant/bin"
+    done
 done
 
 if [ ${#failed_names[@]} -gt 0 ]; then

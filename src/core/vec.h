@@ -40,11 +40,19 @@ static inline ps_vec3 ps_v3_cross(ps_vec3 a, ps_vec3 b)
 }
 static inline double ps_v3_len2(ps_vec3 a) { return ps_v3_dot(a, a); }
 static inline double ps_v3_len(ps_vec3 a) { return sqrt(ps_v3_dot(a, a)); }
-/* Unit vector along a; the zero vector stays zero rather than becoming NaN. */
+/* Unit vector along a; the zero vector stays zero rather than becoming NaN.
+ * Components so small (or large) that their squares under- or overflow are
+ * rescaled first, so that any non-zero finite vector normalises. */
 static inline ps_vec3 ps_v3_norm(ps_vec3 a)
 {
-    double l = ps_v3_len(a);
-    return l > 0.0 ? ps_v3_scale(a, 1.0 / l) : a;
+    double l2 = ps_v3_dot(a, a);
+    if (l2 > 1e-280 && l2 < 1e280)
+        return ps_v3_scale(a, 1.0 / sqrt(l2));
+    double m = fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
+    if (!(m > 0.0) || !isfinite(m))
+        return a;
+    a = ps_v3_scale(a, 1.0 / m);
+    return ps_v3_scale(a, 1.0 / sqrt(ps_v3_dot(a, a)));
 }
 static inline ps_vec3 ps_v3_min(ps_vec3 a, ps_vec3 b) { return ps_v3(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z)); }
 static inline ps_vec3 ps_v3_max(ps_vec3 a, ps_vec3 b) { return ps_v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }

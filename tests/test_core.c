@@ -1,0 +1,231 @@
+/* test_core.c: vectors, boxes, transforms, strict numbers and atomic output. */
+#include "test.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/fileio.h"
+#include "core/number.h"
+#include "core/rng.h"
+#include "core/transform.h"
+#include "core/vec.h"
+
+static void vector_algebra(void **state)
+{
+    (void)state;
+    ps_vec3 x = ps_v3(1, 0, 0), y = ps_v3(0, 1, 0);
+    ps_vec3 z = ps_v3_cross(x, y);
+    assert_near(z.z, 1, 0);
+    assert_near(ps_v3_dot(ps_v3(1, 2, 3), ps_v3(4, -5, 6)), 12, 0);
+    assert_near(ps_v3_len(ps_v3(3, 4, 12)), 13, 1e-15);
+    ps_vec3 zero = ps_v3_norm(ps_v3(0, 0, 0));
+    assert_true(zero.x == 0 && zero.y == 0 && zero.z == 0); /* no NaN from a zero vector */
+    assert_near(ps_v3_len(ps_v3_norm(ps_v3(1e-300, 1e-300, 0))), 1, 1e-12);
+    assert_near(ps_v3_norm(ps_v3(3e200, 4e200, 0)).y, 0.8, 1e-15);
+    assert_near(ps_v3_get(ps_v3(7, 8, 9), 2), 9, 0);
+}
+
+/* The splat basis must be orthonormal for every normal, including each axis
+ * in both directions and normals a hair away from them. */
+static void basis_is_orthonormal(void **state)
+{
+    (void)state;
+    ps_vec3 special[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1},
+                         {1e-9, 0, -1}, {0, 1e-12, -1}, {1e-12, 1e-12, 1}};
+    ps_rng r = ps_rng_make(1, PS_STREAM_TEST, 0);
+    for (int k = 0; k < 2000; k++) {
+        ps_vec3 n = k < 9 ? special[k]
+                          : ps_v3(ps_rng_uniform(&r) - 0.5, ps_rng_uniform(&r) - 0.5, ps_rng_uniform(&r) - 0.5);
+        if (k >= 9 && ps_v3_len(n) < 1e-3)
+            continue;
+        n = ps_v3_norm(n);
+        ps_vec3 t, b;
+        ps_v3_basis(n, &t, &b);
+        assert_near(ps_v3_len(t), 1, 1e-12);
+        assert_near(ps_v3_len(b), 1, 1e-12);
+        assert_near(ps_v3_dot(t, n), 0, 1e-12);
+        assert_near(ps_v3_dot(b, n), 0, 1e-12);
+        assert_near(ps_v3_dot(t, b), 0, 1e-12);
+        /* right-handed: t x b = n */
+        assert_near(ps_v3_dot(ps_v3_cross(t, b), n), 1, 1e-12);
+    }
+}
+
+/* The slab test against a brute-force walk along the ray. */
+static void aabb_slab_test(void **state)
+{
+    (void)state;
+    ps_aabb b = {{-1, -2, -3}, {1, 2, 3}};
+    assert_near(ps_aabb_area(b), 2 * (2 * 4 + 4 * 6 + 6 * 2), 0);
+    assert_true(ps_aabb_is_empty(ps_aabb_empty()));
+    assert_near(ps_aabb_area(ps_aabb_empty()), 0, 0);
+    assert_near(ps_aabb_extent(b), 3, 0);
+    ps_rng r = ps_rng_make(2, PS_STREAM_TEST, 0);
+    int hits = 0;
+    for (int k = 0; k < 5000; k++) {
+        ps_vec3 o = ps_v3(8 * ps_rng_uniform(&r) - 4, 8 * ps_rng_uniform(&r) - 4, 8 * ps_rng_uniform(&r) - 4);
+        ps_vec3 d = ps_v3(ps_rng_uniform(&r) - 0.5, ps_rng_uniform(&r) - 0.5, ps_rng_uniform(&r) - 0.5);
+        if (k % 7 == 0)
+            d.y = 0; /* axis-parallel rays: 1/0 = inf in the slab test */
+        ps_ray ray = ps_ray_make(o, d);
+        ps_vec3 inv = ps_v3(1 / d.x, 1 / d.y, 1 / d.z);
+        double t0, t1;
+        bool hit = ps_aabb_hit(b, ray, inv, 0, 100, &t0, &t1);
+        /* brute force: sample the segment finely */
+        bool brute = false;
+        for (int s = 0; s <= 20000 && !brute; s++)
+            brute = ps_aabb_contains(b, ps_ray_at(ray, 100.0 * s / 20000));
+        if (brute)
+            assert_true(hit);
+        if (hit) {
+            hits++;
+            assert_true(ps_aabb_contains((ps_aabb){{-1 - 1e-9, -2 - 1e-9, -3 - 1e-9}, {1 + 1e-9, 2 + 1e-9, 3 + 1e-9}},
+                                         ps_ray_at(ray, 0.5 * (t0 + t1))));
+        }
+    }
+    assert_true(hits > 500);
+}
+
+static void transforms(void **state)
+{
+    (void)state;
+    /* compose(a, b) applies b first. */
+    ps_xform s = ps_xform_scale(ps_v3(2, 2, 2)), t = ps_xform_translate(ps_v3(1, 0, 0));
+    ps_xform ts = ps_xform_compose(t, s), st = ps_xform_compose(s, t);
+    assert_near(ps_xform_point(&ts, ps_v3(1, 0, 0)).x, 3, 0);
+    assert_near(ps_xform_point(&st, ps_v3(1, 0, 0)).x, 4, 0);
+    /* Right-handed rotation: +90 deg about z takes x to y. */
+    ps_xform rz = ps_xform_rotate(ps_v3(0, 0, 5), 90);
+    ps_vec3 p = ps_xform_point(&rz, ps_v3(1, 0, 0));
+    assert_near(p.x, 0, 1e-15);
+    assert_near(p.y, 1, 1e-15);
+    assert_near(ps_xform_det(rz), 1, 1e-15);
+    assert_near(ps_xform_det(ps_xform_scale(ps_v3(-1, 2, 3))), -6, 0);
+    /* Vectors ignore translation. */
+    assert_near(ps_xform_vector(&ts, ps_v3(1, 0, 0)).x, 2, 0);
+    /* Normals stay perpendicular to transformed tangents under a shear-like
+     * composite, for random planes. */
+    ps_xform m = ps_xform_compose(ps_xform_rotate(ps_v3(1, 2, 3), 37), ps_xform_scale(ps_v3(3, -0.5, 2)));
+    ps_rng r = ps_rng_make(3, PS_STREAM_TEST, 0);
+    for (int k = 0; k < 200; k++) {
+        ps_vec3 n = ps_v3_norm(ps_v3(ps_rng_uniform(&r) - .5, ps_rng_uniform(&r) - .5, ps_rng_uniform(&r) - .5));
+        ps_vec3 a, b;
+        ps_v3_basis(n, &a, &b);
+        ps_vec3 n2 = ps_xform_normal(&m, n);
+        assert_near(ps_v3_len(n2), 1, 1e-12);
+        assert_near(ps_v3_dot(n2, ps_xform_vector(&m, a)), 0, 1e-12);
+        assert_near(ps_v3_dot(n2, ps_xform_vector(&m, b)), 0, 1e-12);
+        /* Outward stays outward: the transformed normal points the same way as
+         * the transformed offset of a point just above the surface. */
+        assert_true(ps_v3_dot(n2, ps_xform_vector(&m, n)) > 0);
+    }
+}
+
+static void strict_numbers(void **state)
+{
+    (void)state;
+    double d;
+    int64_t i;
+    assert_true(ps_parse_double("1.5e-3", &d) && d == 1.5e-3);
+    assert_true(ps_parse_double("-0", &d) && d == 0);
+    assert_true(ps_parse_double("1e-320", &d)); /* a denormal is a finite number */
+    const char *bad[] = {"", "nan", "NaN", "inf", "-Infinity", "1e999", "1.0x", "0x", " ", "1 2", "--1"};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; k++)
+        if (ps_parse_double(bad[k], &d))
+            fail_msg("'%s' was accepted as %g", bad[k], d);
+    assert_true(ps_parse_int64("-42", &i) && i == -42);
+    assert_true(ps_parse_int64("9223372036854775807", &i) && i == INT64_MAX);
+    assert_false(ps_parse_int64("9223372036854775808", &i));
+    assert_false(ps_parse_int64("1.0", &i));
+    assert_false(ps_parse_int64("12abc", &i));
+    assert_false(ps_parse_int64("", &i));
+}
+
+static bool exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+/* Output appears whole under its name on commit, and not at all on abort. */
+static void atomic_output(void **state)
+{
+    (void)state;
+    char path[1024];
+    snprintf(path, sizeof path, "%s", test_path("out.txt"));
+    remove(path);
+    ps_error err;
+    ps_outfile *f = ps_outfile_open(path, &err);
+    assert_non_null(f);
+    fputs("hello", ps_outfile_stream(f));
+    assert_false(exists(path)); /* nothing under the name while writing */
+    assert_int_equal(ps_outfile_commit(f, &err), PS_OK);
+    char *text;
+    size_t len;
+    assert_int_equal(ps_read_file(path, 100, &text, &len, &err), PS_OK);
+    assert_string_equal(text, "hello");
+    free(text);
+
+    f = ps_outfile_open(path, &err);
+    fputs("partial", ps_outfile_stream(f));
+    ps_outfile_abort(f);
+    assert_int_equal(ps_read_file(path, 100, &text, &len, &err), PS_OK);
+    assert_string_equal(text, "hello"); /* the old file is untouched */
+    free(text);
+
+    /* A directory that does not exist: refused at open, nothing created. */
+    assert_null(ps_outfile_open("build/no/such/dir/x.png", &err));
+    assert_int_equal(err.status, PS_ERR_IO);
+    assert_non_null(strstr(err.msg, "build/no/such/dir/x.png: cannot create"));
+    /* A directory as the output name. */
+    assert_null(ps_outfile_open("build", &err));
+    assert_non_null(strstr(err.msg, "is a directory"));
+}
+
+static void read_file_limits(void **state)
+{
+    (void)state;
+    char *text;
+    size_t len;
+    ps_error err;
+    const char *path = test_path("ten.txt");
+    FILE *fp = fopen(path, "wb");
+    fputs("0123456789", fp);
+    fclose(fp);
+    assert_int_equal(ps_read_file(path, 10, &text, &len, &err), PS_OK);
+    assert_int_equal(len, 10);
+    free(text);
+    assert_int_equal(ps_read_file(path, 9, &text, &len, &err), PS_ERR_LIMIT);
+    assert_null(text);
+    assert_int_equal(ps_read_file("/dev/zero", 100, &text, &len, &err), PS_ERR_IO); /* a device never ends */
+    assert_non_null(strstr(err.msg, "not a regular file"));
+}
+
+static void error_messages_are_one_line(void **state)
+{
+    (void)state;
+    ps_error err;
+    assert_int_equal(ps_error_set(&err, PS_ERR_PARSE, "%s:%d: bad\nthing", "a\nb.scn", 3), PS_ERR_PARSE);
+    assert_null(strchr(err.msg, '\n'));
+    assert_string_equal(err.msg, "a b.scn:3: bad thing");
+    assert_int_equal(ps_error_set(NULL, PS_ERR_IO, "x"), PS_ERR_IO); /* NULL err is allowed */
+    ps_error_clear(&err);
+    assert_int_equal(err.status, PS_OK);
+    assert_string_equal(ps_status_name(PS_ERR_NOMEM), "out of memory");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(vector_algebra),
+        cmocka_unit_test(basis_is_orthonormal),
+        cmocka_unit_test(aabb_slab_test),
+        cmocka_unit_test(transforms),
+        cmocka_unit_test(strict_numbers),
+        cmocka_unit_test(atomic_output),
+        cmocka_unit_test(read_file_limits),
+        cmocka_unit_test(error_messages_are_one_line),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
