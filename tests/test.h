@@ -38,4 +38,17 @@ static inline const char *test_path(const char *name)
     return buf;
 }
 
+/* Records warnings (a ps_warn_sink's function) so tests can assert on them. */
+typedef struct warn_log {
+    int count;
+    char last[1024];
+} warn_log;
+
+static inline void log_warning(void *user, const char *msg)
+{
+    warn_log *log = user;
+    log->count++;
+    snprintf(log->last, sizeof log->last, "%s", msg);
+}
+
 #endif

@@ -8,18 +8,6 @@
 #include "scene/obj.h"
 #include "scene/scene.h"
 
-typedef struct warn_log {
-    int count;
-    char last[PS_ERROR_MSG_MAX];
-} warn_log;
-
-static void log_warning(void *user, const char *msg)
-{
-    warn_log *log = user;
-    log->count++;
-    snprintf(log->last, sizeof log->last, "%s", msg);
-}
-
 /* Writes `text` to a scratch file and returns its path (static buffer). */
 static const char *write_file(const char *name, const char *text, size_t len)
 {

@@ -19,19 +19,6 @@ static ps_scene *load_ok(const char *path)
     return s;
 }
 
-/* Records warnings so that tests can assert on them. */
-typedef struct warn_log {
-    int count;
-    char last[PS_ERROR_MSG_MAX];
-} warn_log;
-
-static void log_warning(void *user, const char *msg)
-{
-    warn_log *log = user;
-    log->count++;
-    snprintf(log->last, sizeof log->last, "%s", msg);
-}
-
 static ps_status load_text(const char *text, ps_scene **s, ps_error *err, warn_log *log)
 {
     ps_scene_load_options opts = {{log_warning, log}};

@@ -77,12 +77,19 @@ ps_status ps_cli_string(ps_cli *cli, const char **out, ps_error *err)
     return PS_OK;
 }
 
+/* The current option's name (length n, for messages) and value. */
+static ps_status fetch(ps_cli *cli, int *n, const char **opt, const char **value, ps_error *err)
+{
+    *n = name_len(cli);
+    *opt = cli->argv[cli->i];
+    return ps_cli_string(cli, value, err);
+}
+
 ps_status ps_cli_double(ps_cli *cli, double lo, double hi, double *out, ps_error *err)
 {
-    int n = name_len(cli);
-    const char *opt = cli->argv[cli->i];
-    const char *s;
-    ps_status st = ps_cli_string(cli, &s, err);
+    int n;
+    const char *opt, *s;
+    ps_status st = fetch(cli, &n, &opt, &s, err);
     if (st != PS_OK)
         return st;
     double v;
@@ -97,10 +104,9 @@ ps_status ps_cli_double(ps_cli *cli, double lo, double hi, double *out, ps_error
 
 ps_status ps_cli_int(ps_cli *cli, int64_t lo, int64_t hi, int64_t *out, ps_error *err)
 {
-    int n = name_len(cli);
-    const char *opt = cli->argv[cli->i];
-    const char *s;
-    ps_status st = ps_cli_string(cli, &s, err);
+    int n;
+    const char *opt, *s;
+    ps_status st = fetch(cli, &n, &opt, &s, err);
     if (st != PS_OK)
         return st;
     int64_t v;
@@ -115,10 +121,9 @@ ps_status ps_cli_int(ps_cli *cli, int64_t lo, int64_t hi, int64_t *out, ps_error
 
 ps_status ps_cli_choice(ps_cli *cli, const char *const *choices, int *out, ps_error *err)
 {
-    int n = name_len(cli);
-    const char *opt = cli->argv[cli->i];
-    const char *s;
-    ps_status st = ps_cli_string(cli, &s, err);
+    int n;
+    const char *opt, *s;
+    ps_status st = fetch(cli, &n, &opt, &s, err);
     if (st != PS_OK)
         return st;
     char list[256] = "";
@@ -135,10 +140,9 @@ ps_status ps_cli_choice(ps_cli *cli, const char *const *choices, int *out, ps_er
 
 ps_status ps_cli_size(ps_cli *cli, int max_side, int *w, int *h, ps_error *err)
 {
-    int n = name_len(cli);
-    const char *opt = cli->argv[cli->i];
-    const char *s;
-    ps_status st = ps_cli_string(cli, &s, err);
+    int n;
+    const char *opt, *s;
+    ps_status st = fetch(cli, &n, &opt, &s, err);
     if (st != PS_OK)
         return st;
     const char *x = strchr(s, 'x');
