@@ -51,8 +51,9 @@ static ps_status parse(int argc, char **argv, options *o, ps_error *err)
     while (ps_cli_next(&cli)) {
         if (ps_cli_positional(&cli)) {
             if (npos == 2)
-                return ps_error_set(err, PS_ERR_PARSE, "%s: unexpected argument '%s': give two images A and B (see --help)",
-                                    PROG, ps_cli_arg(&cli));
+                return ps_error_set(err, PS_ERR_PARSE,
+                                    "%s: unexpected argument '%s': give two images A and B (see --help)", PROG,
+                                    ps_cli_arg(&cli));
             o->path[npos++] = ps_cli_arg(&cli);
         } else if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "--linear")) {
             if (cli.inline_v)

@@ -4,8 +4,9 @@
 #include <math.h>
 #include <string.h>
 
-/* A running sum with Kahan-Babuska (Neumaier) compensation: adding 65536 row
- * sums of very different size loses nothing a double can hold. */
+/* A running sum with Kahan-Babuska (Neumaier) compensation: the error stays
+ * about one rounding of the total however many terms (up to 3·2^28) are
+ * added, where a plain double sum drifts by up to terms·eps. */
 typedef struct ksum {
     double sum, comp;
 } ksum;
@@ -56,8 +57,6 @@ ps_status ps_image_compare(const ps_image *a, const ps_image *b, const ps_image 
     ksum sq = {0, 0}, rel = {0, 0}, sa = {0, 0}, sb = {0, 0};
     size_t pixels = 0;
     for (int y = 0; y < a->height; y++) {
-        /* Within a row plain double sums suffice: at most 65536·3 terms. */
-        double row_sq = 0, row_rel = 0, row_a = 0, row_b = 0;
         for (int x = 0; x < a->width; x++) {
             if (!mask_selects(mask, x, y))
                 continue;
@@ -70,17 +69,13 @@ ps_status ps_image_compare(const ps_image *a, const ps_image *b, const ps_image 
                                     (double)pb[0], (double)pb[1], (double)pb[2]);
             for (int c = 0; c < 3; c++) {
                 double va = pa[c], vb = pb[c], d = va - vb;
-                row_sq += d * d;
-                row_rel += d * d / (vb * vb + PS_RELMSE_EPSILON);
-                row_a += va;
-                row_b += vb;
+                ksum_add(&sq, d * d);
+                ksum_add(&rel, d * d / (vb * vb + PS_RELMSE_EPSILON));
+                ksum_add(&sa, va);
+                ksum_add(&sb, vb);
             }
             pixels++;
         }
-        ksum_add(&sq, row_sq);
-        ksum_add(&rel, row_rel);
-        ksum_add(&sa, row_a);
-        ksum_add(&sb, row_b);
     }
     if (pixels == 0)
         return ps_error_set(err, PS_ERR_RANGE, "%s: mask selects no pixel (white means a channel mean >= %g)", nm,

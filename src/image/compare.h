@@ -38,9 +38,8 @@ typedef struct ps_compare_names {
  * all pixels). Errors, each one line "NAME: problem": sizes differ
  * (PS_ERR_RANGE), the mask selects no pixel (PS_ERR_RANGE), a selected pixel
  * of a or b is NaN or infinite (PS_ERR_RANGE, naming the pixel as x,y from the
- * top left). Masked-out pixels are not looked at. Sums are in double,
- * per row, and compensated across rows, so 2^28-pixel images keep full
- * precision. */
+ * top left). Masked-out pixels are not looked at. Sums are compensated
+ * (Neumaier) in double, so 2^28-pixel images keep full precision. */
 ps_status ps_image_compare(const ps_image *a, const ps_image *b, const ps_image *mask, const ps_compare_names *names,
                            ps_compare_result *out, ps_error *err);
 

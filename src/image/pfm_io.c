@@ -199,14 +199,16 @@ ps_status ps_pfm_read(const char *path, ps_image *out, ps_error *err)
     uint64_t expect = (uint64_t)h.width * (uint64_t)h.height * (uint64_t)h.channels * SAMPLE_BYTES;
     uint64_t have = sb.st_size > header_len ? (uint64_t)sb.st_size - (uint64_t)header_len : 0;
     if (have < expect) {
-        st = ps_error_set(err, PS_ERR_FORMAT, "%s: truncated: %llu bytes of pixel data, the %lldx%lld header needs %llu",
-                          path, (unsigned long long)have, (long long)h.width, (long long)h.height,
+        st = ps_error_set(err, PS_ERR_FORMAT,
+                          "%s: truncated: %llu bytes of pixel data, the %lldx%lld header needs %llu", path,
+                          (unsigned long long)have, (long long)h.width, (long long)h.height,
                           (unsigned long long)expect);
         goto done;
     }
     if (have > expect) {
-        st = ps_error_set(err, PS_ERR_FORMAT, "%s: %llu bytes of unexpected data after the %lldx%lld pixels", path,
-                          (unsigned long long)(have - expect), (long long)h.width, (long long)h.height);
+        st = ps_error_set(err, PS_ERR_FORMAT, "%s: %llu byte%s of unexpected data after the %lldx%lld pixels", path,
+                          (unsigned long long)(have - expect), have - expect == 1 ? "" : "s", (long long)h.width,
+                          (long long)h.height);
         goto done;
     }
     if ((st = ps_image_create((int)h.width, (int)h.height, out, &sub)) != PS_OK) {

@@ -10,6 +10,7 @@
 #include <errno.h>
 #include <png.h>
 #include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -20,30 +21,50 @@
 /* Largest sample values, to scale codes to [0,1]. */
 #define MAX_CODE_8 255.0f
 #define MAX_CODE_16 65535.0f
+/* We write 8 bits per channel: the contract's PNG is 8-bit sRGB. */
+#define WRITE_BIT_DEPTH 8
+
+/* Room for one libpng warning. */
+#define WARNING_MAX 200
 
 /* What the error callback needs to turn libpng's message into ours. */
 typedef struct png_ctx {
     const char *path;
     const char *doing; /* "invalid PNG" or "cannot write PNG" */
     ps_error *err;
+    char last_warning[WARNING_MAX];
 } png_ctx;
 
 static void on_error(png_structp png, png_const_charp msg)
 {
     png_ctx *ctx = png_get_error_ptr(png);
+    /* libpng explains a bad header in a warning ("Image width exceeds user
+     * limit in IHDR") and then fails with a generic "Invalid IHDR data":
+     * report the explanation. */
+    if (strcmp(msg, "Invalid IHDR data") == 0 && ctx->last_warning[0])
+        msg = ctx->last_warning;
     ps_error_set(ctx->err, PS_ERR_FORMAT, "%s: %s: %s", ctx->path, ctx->doing, msg);
     png_longjmp(png, 1);
 }
 
 /* Warnings (an odd ICC profile, a bad ancillary chunk we then skip) are not
- * errors, and the contract allows one stderr line only for real failures. */
+ * errors, and the contract allows one stderr line only for real failures:
+ * keep the last one quietly, in case an error needs it. */
 static void on_warning(png_structp png, png_const_charp msg)
 {
-    (void)png;
-    (void)msg;
+    png_ctx *ctx = png_get_error_ptr(png);
+    snprintf(ctx->last_warning, sizeof ctx->last_warning, "%s", msg);
 }
 
 /* ---- reading ---------------------------------------------------------------- */
+
+/* Like libpng's default reader, but tells a truncated file from a failed read. */
+static void read_data(png_structp png, png_bytep data, size_t n)
+{
+    FILE *fp = png_get_io_ptr(png);
+    if (fread(data, 1, n, fp) != n)
+        png_error(png, ferror(fp) ? "read failed" : "file is truncated");
+}
 
 typedef struct png_reader {
     png_ctx ctx;
@@ -62,7 +83,7 @@ static ps_status read_body(png_reader *r)
 {
     if (setjmp(png_jmpbuf(r->png)))
         return PS_ERR_FORMAT; /* on_error has set the message */
-    png_init_io(r->png, r->fp);
+    png_set_read_fn(r->png, r->fp, read_data);
     png_set_sig_bytes(r->png, PNG_SIG_BYTES);
     /* Refuse absurd headers before libpng allocates anything for them, and
      * treat any CRC error, even in an ancillary chunk, as a corrupt file. */
@@ -152,7 +173,9 @@ ps_status ps_png_read(const char *path, ps_image *out, ps_error *err)
 
     unsigned char sig[PNG_SIG_BYTES];
     size_t got = fread(sig, 1, sizeof sig, r.fp);
-    if (got == 0 && !ferror(r.fp)) {
+    if (ferror(r.fp)) {
+        st = ps_error_set(err, PS_ERR_IO, "%s: read failed", path);
+    } else if (got == 0) {
         st = ps_error_set(err, PS_ERR_FORMAT, "%s: empty file, not a PNG", path);
     } else if (got != sizeof sig || png_sig_cmp(sig, 0, sizeof sig) != 0) {
         st = ps_error_set(err, PS_ERR_FORMAT, "%s: not a PNG file", path);
@@ -199,8 +222,8 @@ static ps_status write_body(png_writer *w)
         return PS_ERR_IO; /* on_error has set the message; fix its status below */
     png_init_io(w->png, w->fp);
     const ps_image *img = w->img;
-    png_set_IHDR(w->png, w->info, (png_uint_32)img->width, (png_uint_32)img->height, 8, PNG_COLOR_TYPE_RGB,
-                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(w->png, w->info, (png_uint_32)img->width, (png_uint_32)img->height, WRITE_BIT_DEPTH,
+                 PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     /* The sRGB chunk (plus the gAMA and cHRM that older readers use instead)
      * says the codes are sRGB-encoded, which they are. */
     png_set_sRGB_gAMA_and_cHRM(w->png, w->info, PNG_sRGB_INTENT_PERCEPTUAL);
