@@ -106,17 +106,24 @@ ps_status ps_check_input_file(const char *path, ps_error *err)
     return PS_OK;
 }
 
+FILE *ps_open_input(const char *path, ps_error *err)
+{
+    if (ps_check_input_file(path, err) != PS_OK)
+        return NULL;
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    return fp;
+}
+
 ps_status ps_read_file(const char *path, size_t max_bytes, char **out, size_t *out_len, ps_error *err)
 {
     *out = NULL;
     if (out_len)
         *out_len = 0;
-    ps_status st = ps_check_input_file(path, err);
-    if (st != PS_OK)
-        return st;
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = ps_open_input(path, err);
     if (!fp)
-        return ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+        return err ? err->status : PS_ERR_IO;
     size_t cap = 4096, len = 0;
     char *buf = malloc(cap);
     if (!buf) {

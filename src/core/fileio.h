@@ -26,6 +26,9 @@ void ps_outfile_abort(ps_outfile *f);
  * FIFO, which would make a reader hang or fail obscurely). */
 ps_status ps_check_input_file(const char *path, ps_error *err);
 
+/* ps_check_input_file, then fopen(path, "rb"): a stream, or NULL with err set. */
+FILE *ps_open_input(const char *path, ps_error *err);
+
 /* Reads a whole regular file into a NUL-terminated buffer the caller frees.
  * Refuses files larger than max_bytes with PS_ERR_LIMIT. */
 ps_status ps_read_file(const char *path, size_t max_bytes, char **out, size_t *out_len, ps_error *err);

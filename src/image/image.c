@@ -1,7 +1,6 @@
 /* image.c: image allocation, the sRGB transfer function, tone mapping, and format sniffing. */
 #include "image/image.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -114,12 +113,9 @@ ps_status ps_image_read(const char *path, ps_image *out, ps_image_format *format
 {
     static const unsigned char png_magic[SNIFF_BYTES] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     memset(out, 0, sizeof *out);
-    ps_status st = ps_check_input_file(path, err);
-    if (st != PS_OK)
-        return st;
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = ps_open_input(path, err);
     if (!fp)
-        return ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+        return err ? err->status : PS_ERR_IO;
     unsigned char head[SNIFF_BYTES];
     size_t got = fread(head, 1, sizeof head, fp);
     int bad = ferror(fp);

@@ -172,12 +172,10 @@ static ps_status read_pixels(FILE *fp, const char *path, const pfm_header *h, ps
 ps_status ps_pfm_read(const char *path, ps_image *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
-    ps_status st = ps_check_input_file(path, err);
-    if (st != PS_OK)
-        return st;
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = ps_open_input(path, err);
     if (!fp)
-        return ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+        return err ? err->status : PS_ERR_IO;
+    ps_status st;
     pfm_header h;
     ps_error sub;
     ps_error_clear(&sub);

@@ -7,7 +7,6 @@
  * local of a body function is read after a longjmp, so none needs volatile. */
 #include "image/image.h"
 
-#include <errno.h>
 #include <png.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -159,17 +158,15 @@ static void convert(const png_reader *r, ps_image *img)
 ps_status ps_png_read(const char *path, ps_image *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
-    ps_status st = ps_check_input_file(path, err);
-    if (st != PS_OK)
-        return st;
+    ps_status st = PS_OK;
     png_reader r;
     memset(&r, 0, sizeof r);
     r.ctx.path = path;
     r.ctx.doing = "invalid PNG";
     r.ctx.err = err;
-    r.fp = fopen(path, "rb");
+    r.fp = ps_open_input(path, err);
     if (!r.fp)
-        return ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+        return err ? err->status : PS_ERR_IO;
 
     unsigned char sig[PNG_SIG_BYTES];
     size_t got = fread(sig, 1, sizeof sig, r.fp);

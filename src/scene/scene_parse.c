@@ -200,7 +200,7 @@ static ps_status check_direction(parser *p, const char *what, ps_vec3 d)
 static ps_status check_parallelogram(parser *p, ps_vec3 e1, ps_vec3 e2)
 {
     double cross = ps_v3_len(ps_v3_cross(e1, e2));
-    if (!(cross > QUAD_MIN_SINE * ps_v3_len(e1) * ps_v3_len(e2)) || cross == 0.0)
+    if (!(cross > QUAD_MIN_SINE * ps_v3_len(e1) * ps_v3_len(e2)))
         return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: %s: edge1 and edge2 span no area (zero or parallel)",
                             p->name, p->line, p->tok[0]);
     return PS_OK;
