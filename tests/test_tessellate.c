@@ -42,9 +42,9 @@ static void check_sphere(ps_vec3 c, double r, double tol)
         ps_vec3 centroid = ps_v3_scale(ps_v3_add(ps_v3_add(p0, p1), p2), 1.0 / 3.0);
         /* outward: the face normal points away from the centre */
         assert_true(ps_v3_dot(cr, ps_v3_sub(centroid, c)) > 0);
-        /* The deepest point of a flat triangle below the sphere is at most its
-         * distance from the sphere at the centroid (checked) or at edge midpoints. */
-        double d = r - ps_v3_len(ps_v3_sub(centroid, c));
+        /* No point of the triangle is nearer the centre than its plane is, so
+         * r minus the plane's distance bounds how deep any point lies. */
+        double d = r - fabs(ps_v3_dot(ps_v3_sub(p0, c), ps_v3_norm(cr)));
         if (d > max_depth)
             max_depth = d;
     }
