@@ -92,6 +92,30 @@ run: deps
 	@$(MAKE) --no-print-directory -j$(JOBS) all
 	@$(MAKE) --no-print-directory run-built
 
+# Benchmarks: every bench/bench_NAME.c becomes build/release/bench/bench_NAME
+# (release flags, linked against the release library); `make bench` installs
+# packages, builds them and runs each in turn (scripts/bench.sh).
+# Embree 3 is a bench-only baseline, never linked by the library or tests:
+# found through pkg-config (embree3) or, since Debian's libembree-dev ships no
+# .pc file, through its header (then -lembree3). Recursive (=) so that the
+# probe runs only when a bench program is built.
+BENCHES := $(patsubst bench/%.c,build/release/bench/%,$(wildcard bench/bench_*.c))
+EMBREE_HOW = $(shell if pkg-config --exists embree3 2>/dev/null; then echo pc; \
+                     elif $(CC) -E -include embree3/rtcore.h -x c /dev/null >/dev/null 2>&1; then echo header; fi)
+EMBREE_CFLAGS = $(if $(filter pc,$(EMBREE_HOW)),-DPS_HAVE_EMBREE $(shell pkg-config --cflags embree3),$(if $(filter header,$(EMBREE_HOW)),-DPS_HAVE_EMBREE))
+EMBREE_LIBS = $(if $(filter pc,$(EMBREE_HOW)),$(shell pkg-config --libs embree3),$(if $(filter header,$(EMBREE_HOW)),-lembree3))
+build/release/bench/%: bench/%.c $(LIB_release)
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(WARN) -O2 -g -Isrc -Ibench $(EMBREE_CFLAGS) -MMD -MP $< -o $@ $(LIB_release) $(EMBREE_LIBS) $(LIBS)
+-include $(BENCHES:=.d)
+
+.PHONY: build-bench
+build-bench: $(BENCHES)
+
+bench: deps
+	@$(MAKE) --no-print-directory -j$(JOBS) build-bench
+	@scripts/bench.sh
+
 SCENE ?= data/scenes/cornell-caustic.scn
 # Until the preview window exists this prints what the default scene holds.
 run-built:

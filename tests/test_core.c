@@ -181,6 +181,30 @@ static void atomic_output(void **state)
     /* A directory as the output name. */
     assert_null(ps_outfile_open("build", &err));
     assert_non_null(strstr(err.msg, "is a directory"));
+
+    /* A device (as /dev/stdout would be) is written to, never replaced. */
+    f = ps_outfile_open("/dev/null", &err);
+    assert_non_null(f);
+    fputs("discarded", ps_outfile_stream(f));
+    assert_int_equal(ps_outfile_commit(f, &err), PS_OK);
+    struct stat st;
+    assert_int_equal(stat("/dev/null", &st), 0);
+    assert_true(S_ISCHR(st.st_mode));
+
+    /* Through a symbolic link the linked file is replaced and the link kept. */
+    char link[1024];
+    snprintf(link, sizeof link, "%s", test_path("link.txt"));
+    remove(link);
+    assert_int_equal(symlink("out.txt", link), 0);
+    f = ps_outfile_open(link, &err);
+    assert_non_null(f);
+    fputs("via link", ps_outfile_stream(f));
+    assert_int_equal(ps_outfile_commit(f, &err), PS_OK);
+    assert_int_equal(lstat(link, &st), 0);
+    assert_true(S_ISLNK(st.st_mode));
+    assert_int_equal(ps_read_file(path, 100, &text, &len, &err), PS_OK);
+    assert_string_equal(text, "via link");
+    free(text);
 }
 
 static void read_file_limits(void **state)

@@ -1,7 +1,11 @@
 /* fileio.c: atomic output files and input file checks. */
+/* realpath(3) is X/Open, not base POSIX. */
+#define _XOPEN_SOURCE 700
 #include "core/fileio.h"
 
 #include <errno.h>
+#include <limits.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -9,27 +13,48 @@
 
 struct ps_outfile {
     FILE *fp;
-    char *path;
+    char *path;   /* as given, for messages */
+    char *target; /* the file renamed over (path with links resolved); NULL when writing straight to a device */
     char *tmp;
 };
 
 ps_outfile *ps_outfile_open(const char *path, ps_error *err)
 {
     static const char suffix[] = ".tmp.XXXXXX";
-    struct stat st;
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        ps_error_set(err, PS_ERR_IO, "%s: is a directory, cannot write an image there", path);
+    struct stat st, lst;
+    bool exists = stat(path, &st) == 0;
+    if (exists && S_ISDIR(st.st_mode)) {
+        ps_error_set(err, PS_ERR_IO, "%s: is a directory, cannot write a file there", path);
         return NULL;
     }
     ps_outfile *f = calloc(1, sizeof *f);
-    size_t n = strlen(path);
-    if (!f || !(f->path = malloc(n + 1)) || !(f->tmp = malloc(n + sizeof suffix))) {
+    if (!f) {
+        ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
+        return NULL;
+    }
+    if (exists && !S_ISREG(st.st_mode)) {
+        /* A device, FIFO or terminal (/dev/stdout, a pipe): write straight to
+         * it. Renaming a file over it would replace the device node itself. */
+        f->path = strdup(path);
+        f->fp = f->path ? fopen(path, "wb") : NULL;
+        if (!f->fp) {
+            ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+            ps_outfile_abort(f);
+            return NULL;
+        }
+        return f;
+    }
+    /* Through a symbolic link, replace the file it names, not the link. */
+    char *target = exists && lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode) ? realpath(path, NULL) : strdup(path);
+    size_t n = target ? strlen(target) : 0;
+    if (!target || !(f->path = strdup(path)) || !(f->tmp = malloc(n + sizeof suffix))) {
+        free(target);
         ps_outfile_abort(f);
         ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
         return NULL;
     }
-    memcpy(f->path, path, n + 1);
-    memcpy(f->tmp, path, n);
+    f->target = target;
+    memcpy(f->tmp, target, n);
     memcpy(f->tmp + n, suffix, sizeof suffix);
     int fd = mkstemp(f->tmp);
     if (fd < 0) {
@@ -67,7 +92,11 @@ ps_status ps_outfile_commit(ps_outfile *f, ps_error *err)
         ps_outfile_abort(f);
         return PS_ERR_IO;
     }
-    if (rename(f->tmp, f->path) != 0) {
+    if (!f->tmp) { /* written straight to a device or pipe */
+        ps_outfile_abort(f);
+        return PS_OK;
+    }
+    if (rename(f->tmp, f->target) != 0) {
         ps_error_set(err, PS_ERR_IO, "%s: cannot rename into place: %s", f->path, strerror(errno));
         ps_outfile_abort(f);
         return PS_ERR_IO;
@@ -88,6 +117,7 @@ void ps_outfile_abort(ps_outfile *f)
         remove(f->tmp);
         free(f->tmp);
     }
+    free(f->target);
     free(f->path);
     free(f);
 }

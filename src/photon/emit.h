@@ -1,0 +1,68 @@
+/* emit.h: where photons leave the lights, and in which directions.
+ *
+ * Each light emits with its own distribution (contract, "Lights"):
+ *   point   uniform over the sphere of directions
+ *   spot    uniform inside its cone (constant intensity)
+ *   quad, disc, mesh (MTL Ke faces)
+ *           uniform position, cosine-weighted direction about the emitting side
+ *   sphere  uniform position on the sphere, cosine-weighted about the outward normal
+ *
+ * Caustic photons are emitted only inside cones (thesis 4.1.1): from the light
+ * around a specular object's bounding sphere, that sphere's radius widened by
+ * the light's own bounding radius, so the cone holds every direction from any
+ * point of the light towards the object. Inside a cone, directions are uniform
+ * and each photon's power is the flux the light sends into the cone, estimated
+ * from that one sample: E[power] over the cone equals that flux exactly. */
+#ifndef PS_PHOTON_EMIT_H
+#define PS_PHOTON_EMIT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/status.h"
+#include "core/vec.h"
+#include "scene/scene.h"
+
+/* A cone of directions: those within acos(cos_half) of the unit axis.
+ * cos_half <= -1 is every direction (the light is inside the bounding sphere). */
+typedef struct ps_cone {
+    ps_vec3 axis;
+    double cos_half;
+} ps_cone;
+
+/* What one emitted photon is: where it starts, where it goes, what it carries.
+ * power is in watts for one photon that stands for all of the light's flux
+ * (or of the flux into the cone); the tracer divides by the photon count. */
+typedef struct ps_emission {
+    ps_ray ray;     /* unit direction */
+    ps_rgb power;
+    ps_vec3 normal; /* the emitter's normal at the origin (0 for point and spot) */
+} ps_emission;
+
+/* Per-scene data for sampling its lights: face tables of mesh lights and each
+ * light's bounding sphere. Immutable once made; safe to share between threads. */
+typedef struct ps_light_sampler ps_light_sampler;
+
+ps_status ps_light_sampler_create(const ps_scene *s, ps_light_sampler **out, ps_error *err);
+void ps_light_sampler_destroy(ps_light_sampler *ls);
+
+/* The smallest sphere we know around light l: radius 0 for point and spot. */
+void ps_light_bounding_sphere(const ps_light_sampler *ls, uint32_t l, ps_vec3 *center, double *radius);
+
+/* The caustic cone from light l around the sphere (center, radius). False when
+ * no photon of the light can reach the sphere at all (it lies wholly behind a
+ * one-sided light or outside a spot's cone): then no caustic photons go there. */
+bool ps_light_cone(const ps_light_sampler *ls, uint32_t l, ps_vec3 center, double radius, ps_cone *out);
+
+/* Roughly which fraction of light l's flux goes into cone; used only to share
+ * photons between cones (the photon powers make the estimate exact anyway). */
+double ps_light_cone_share(const ps_light_sampler *ls, uint32_t l, const ps_cone *cone);
+
+/* Emits one photon from light l using the four numbers u in [0, 1): u[0], u[1]
+ * choose the point on the light, u[2], u[3] the direction. cone == NULL: the
+ * light's own distribution. False when the sample carries no power (a
+ * direction in the cone that the light does not emit into); it still counts as
+ * emitted, which is what keeps the estimate unbiased. */
+bool ps_light_emit(const ps_light_sampler *ls, uint32_t l, const ps_cone *cone, const double u[4], ps_emission *out);
+
+#endif

@@ -1,0 +1,655 @@
+/* tracer.c: photon emission plans, the per-photon path, and the threads. */
+#include "photon/tracer.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/array.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "photon/emit.h"
+#include "scene/bsdf.h"
+
+/* Emission uses Halton dimensions 1..4 (dimension 0 picks the light/cone). */
+#define EMIT_DIMS 4
+
+/* One way photons leave: a light, and for caustic photons the cone around one
+ * specular object. Photon indices are shared between strata in proportion to
+ * `share` (the flux each is expected to carry). */
+typedef struct stratum {
+    uint32_t light;
+    int64_t target; /* caustic: the object the cone is aimed at; -1: none */
+    bool has_cone;
+    ps_cone cone;
+    double share;
+    double cdf; /* cumulative share, normalised; the last is 1 */
+} stratum;
+
+typedef struct map_plan {
+    bool enabled;
+    uint32_t stream;
+    stratum *strata;
+    size_t count, cap;
+    double rotation[1 + EMIT_DIMS]; /* Cranley-Patterson shifts from the seed */
+    /* Normalisation for `counted_total` photons: scale[s] = 1 / photons of s. */
+    uint64_t counted_total;
+    bool counted;
+    uint64_t *counts;
+    double *scale;
+} map_plan;
+
+struct ps_tracer {
+    const ps_world *world;
+    const ps_scene *scene;
+    const ps_material *materials;
+    ps_tracer_options opt;
+    int threads;
+    ps_light_sampler *lights;
+    map_plan plans[PS_MAP_COUNT];
+    ps_skip *skips;
+    size_t skip_count, skip_cap;
+};
+
+ps_tracer_options ps_tracer_default_options(void)
+{
+    ps_tracer_options o = {0};
+    o.caustic_cones = true;
+    o.first_hit_test = true;
+    return o;
+}
+
+void ps_photon_map_init(ps_photon_map *m, ps_map_kind kind)
+{
+    memset(m, 0, sizeof *m);
+    m->kind = kind;
+}
+
+void ps_photon_map_free(ps_photon_map *m)
+{
+    ps_map_kind kind = m->kind;
+    free(m->photons);
+    ps_photon_map_init(m, kind);
+}
+
+ps_rgb ps_photon_map_power(const ps_photon_map *m)
+{
+    ps_rgb sum = ps_rgb_gray(0.0);
+    for (size_t i = 0; i < m->count; i++)
+        sum = ps_rgb_add(sum, ps_photon_power(&m->photons[i]));
+    return sum;
+}
+
+/* ---- the plan: strata and skips ------------------------------------------ */
+
+static ps_status add_skip(ps_tracer *t, const char *pass, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static ps_status add_skip(ps_tracer *t, const char *pass, const char *fmt, ...)
+{
+    if (!PS_RESERVE(t->skips, t->skip_cap, t->skip_count + 1))
+        return PS_ERR_NOMEM;
+    ps_skip *s = &t->skips[t->skip_count++];
+    snprintf(s->pass, sizeof s->pass, "%s", pass);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(s->reason, sizeof s->reason, fmt, ap);
+    va_end(ap);
+    return PS_OK;
+}
+
+static bool add_stratum(map_plan *p, uint32_t light, int64_t target, const ps_cone *cone, double share)
+{
+    if (!PS_RESERVE(p->strata, p->cap, p->count + 1))
+        return false;
+    stratum *s = &p->strata[p->count++];
+    memset(s, 0, sizeof *s);
+    s->light = light;
+    s->target = target;
+    s->has_cone = cone != NULL;
+    if (cone)
+        s->cone = *cone;
+    s->share = share;
+    return true;
+}
+
+/* Normalises the shares into a CDF; a plan whose shares are all zero is off. */
+static void finish_plan(map_plan *p)
+{
+    double total = 0.0;
+    for (size_t k = 0; k < p->count; k++)
+        total += p->strata[k].share;
+    if (!(total > 0.0) || !isfinite(total)) {
+        p->enabled = false;
+        return;
+    }
+    double run = 0.0;
+    for (size_t k = 0; k < p->count; k++) {
+        run += p->strata[k].share;
+        p->strata[k].cdf = run / total;
+    }
+    p->strata[p->count - 1].cdf = 1.0;
+}
+
+/* The sphere around object o that its cone is built on: exact for spheres,
+ * around the box centre through the farthest vertex for meshes. */
+static void object_sphere(const ps_scene *s, const ps_object *o, ps_vec3 *c, double *r)
+{
+    if (o->type == PS_OBJ_SPHERE) {
+        *c = o->center;
+        *r = o->radius;
+        return;
+    }
+    size_t nt, np;
+    const ps_triangle *tris = ps_scene_triangles(s, &nt);
+    const ps_vec3 *pos = ps_scene_positions(s, &np);
+    *c = ps_aabb_center(o->bounds);
+    double r2 = 0.0;
+    for (uint32_t k = 0; k < o->triangle_count; k++)
+        for (int v = 0; v < 3; v++)
+            r2 = fmax(r2, ps_v3_len2(ps_v3_sub(pos[tris[o->first_triangle + k].v[v]], *c)));
+    *r = sqrt(r2);
+}
+
+static bool reflects_diffusely(const ps_material *m)
+{
+    if (m->type == PS_MAT_DIFFUSE)
+        return ps_rgb_max(m->albedo) > 0.0;
+    if (m->type == PS_MAT_GLOSSY)
+        return ps_rgb_max(m->albedo) > 0.0 || ps_rgb_max(m->specular) > 0.0;
+    return false;
+}
+
+static ps_status plan_maps(ps_tracer *t, ps_error *err)
+{
+    const ps_scene *s = t->scene;
+    const char *path = ps_scene_path(s);
+    size_t nl, no, nt, nm;
+    const ps_light *lights = ps_scene_lights(s, &nl);
+    const ps_object *objs = ps_scene_objects(s, &no);
+    const ps_triangle *tris = ps_scene_triangles(s, &nt);
+    (void)ps_scene_materials(s, &nm);
+    map_plan *caustic = &t->plans[PS_MAP_CAUSTIC], *global = &t->plans[PS_MAP_GLOBAL];
+    caustic->stream = PS_STREAM_CAUSTIC;
+    global->stream = PS_STREAM_GLOBAL;
+    caustic->enabled = global->enabled = true;
+#define SKIP(pass, ...)                                                                                     \
+    do {                                                                                                    \
+        if (add_skip(t, pass, __VA_ARGS__) != PS_OK)                                                        \
+            return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);     \
+    } while (0)
+
+    /* Does anything reflect diffusely? Only such surfaces store photons. */
+    bool diffuse = false;
+    for (size_t k = 0; k < nt && !diffuse; k++)
+        diffuse = reflects_diffusely(&t->materials[tris[k].material]);
+    for (size_t k = 0; k < no && !diffuse; k++)
+        diffuse = objs[k].type == PS_OBJ_SPHERE && reflects_diffusely(&t->materials[objs[k].material]);
+    bool lit = false;
+    for (size_t l = 0; l < nl; l++)
+        lit |= ps_rgb_max(lights[l].power) > 0.0;
+
+    if (!lit) {
+        SKIP("caustic", "no light emits any power");
+        SKIP("global", "no light emits any power");
+        caustic->enabled = global->enabled = false;
+        return PS_OK;
+    }
+    if (!diffuse) {
+        SKIP("caustic", "no diffuse reflectance anywhere: nothing can receive a caustic");
+        SKIP("global", "no diffuse reflectance anywhere");
+        caustic->enabled = global->enabled = false;
+        return PS_OK;
+    }
+
+    /* Global map: every light, in proportion to its flux. */
+    for (uint32_t l = 0; l < nl; l++)
+        if (!add_stratum(global, l, -1, NULL, ps_rgb_sum(lights[l].power)))
+            return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
+    finish_plan(global);
+
+    /* Caustic map: only towards specular objects. */
+    size_t specular = 0;
+    for (size_t o = 0; o < no; o++)
+        specular += objs[o].specular ? 1 : 0;
+    if (specular == 0) {
+        SKIP("caustic", "no specular (mirror or dielectric) object in the scene");
+        caustic->enabled = false;
+        return PS_OK;
+    }
+    for (uint32_t l = 0; l < nl; l++) {
+        double flux = ps_rgb_sum(lights[l].power);
+        if (!(flux > 0.0))
+            continue;
+        if (!t->opt.caustic_cones) {
+            if (!add_stratum(caustic, l, -1, NULL, flux))
+                return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
+            continue;
+        }
+        size_t cones = 0;
+        for (size_t o = 0; o < no; o++) {
+            if (!objs[o].specular)
+                continue;
+            ps_vec3 c;
+            double r;
+            ps_cone cone;
+            object_sphere(s, &objs[o], &c, &r);
+            if (!ps_light_cone(t->lights, l, c, r, &cone))
+                continue;
+            double share = flux * ps_light_cone_share(t->lights, l, &cone);
+            if (!add_stratum(caustic, l, (int64_t)o, &cone, share))
+                return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
+            cones++;
+        }
+        if (cones == 0)
+            SKIP("caustic", "%s light %u (line %d): no specular object inside its emission", ps_light_type_name(lights[l].type),
+                 l, lights[l].line);
+    }
+    if (caustic->count == 0) {
+        caustic->enabled = false;
+        return PS_OK;
+    }
+    finish_plan(caustic);
+#undef SKIP
+    return PS_OK;
+}
+
+static int online_cores(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > PS_TRACER_MAX_THREADS ? PS_TRACER_MAX_THREADS : (int)n;
+}
+
+ps_status ps_tracer_create(const ps_world *w, const ps_tracer_options *opt, ps_tracer **out, ps_error *err)
+{
+    *out = NULL;
+    const ps_scene *s = ps_world_scene(w);
+    ps_tracer *t = calloc(1, sizeof *t);
+    if (!t)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for the photon tracer", ps_scene_path(s));
+    t->world = w;
+    t->scene = s;
+    size_t nm;
+    t->materials = ps_scene_materials(s, &nm);
+    t->opt = opt ? *opt : ps_tracer_default_options();
+    t->threads = t->opt.threads > 0 ? (t->opt.threads < PS_TRACER_MAX_THREADS ? t->opt.threads : PS_TRACER_MAX_THREADS)
+                                    : online_cores();
+    ps_status st = ps_light_sampler_create(s, &t->lights, err);
+    if (st == PS_OK)
+        st = plan_maps(t, err);
+    if (st != PS_OK) {
+        ps_tracer_destroy(t);
+        return st;
+    }
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        map_plan *p = &t->plans[k];
+        /* Independent shifts per map and seed: the maps never share samples. */
+        uint64_t h = ps_hash64(t->opt.seed ^ ps_hash64(p->stream));
+        for (int d = 0; d <= EMIT_DIMS; d++) {
+            h = ps_hash64(h + (uint64_t)d);
+            p->rotation[d] = (double)(h >> 11) * (1.0 / 9007199254740992.0);
+        }
+        p->counts = calloc(p->count ? p->count : 1, sizeof *p->counts);
+        p->scale = calloc(p->count ? p->count : 1, sizeof *p->scale);
+        if (!p->counts || !p->scale) {
+            ps_tracer_destroy(t);
+            return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for the photon tracer", ps_scene_path(s));
+        }
+    }
+    *out = t;
+    return PS_OK;
+}
+
+void ps_tracer_destroy(ps_tracer *t)
+{
+    if (!t)
+        return;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        free(t->plans[k].strata);
+        free(t->plans[k].counts);
+        free(t->plans[k].scale);
+    }
+    ps_light_sampler_destroy(t->lights);
+    free(t->skips);
+    free(t);
+}
+
+bool ps_tracer_map_enabled(const ps_tracer *t, ps_map_kind kind) { return t->plans[kind].enabled; }
+
+const ps_skip *ps_tracer_skips(const ps_tracer *t, size_t *count)
+{
+    *count = t->skip_count;
+    return t->skips;
+}
+
+int ps_tracer_threads(const ps_tracer *t) { return t->threads; }
+
+ps_status ps_tracer_note_skip(ps_tracer *t, const char *pass, const char *reason)
+{
+    return add_skip(t, pass, "%s", reason);
+}
+
+/* ---- which stratum photon i belongs to ----------------------------------- */
+
+/* The base-2 radical inverse by bit reversal: Halton dimension 0, exact. */
+static double van_der_corput(uint64_t i)
+{
+    i = (i << 32) | (i >> 32);
+    i = ((i & 0x0000ffff0000ffffULL) << 16) | ((i >> 16) & 0x0000ffff0000ffffULL);
+    i = ((i & 0x00ff00ff00ff00ffULL) << 8) | ((i >> 8) & 0x00ff00ff00ff00ffULL);
+    i = ((i & 0x0f0f0f0f0f0f0f0fULL) << 4) | ((i >> 4) & 0x0f0f0f0f0f0f0f0fULL);
+    i = ((i & 0x3333333333333333ULL) << 2) | ((i >> 2) & 0x3333333333333333ULL);
+    i = ((i & 0x5555555555555555ULL) << 1) | ((i >> 1) & 0x5555555555555555ULL);
+    return (double)(i >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static double shift(double u, double by)
+{
+    u += by;
+    return u < 1.0 ? u : u - 1.0;
+}
+
+/* Low-discrepancy choice: any prefix of photon indices is shared between the
+ * strata within a few photons of their shares, so each light's photon count is
+ * proportional to its flux for every total, not just on average. */
+static size_t stratum_of(const map_plan *p, uint64_t i)
+{
+    double u = shift(van_der_corput(i), p->rotation[0]);
+    size_t lo = 0, hi = p->count - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (p->strata[mid].cdf > u)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo;
+}
+
+static void count_strata(map_plan *p, uint64_t total)
+{
+    if (p->counted && p->counted_total == total)
+        return;
+    memset(p->counts, 0, p->count * sizeof *p->counts);
+    for (uint64_t i = 0; i < total; i++)
+        p->counts[stratum_of(p, i)]++;
+    for (size_t k = 0; k < p->count; k++)
+        p->scale[k] = p->counts[k] ? 1.0 / (double)p->counts[k] : 0.0;
+    p->counted_total = total;
+    p->counted = true;
+}
+
+uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light, uint64_t total)
+{
+    map_plan *p = &t->plans[kind];
+    if (!p->enabled)
+        return 0;
+    count_strata(p, total);
+    uint64_t n = 0;
+    for (size_t k = 0; k < p->count; k++)
+        if (p->strata[k].light == light)
+            n += p->counts[k];
+    return n;
+}
+
+/* ---- one photon's path --------------------------------------------------- */
+
+typedef struct chunk_out {
+    ps_photon *photons;
+    size_t count, cap;
+    ps_trace_counters c;
+    bool failed;
+} chunk_out;
+
+static void store(chunk_out *out, ps_vec3 p, ps_rgb power, ps_vec3 d, ps_vec3 n, double dither)
+{
+    if (!PS_RESERVE(out->photons, out->cap, out->count + 1)) {
+        out->failed = true;
+        return;
+    }
+    out->photons[out->count++] = ps_photon_pack(p, power, d, n, dither);
+    out->c.stored++;
+}
+
+static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk_out *out)
+{
+    const map_plan *plan = &t->plans[kind];
+    const ps_world *w = t->world;
+    ps_trace_counters *c = &out->c;
+    c->emitted++;
+
+    /* Emission: the stratum and the four emission numbers are Halton
+     * coordinates of index i; the rest of the path draws from its own PCG. */
+    size_t k = stratum_of(plan, i);
+    const stratum *st = &plan->strata[k];
+    double u[EMIT_DIMS];
+    for (unsigned d = 0; d < EMIT_DIMS; d++)
+        u[d] = shift(ps_halton(d + 1, i), plan->rotation[d + 1]);
+    ps_emission e;
+    if (!ps_light_emit(t->lights, st->light, st->has_cone ? &st->cone : NULL, u, &e) || plan->scale[k] == 0.0) {
+        c->empty++;
+        return;
+    }
+    ps_rgb power = ps_rgb_scale(e.power, plan->scale[k]);
+    ps_ray ray = e.ray;
+    if (ps_v3_len2(e.normal) > 0.0) /* leave an emitting surface (mesh lights are geometry too) */
+        ray.o = ps_v3_madd(ray.o, e.normal, ps_world_epsilon(w));
+    ps_rng rng = ps_rng_make(t->opt.seed, plan->stream, i);
+    bool diffuse_seen = false;
+
+    for (int bounce = 0;; bounce++) {
+        if (bounce >= PS_PHOTON_MAX_BOUNCES) {
+            c->truncated++;
+            return;
+        }
+        ps_surface sp;
+        c->rays++;
+        if (!ps_world_intersect(w, ray, INFINITY, &sp)) {
+            c->escaped++;
+            return;
+        }
+        const ps_material *m = &t->materials[sp.material];
+        ps_vec3 d = ray.d;
+        bool specular = ps_material_is_specular(m);
+        if (kind == PS_MAP_CAUSTIC && bounce == 0) {
+            /* The first-hit test (thesis 4.1.1): a photon aimed at one object
+             * that first meets another is not that cone's to carry; the other
+             * object's own cone carries it. Without it overlapping cones count
+             * the same caustic twice. And a first diffuse hit is no caustic. */
+            bool other = st->target >= 0 && t->opt.first_hit_test && sp.object != (uint32_t)st->target;
+            if (other || !specular) {
+                c->discarded++;
+                return;
+            }
+        }
+        /* Surfaces are two-sided: work with the normals on the arriving side. */
+        bool front = ps_v3_dot(d, sp.ng) < 0.0;
+        ps_vec3 ns = front ? sp.ns : ps_v3_neg(sp.ns);
+        ps_vec3 ng = front ? sp.ng : ps_v3_neg(sp.ng);
+        ps_vec3 dir;
+
+        switch (m->type) {
+        case PS_MAT_DIFFUSE:
+        case PS_MAT_GLOSSY: {
+            if (kind == PS_MAP_CAUSTIC) { /* light, specular bounces, here: a caustic */
+                store(out, sp.p, power, d, ns, ps_rng_uniform(&rng));
+                return;
+            }
+            if (diffuse_seen)
+                store(out, sp.p, power, d, ns, ps_rng_uniform(&rng));
+            /* Russian roulette on the albedo: the expected power leaving is the
+             * power arriving times the albedo, with no photon made heavier than
+             * the albedo's colour ratio. */
+            double pd = ps_rgb_mean(m->albedo);
+            double pg = m->type == PS_MAT_GLOSSY ? ps_rgb_mean(m->specular) : 0.0;
+            double x = ps_rng_uniform(&rng);
+            double u1 = ps_rng_uniform(&rng), u2 = ps_rng_uniform(&rng);
+            if (x < pd) {
+                dir = ps_sample_cosine(u1, u2, ns);
+                power = ps_rgb_scale(ps_rgb_mul(power, m->albedo), 1.0 / pd);
+            } else if (x < pd + pg) {
+                /* Lobe sampling: density (e+1)/(2 pi) cos^e; the BRDF's (e+2)/(2 pi)
+                 * cos^e times the cosine at the surface leaves this weight. */
+                dir = ps_sample_phong(u1, u2, ps_reflect(d, ns), m->exponent);
+                double cos_out = ps_v3_dot(dir, ns);
+                if (cos_out <= 0.0) {
+                    c->absorbed++;
+                    return;
+                }
+                double wgt = (m->exponent + 2.0) / (m->exponent + 1.0) * cos_out / pg;
+                power = ps_rgb_scale(ps_rgb_mul(power, m->specular), wgt);
+            } else {
+                c->absorbed++;
+                return;
+            }
+            diffuse_seen = true;
+            break;
+        }
+        case PS_MAT_MIRROR: {
+            double p = fmin(1.0, ps_rgb_max(m->reflectance));
+            if (!(p > 0.0) || (p < 1.0 && ps_rng_uniform(&rng) >= p)) {
+                c->absorbed++;
+                return;
+            }
+            power = ps_rgb_scale(ps_rgb_mul(power, m->reflectance), 1.0 / p);
+            dir = ps_reflect(d, ns);
+            break;
+        }
+        case PS_MAT_DIELECTRIC:
+        default: {
+            double eta_i = front ? 1.0 : m->ior, eta_t = front ? m->ior : 1.0;
+            double f = ps_fresnel_dielectric(-ps_v3_dot(d, ns), eta_i, eta_t);
+            /* Choose reflection with probability F: no weight change, unbiased. */
+            if (ps_rng_uniform(&rng) < f || !ps_refract(d, ns, eta_i / eta_t, &dir)) {
+                dir = ps_reflect(d, ns);
+            } else {
+                power = ps_rgb_mul(power, m->transmittance);
+            }
+            break;
+        }
+        }
+        /* An interpolated normal can send a diffuse bounce under the true
+         * surface; such a photon would start inside the object. */
+        if (!specular && ps_v3_dot(dir, ng) <= 0.0) {
+            c->absorbed++;
+            return;
+        }
+        ray = ps_world_spawn(w, &sp, dir);
+    }
+}
+
+/* ---- threads ------------------------------------------------------------- */
+
+typedef struct trace_job {
+    const ps_tracer *t;
+    ps_map_kind kind;
+    uint64_t first, count;
+    size_t chunks;
+    chunk_out *outs;
+    atomic_size_t next;
+} trace_job;
+
+static void *worker(void *arg)
+{
+    trace_job *job = arg;
+    for (;;) {
+        size_t k = atomic_fetch_add(&job->next, 1);
+        if (k >= job->chunks)
+            return NULL;
+        uint64_t lo = job->first + (uint64_t)k * PS_PHOTON_CHUNK;
+        uint64_t hi = lo + PS_PHOTON_CHUNK;
+        if (hi > job->first + job->count)
+            hi = job->first + job->count;
+        for (uint64_t i = lo; i < hi && !job->outs[k].failed; i++)
+            trace_photon(job->t, job->kind, i, &job->outs[k]);
+    }
+}
+
+static void add_counters(ps_trace_counters *a, const ps_trace_counters *b)
+{
+    a->emitted += b->emitted;
+    a->stored += b->stored;
+    a->rays += b->rays;
+    a->escaped += b->escaped;
+    a->absorbed += b->absorbed;
+    a->discarded += b->discarded;
+    a->truncated += b->truncated;
+    a->empty += b->empty;
+}
+
+ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
+                          ps_photon_map *m, ps_error *err)
+{
+    const char *path = ps_scene_path(t->scene);
+    if (first > total || count > total - first)
+        return ps_error_set(err, PS_ERR_RANGE, "%s: photons %llu..%llu lie beyond the map's total %llu", path,
+                            (unsigned long long)first, (unsigned long long)(first + count), (unsigned long long)total);
+    map_plan *plan = &t->plans[kind];
+    if (!plan->enabled || count == 0)
+        return PS_OK;
+    count_strata(plan, total);
+
+    trace_job job;
+    memset(&job, 0, sizeof job);
+    job.t = t;
+    job.kind = kind;
+    job.first = first;
+    job.count = count;
+    job.chunks = (size_t)((count + PS_PHOTON_CHUNK - 1) / PS_PHOTON_CHUNK);
+    atomic_init(&job.next, 0);
+    job.outs = calloc(job.chunks, sizeof *job.outs);
+    if (!job.outs)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory tracing %llu photons", path, (unsigned long long)count);
+
+    int threads = t->threads < (int)job.chunks ? t->threads : (int)job.chunks;
+    pthread_t tid[PS_TRACER_MAX_THREADS];
+    int started = 0;
+    for (; started < threads - 1; started++)
+        if (pthread_create(&tid[started], NULL, worker, &job) != 0)
+            break; /* fewer threads only makes it slower, never different */
+    worker(&job);
+    for (int k = 0; k < started; k++)
+        pthread_join(tid[k], NULL);
+
+    /* Join the chunks in index order: the array never depends on who traced what. */
+    ps_status st = PS_OK;
+    size_t need = m->count;
+    for (size_t k = 0; k < job.chunks; k++) {
+        if (job.outs[k].failed)
+            st = PS_ERR_NOMEM;
+        need += job.outs[k].count;
+    }
+    if (st == PS_OK && !PS_RESERVE(m->photons, m->cap, need))
+        st = PS_ERR_NOMEM;
+    for (size_t k = 0; k < job.chunks; k++) {
+        if (st == PS_OK && job.outs[k].count) {
+            memcpy(m->photons + m->count, job.outs[k].photons, job.outs[k].count * sizeof *m->photons);
+            m->count += job.outs[k].count;
+        }
+        if (st == PS_OK)
+            add_counters(&m->counters, &job.outs[k].c);
+        free(job.outs[k].photons);
+    }
+    free(job.outs);
+    if (st != PS_OK)
+        return ps_error_set(err, st, "%s: out of memory storing photons", path);
+    return PS_OK;
+}
+
+void ps_photon_map_write_text(FILE *f, const ps_photon_map *m)
+{
+    const char *name = ps_map_name(m->kind);
+    for (size_t i = 0; i < m->count; i++) {
+        const ps_photon *p = &m->photons[i];
+        ps_rgb c = ps_photon_power(p);
+        ps_vec3 d = ps_photon_dir(p), n = ps_photon_normal(p);
+        /* %.9g round-trips the single-precision position exactly. */
+        fprintf(f, "%s %.9g %.9g %.9g %.9g %.9g %.9g %.6f %.6f %.6f %.6f %.6f %.6f\n", name, p->pos[0], p->pos[1],
+                p->pos[2], c.r, c.g, c.b, d.x, d.y, d.z, n.x, n.y, n.z);
+    }
+}

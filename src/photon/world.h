@@ -1,0 +1,48 @@
+/* world.h: a scene with its accelerator, answering "what does this ray hit"
+ * with everything shading needs (point, normals, material, object).
+ *
+ * Shared by the photon tracer and the reference renderer so that both see the
+ * same surfaces, the same normals and the same self-intersection offset. */
+#ifndef PS_PHOTON_WORLD_H
+#define PS_PHOTON_WORLD_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "accel/accel.h"
+#include "core/status.h"
+#include "core/vec.h"
+#include "scene/scene.h"
+
+typedef struct ps_world ps_world;
+
+/* Where a ray met a surface. */
+typedef struct ps_surface {
+    double t;         /* ray parameter */
+    ps_vec3 p;        /* the point */
+    ps_vec3 ng;       /* unit geometric normal: triangle winding, sphere outward */
+    ps_vec3 ns;       /* unit shading normal (interpolated vertex normals), same side as ng */
+    uint32_t prim;    /* accelerator primitive id */
+    uint32_t object;  /* scene object index */
+    uint32_t material;
+} ps_surface;
+
+/* Builds the accelerator over s (which must outlive the world). opt may be NULL. */
+ps_status ps_world_create(const ps_scene *s, const ps_accel_options *opt, ps_world **out, ps_error *err);
+void ps_world_destroy(ps_world *w);
+
+const ps_scene *ps_world_scene(const ps_world *w);
+const ps_accel *ps_world_accel(const ps_world *w);
+
+/* The offset that keeps a ray leaving a surface from hitting that surface
+ * again: scaled with the scene's size (ps_accel_epsilon), never a fixed value. */
+double ps_world_epsilon(const ps_world *w);
+
+/* The nearest surface along r with t in (0, tmax). */
+bool ps_world_intersect(const ps_world *w, ps_ray r, double tmax, ps_surface *out);
+
+/* A ray leaving surface point sp in direction dir: its origin is pushed off
+ * the surface along the geometric normal, to the side dir goes. */
+ps_ray ps_world_spawn(const ps_world *w, const ps_surface *sp, ps_vec3 dir);
+
+#endif

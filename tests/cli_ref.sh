@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# cli_ref.sh BIN_DIR: photosplat-ref --photons-only from the outside: options,
+# the --stats keys of the contract, the --dump-photons format, byte-identical
+# dumps across thread counts, the skip list, and bad input.
+set -u
+cd "$(dirname "$0")/.."
+bin=${1:-bin}
+. tests/cli_lib.sh
+ref=$bin/photosplat-ref
+scene=data/scenes/cornell-caustic.scn
+small=(--caustic-photons 20000 --global-photons 5000)
+
+expect_success "--help" "$ref" --help
+expect_match "--help text" "$cli_out" '^usage: photosplat-ref SCENE'
+expect_usage_error "no arguments" "$ref"
+expect_usage_error "unknown option" "$ref" "$scene" --photons-only --frobnicate
+expect_usage_error "no image renderer yet" "$ref" "$scene" -o "$cli_tmp/x.png"
+expect_match "says so" "$cli_err" 'use --photons-only'
+expect_usage_error "negative photons" "$ref" "$scene" --photons-only --caustic-photons -1
+expect_usage_error "zero threads" "$ref" "$scene" --photons-only --threads 0
+expect_usage_error "bad seed" "$ref" "$scene" --photons-only --seed 1.5
+expect_usage_error "bad cones value" "$ref" "$scene" --photons-only --caustic-cones maybe
+expect_usage_error "missing scene" "$ref" tests/data/no-such.scn --photons-only
+bad_scene=$(ls tests/data/bad/*.scn | head -1)
+expect_usage_error "malformed scene" "$ref" "$bad_scene" --photons-only
+expect_usage_error "unwritable dump" "$ref" "$scene" --photons-only "${small[@]}" --dump-photons /nonexistent/dir/d.txt
+expect_usage_error "unwritable stats" "$ref" "$scene" --photons-only "${small[@]}" --stats /nonexistent/dir/s.json
+
+# The tracer alone: dump and stats.
+expect_success "photons-only" "$ref" "$scene" --photons-only "${small[@]}" --threads 1 \
+    --dump-photons "$cli_tmp/t1.txt" --stats "$cli_tmp/s1.json"
+expect_match "summary line" "$cli_out" '^caustic: 20000 emitted, [0-9]+ stored; global: 5000 emitted'
+for key in emitted_caustic emitted_global stored_caustic stored_global trace_seconds splat_seconds frames \
+    photons_per_second rays_traced rays_per_second skipped; do
+    grep -q "\"$key\":" "$cli_tmp/s1.json" && ok || bad "stats lacks $key"
+done
+grep -q '"emitted_caustic": 20000,' "$cli_tmp/s1.json" && ok || bad "emitted_caustic is not 20000"
+grep -q '"skipped": \[\]' "$cli_tmp/s1.json" && ok || bad "the default scene skips something: $(cat "$cli_tmp/s1.json")"
+if command -v python3 >/dev/null; then
+    python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["rays_traced"] > 0' "$cli_tmp/s1.json" \
+        && ok || bad "stats is not valid JSON with rays"
+fi
+stat() { sed -nE "s/.*\"$1\": ([0-9]+).*/\1/p" "$2"; }
+stored=$(($(stat stored_caustic "$cli_tmp/s1.json") + $(stat stored_global "$cli_tmp/s1.json")))
+lines=$(wc -l <"$cli_tmp/t1.txt")
+[ "$lines" -eq "$stored" ] && ok || bad "dump has $lines lines, stats say $stored stored"
+# Each line: map and 12 numbers.
+awk 'NF != 13 || ($1 != "caustic" && $1 != "global") { bad = 1 } END { exit bad }' "$cli_tmp/t1.txt" \
+    && ok || bad "dump lines are not 'map x y z r g b dx dy dz nx ny nz'"
+grep -q '^caustic ' "$cli_tmp/t1.txt" && grep -q '^global ' "$cli_tmp/t1.txt" && ok || bad "dump lacks a map"
+
+# Thread count never changes the photons.
+expect_success "two threads" "$ref" "$scene" --photons-only "${small[@]}" --threads 2 --dump-photons "$cli_tmp/t2.txt"
+cmp -s "$cli_tmp/t1.txt" "$cli_tmp/t2.txt" && ok || bad "dumps differ between 1 and 2 threads"
+expect_success "other seed" "$ref" "$scene" --photons-only "${small[@]}" --seed 99 --dump-photons "$cli_tmp/t3.txt"
+cmp -s "$cli_tmp/t1.txt" "$cli_tmp/t3.txt" && bad "another seed gave the same photons" || ok
+
+# Skips: no specular object, and zero photons asked for.
+expect_success "diffuse box" "$ref" tests/data/good/diffuse-box.scn --photons-only --stats "$cli_tmp/s4.json"
+grep -q '"pass": "caustic", "reason": "no specular' "$cli_tmp/s4.json" && ok || bad "no caustic skip: $(cat "$cli_tmp/s4.json")"
+grep -q '"emitted_caustic": 0,' "$cli_tmp/s4.json" && ok || bad "caustic photons emitted in a diffuse box"
+grep -q '"emitted_global": 2000,' "$cli_tmp/s4.json" && ok || bad "the scene's photon count was not used"
+expect_success "zero global" "$ref" "$scene" --photons-only --caustic-photons 1000 --global-photons 0 \
+    --stats "$cli_tmp/s5.json"
+grep -q '"pass": "global", "reason": "0 photons requested"' "$cli_tmp/s5.json" && ok || bad "no skip for 0 photons"
+
+cli_summary
