@@ -58,7 +58,8 @@ typedef struct result {
     size_t triangles;
 } result;
 
-static int run(const char *scene_path, const char *text, const char *dir, int threads, uint64_t photons, result *r)
+static int run_map(const char *scene_path, const char *text, const char *dir, int threads, uint64_t photons,
+                   ps_map_kind kind, ps_accel_kind accel, result *r)
 {
     ps_scene *s = NULL;
     ps_world *w = NULL;
@@ -66,8 +67,10 @@ static int run(const char *scene_path, const char *text, const char *dir, int th
     ps_error err;
     ps_status st = text ? ps_scene_load_text(text, "bench.scn", dir, NULL, &s, &err)
                         : ps_scene_load(scene_path, NULL, &s, &err);
+    ps_accel_options aopt = {0};
+    aopt.kind = accel;
     if (st == PS_OK)
-        st = ps_world_create(s, NULL, &w, &err);
+        st = ps_world_create(s, &aopt, &w, &err);
     ps_tracer_options o = ps_tracer_default_options();
     o.threads = threads;
     if (st == PS_OK)
@@ -80,9 +83,9 @@ static int run(const char *scene_path, const char *text, const char *dir, int th
         return -1;
     }
     ps_photon_map m;
-    ps_photon_map_init(&m, PS_MAP_GLOBAL);
+    ps_photon_map_init(&m, kind);
     double t0 = now();
-    st = ps_tracer_trace(t, PS_MAP_GLOBAL, 0, photons, photons, &m, &err);
+    st = ps_tracer_trace(t, kind, 0, photons, photons, &m, &err);
     r->seconds = now() - t0;
     r->rays_per_photon = (double)m.counters.rays / (double)photons;
     r->stored_per_photon = (double)m.counters.stored / (double)photons;
@@ -94,6 +97,11 @@ static int run(const char *scene_path, const char *text, const char *dir, int th
     return st == PS_OK ? 0 : -1;
 }
 
+static int run(const char *scene_path, const char *text, const char *dir, int threads, uint64_t photons, result *r)
+{
+    return run_map(scene_path, text, dir, threads, photons, PS_MAP_GLOBAL, PS_ACCEL_AUTO, r);
+}
+
 int main(void)
 {
     const char *dir = "build/bench-tmp";
@@ -101,15 +109,30 @@ int main(void)
     mkdir(dir, 0777);
     const uint64_t photons = 200000;
     int all = 0; /* 0: one thread per core */
-    result base1, baseN;
-    if (run("data/scenes/cornell-caustic.scn", NULL, NULL, 1, photons, &base1) ||
-        run("data/scenes/cornell-caustic.scn", NULL, NULL, all, photons, &baseN))
+    /* The default scene (12 primitives), both maps, with the octree and with
+     * the brute-force loop as the baseline measured in the same run. */
+    const char *def = "data/scenes/cornell-caustic.scn";
+    result base1, baseN, c1, cN, b1, bc1;
+    if (run_map(def, NULL, NULL, 1, photons, PS_MAP_GLOBAL, PS_ACCEL_OCTREE, &base1) ||
+        run_map(def, NULL, NULL, all, photons, PS_MAP_GLOBAL, PS_ACCEL_OCTREE, &baseN) ||
+        run_map(def, NULL, NULL, 1, photons, PS_MAP_CAUSTIC, PS_ACCEL_OCTREE, &c1) ||
+        run_map(def, NULL, NULL, all, photons, PS_MAP_CAUSTIC, PS_ACCEL_OCTREE, &cN) ||
+        run_map(def, NULL, NULL, 1, photons, PS_MAP_GLOBAL, PS_ACCEL_BRUTE, &b1) ||
+        run_map(def, NULL, NULL, 1, photons, PS_MAP_CAUSTIC, PS_ACCEL_BRUTE, &bc1))
         return 1;
-    printf("photon tracing: %llu global photons a run (Russian roulette on albedo)\n", (unsigned long long)photons);
+    printf("photon tracing: %llu photons a run; 1t: one thread, Nt: all cores\n", (unsigned long long)photons);
+    printf("vs base: one-thread speed relative to the first row\n");
     printf("%-34s %10s %12s %12s %9s %9s %10s\n", "scene", "triangles", "photons/s 1t", "photons/s Nt",
            "vs base", "rays/ph", "stored/ph");
-    printf("%-34s %10zu %12.0f %12.0f %9.2f %9.2f %10.2f\n", "cornell-caustic (baseline)", base1.triangles,
+    printf("%-34s %10zu %12.0f %12.0f %9.2f %9.2f %10.2f\n", "cornell global, octree (base)", base1.triangles,
            photons / base1.seconds, photons / baseN.seconds, 1.0, base1.rays_per_photon, base1.stored_per_photon);
+    printf("%-34s %10zu %12.0f %12s %9.2f %9.2f %10.2f\n", "cornell global, brute force", b1.triangles,
+           photons / b1.seconds, "-", base1.seconds / b1.seconds, b1.rays_per_photon, b1.stored_per_photon);
+    printf("%-34s %10zu %12.0f %12.0f %9.2f %9.2f %10.2f\n", "cornell caustic, octree", c1.triangles,
+           photons / c1.seconds, photons / cN.seconds, base1.seconds / c1.seconds, c1.rays_per_photon,
+           c1.stored_per_photon);
+    printf("%-34s %10zu %12.0f %12s %9.2f %9.2f %10.2f\n", "cornell caustic, brute force", bc1.triangles,
+           photons / bc1.seconds, "-", base1.seconds / bc1.seconds, bc1.rays_per_photon, bc1.stored_per_photon);
     long sizes[] = {1000, 10000, 100000, 1000000};
     double first_us = 0;
     printf("csv,scene,triangles,photons_per_s_1t,photons_per_s_nt,us_per_photon_1t,rays_per_photon\n");
