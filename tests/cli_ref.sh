@@ -14,8 +14,14 @@ expect_success "--help" "$ref" --help
 expect_match "--help text" "$cli_out" '^usage: photosplat-ref SCENE'
 expect_usage_error "no arguments" "$ref"
 expect_usage_error "unknown option" "$ref" "$scene" --photons-only --frobnicate
-expect_usage_error "no image renderer yet" "$ref" "$scene" -o "$cli_tmp/x.png"
-expect_match "says so" "$cli_err" 'use --photons-only'
+expect_usage_error "nothing to write" "$ref" "$scene"
+expect_match "says so" "$cli_err" 'nothing to write'
+expect_usage_error "bad component" "$ref" "$scene" -o "$cli_tmp/x.png" --component glow
+expect_usage_error "bad kernel" "$ref" "$scene" -o "$cli_tmp/x.png" --kernel triangle
+expect_usage_error "zero spp" "$ref" "$scene" -o "$cli_tmp/x.png" --spp 0
+expect_usage_error "bad size" "$ref" "$scene" -o "$cli_tmp/x.png" --size 0x10
+expect_usage_error "unwritable png" "$ref" "$scene" -o /nonexistent/dir/x.png --size 8x8 --spp 1 "${small[@]}"
+[ ! -e "$cli_tmp/x.png" ] && ok || bad "a failed run left x.png behind"
 expect_usage_error "negative photons" "$ref" "$scene" --photons-only --caustic-photons -1
 expect_usage_error "zero threads" "$ref" "$scene" --photons-only --threads 0
 expect_usage_error "bad seed" "$ref" "$scene" --photons-only --seed 1.5
@@ -63,5 +69,22 @@ grep -q '"emitted_global": 2000,' "$cli_tmp/s4.json" && ok || bad "the scene's p
 expect_success "zero global" "$ref" "$scene" --photons-only --caustic-photons 1000 --global-photons 0 \
     --stats "$cli_tmp/s5.json"
 grep -q '"pass": "global", "reason": "0 photons requested"' "$cli_tmp/s5.json" && ok || bad "no skip for 0 photons"
+
+# The image: PNG and PFM of the right size, every component.
+expect_success "render" "$ref" "$scene" -o "$cli_tmp/r.png" --hdr "$cli_tmp/r.pfm" --size 32x24 --spp 1 \
+    --gather 4 "${small[@]}" --stats "$cli_tmp/r.json"
+[ "$(head -c 8 "$cli_tmp/r.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a ] && ok || bad "r.png is not a PNG"
+[ "$(head -2 "$cli_tmp/r.pfm" | tr '\n' ' ')" = "PF 32 24 " ] && ok || bad "r.pfm is not a 32x24 PFM"
+grep -q '"render_seconds":' "$cli_tmp/r.json" && ok || bad "stats lack render_seconds"
+for c in all direct caustic indirect specular; do
+    expect_success "component $c" "$ref" "$scene" --hdr "$cli_tmp/c-$c.pfm" --size 16x16 --spp 1 --gather 2 \
+        --component "$c" "${small[@]}"
+done
+# Thread count never changes the image.
+expect_success "render 1 thread" "$ref" "$scene" --hdr "$cli_tmp/t1.pfm" --size 16x16 --spp 1 --gather 2 \
+    --threads 1 "${small[@]}"
+expect_success "render 2 threads" "$ref" "$scene" --hdr "$cli_tmp/t2.pfm" --size 16x16 --spp 1 --gather 2 \
+    --threads 2 "${small[@]}"
+cmp -s "$cli_tmp/t1.pfm" "$cli_tmp/t2.pfm" && ok || bad "images differ between 1 and 2 threads"
 
 cli_summary

@@ -1,19 +1,28 @@
-/* ref_main.c: photosplat-ref, the software reference renderer.
- *
- * For now it traces the photon maps (--photons-only) so the tracer can be
- * checked on its own: --dump-photons writes every stored photon, --stats the
- * figures of the run. The ray-traced image (-o, --hdr) comes with the
- * reference renderer itself. */
+/* ref_main.c: photosplat-ref, the software reference renderer: traces the
+ * photon maps, then ray traces the image over them (src/render). With
+ * --photons-only it stops after the maps, so the tracer can be checked alone. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "app/cli.h"
 #include "app/stats.h"
 #include "core/fileio.h"
+#include "photon/estimate.h"
+#include "photon/kdtree.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
+#include "render/render.h"
 #include "scene/scene.h"
+
+/* Defaults for the image (see the README's recommended settings). */
+#define REF_DEFAULT_SPP 4
+#define REF_DEFAULT_K 100
+#define REF_DEFAULT_GATHER 64
+/* Final gathering looks irradiance up at every this-many-th photon (Christensen 1999 uses a subset). */
+#define REF_IRRADIANCE_STRIDE 4
 
 static const char usage[] =
     "usage: photosplat-ref SCENE.scn --photons-only [options]\n"
@@ -24,8 +33,8 @@ static const char usage[] =
     "writes them (--dump-photons) and the run's figures (--stats) without an image.\n"
     "\n"
     "options:\n"
-    "  -o FILE.png              8-bit PNG, sRGB after exposure (not yet available)\n"
-    "  --hdr FILE.pfm           linear radiance, little-endian PFM (not yet available)\n"
+    "  -o FILE.png              8-bit PNG, sRGB after exposure\n"
+    "  --hdr FILE.pfm           linear radiance (W sr^-1 m^-2), little-endian PFM\n"
     "  --size WxH               image size (default from the scene)\n"
     "  --exposure E             radiance multiplier before encoding (default 1)\n"
     "  --caustic-photons N      photons emitted for the caustic map (default from the scene)\n"
@@ -37,8 +46,13 @@ static const char usage[] =
     "  --stats FILE.json        figures of the run\n"
     "  --dump-photons FILE      every stored photon: map x y z r g b dx dy dz nx ny nz\n"
     "  --photons-only           trace the photon maps only; -o is not needed\n"
-    "  --spp N, --k N, --max-radius R, --gather N\n"
-    "                           eye samples, photons per estimate, largest radius, final gather\n"
+    "  --spp N                  eye samples per pixel (default 4)\n"
+    "  --k N                    photons per radiance estimate (default 100)\n"
+    "  --max-radius R           largest search radius of both maps (default: their radii)\n"
+    "  --gather N               final gather rays per indirect estimate (default 64;\n"
+    "                           0: the global map's estimate directly)\n"
+    "  --kernel box|cone|gauss|epanechnikov  radiance estimate kernel (default cone)\n"
+    "  --light-samples N        shadow rays per area light per eye sample (default 1)\n"
     "  --component all|direct|caustic|indirect|specular\n"
     "                           render one term of the split rendering equation\n"
     "  --caustic-cones on|off   aim caustic photons only at specular objects (default on)\n"
@@ -50,7 +64,12 @@ static const char usage[] =
 typedef struct ref_options {
     const char *scene, *out_png, *out_hdr, *stats, *dump;
     int64_t photons[PS_MAP_COUNT]; /* -1: the scene's default */
-    int64_t seed, threads;
+    double radius[PS_MAP_COUNT];   /* 0: the scene's default */
+    double max_radius;             /* 0: the radii */
+    int width, height;             /* 0: the scene's */
+    double exposure;
+    int64_t seed, threads, spp, k, gather, light_samples;
+    int component, kernel;
     bool photons_only;
     bool cones, first_hit;
     int accel;
@@ -68,14 +87,19 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
     static const char *const on_off[] = {"off", "on", NULL};
     static const char *const components[] = {"all", "direct", "caustic", "indirect", "specular", NULL};
     static const char *const accels[] = {"auto", "octree", "brute", NULL};
+    static const char *const kernels[] = {"box", "cone", "gauss", "epanechnikov", NULL};
     ps_cli cli = ps_cli_begin("photosplat-ref", argc, argv);
     memset(o, 0, sizeof *o);
     o->photons[PS_MAP_CAUSTIC] = o->photons[PS_MAP_GLOBAL] = -1;
     o->cones = o->first_hit = true;
+    o->exposure = 1.0;
+    o->spp = REF_DEFAULT_SPP;
+    o->k = REF_DEFAULT_K;
+    o->gather = REF_DEFAULT_GATHER;
+    o->light_samples = 1;
+    o->kernel = PS_KERNEL_CONE;
     ps_status st = PS_OK;
-    double dummy_d;
-    int64_t dummy_i;
-    int choice, w, h;
+    int choice;
     while (st == PS_OK && ps_cli_next(&cli)) {
         if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "-h")) {
             *help = true;
@@ -94,26 +118,35 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
         } else if (ps_cli_is(&cli, "--dump-photons")) {
             st = ps_cli_string(&cli, &o->dump, err);
         } else if (ps_cli_is(&cli, "--size")) {
-            st = ps_cli_size(&cli, PS_SCENE_MAX_IMAGE_SIDE, &w, &h, err);
+            st = ps_cli_size(&cli, PS_SCENE_MAX_IMAGE_SIDE, &o->width, &o->height, err);
         } else if (ps_cli_is(&cli, "--exposure")) {
-            st = ps_cli_double(&cli, 0.0, 1e30, &dummy_d, err);
+            st = ps_cli_double(&cli, 0.0, 1e30, &o->exposure, err);
         } else if (ps_cli_is(&cli, "--caustic-photons")) {
             st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_CAUSTIC], err);
         } else if (ps_cli_is(&cli, "--global-photons")) {
             st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_GLOBAL], err);
-        } else if (ps_cli_is(&cli, "--caustic-radius") || ps_cli_is(&cli, "--global-radius") ||
-                   ps_cli_is(&cli, "--max-radius")) {
-            st = ps_cli_double(&cli, 1e-300, 1e300, &dummy_d, err);
+        } else if (ps_cli_is(&cli, "--caustic-radius")) {
+            st = ps_cli_double(&cli, 1e-300, 1e300, &o->radius[PS_MAP_CAUSTIC], err);
+        } else if (ps_cli_is(&cli, "--global-radius")) {
+            st = ps_cli_double(&cli, 1e-300, 1e300, &o->radius[PS_MAP_GLOBAL], err);
+        } else if (ps_cli_is(&cli, "--max-radius")) {
+            st = ps_cli_double(&cli, 1e-300, 1e300, &o->max_radius, err);
         } else if (ps_cli_is(&cli, "--seed")) {
             st = ps_cli_int(&cli, 0, INT64_MAX, &o->seed, err);
         } else if (ps_cli_is(&cli, "--threads")) {
             st = ps_cli_int(&cli, 1, PS_TRACER_MAX_THREADS, &o->threads, err);
-        } else if (ps_cli_is(&cli, "--spp") || ps_cli_is(&cli, "--k")) {
-            st = ps_cli_int(&cli, 1, 1000000, &dummy_i, err);
+        } else if (ps_cli_is(&cli, "--spp")) {
+            st = ps_cli_int(&cli, 1, 1000000, &o->spp, err);
+        } else if (ps_cli_is(&cli, "--k")) {
+            st = ps_cli_int(&cli, 1, 100000, &o->k, err);
         } else if (ps_cli_is(&cli, "--gather")) {
-            st = ps_cli_int(&cli, 0, 1000000, &dummy_i, err);
+            st = ps_cli_int(&cli, 0, 100000, &o->gather, err);
+        } else if (ps_cli_is(&cli, "--light-samples")) {
+            st = ps_cli_int(&cli, 1, 100000, &o->light_samples, err);
         } else if (ps_cli_is(&cli, "--component")) {
-            st = ps_cli_choice(&cli, components, &choice, err);
+            st = ps_cli_choice(&cli, components, &o->component, err);
+        } else if (ps_cli_is(&cli, "--kernel")) {
+            st = ps_cli_choice(&cli, kernels, &o->kernel, err);
         } else if (ps_cli_is(&cli, "--photons-only")) {
             o->photons_only = true;
         } else if (ps_cli_is(&cli, "--caustic-cones")) {
@@ -132,9 +165,9 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
         return st;
     if (!o->scene)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-ref: no scene given (see --help)");
-    if (!o->photons_only)
+    if (!o->photons_only && !o->out_png && !o->out_hdr)
         return ps_error_set(err, PS_ERR_PARSE,
-                            "photosplat-ref: the image renderer is not built yet; use --photons-only (see --help)");
+                            "photosplat-ref: nothing to write: give -o FILE.png, --hdr FILE.pfm or --photons-only");
     return PS_OK;
 }
 
@@ -148,20 +181,139 @@ static ps_status write_dump(const char *path, const ps_photon_map maps[PS_MAP_CO
     return ps_outfile_commit(out, err);
 }
 
-/* Traces both maps and writes what was asked for. */
+/* A progress line on stderr when it is a terminal: percent, elapsed, left. */
+typedef struct progress {
+    double start, last;
+} progress;
+
+static void show_progress(void *user, double fraction)
+{
+    progress *p = user;
+    double t = now_seconds();
+    if (t - p->last < 0.25 && fraction < 1.0)
+        return;
+    p->last = t;
+    double elapsed = t - p->start, left = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
+    fprintf(stderr, "\rrendering %3.0f%%  %5.1f s elapsed, ~%5.1f s left ", 100.0 * fraction, elapsed, left);
+    if (fraction >= 1.0)
+        fputc('\n', stderr);
+    fflush(stderr);
+}
+
+typedef struct ref_run {
+    ps_world *world;
+    ps_tracer *tracer, *full_tracer;
+    ps_photon_map maps[PS_MAP_COUNT], full;
+    ps_kdtree *trees[PS_MAP_COUNT], *full_tree, *irradiance;
+    ps_light_sampler *lights;
+    ps_image image;
+} ref_run;
+
+static void ref_run_free(ref_run *r)
+{
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        ps_photon_map_free(&r->maps[k]);
+        ps_kdtree_destroy(r->trees[k]);
+    }
+    ps_photon_map_free(&r->full);
+    ps_kdtree_destroy(r->full_tree);
+    ps_kdtree_destroy(r->irradiance);
+    ps_light_sampler_destroy(r->lights);
+    ps_image_destroy(&r->image);
+    ps_tracer_destroy(r->full_tracer);
+    ps_tracer_destroy(r->tracer);
+    ps_world_destroy(r->world);
+}
+
+/* What the image needs beyond the two maps: the kd-trees, and for final
+ * gathering a global map with the direct hits and its precomputed irradiance. */
+static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_run *r, const ps_tracer_options *topt,
+                              uint64_t global_photons, double radius[PS_MAP_COUNT], ps_run_stats *rs, ps_error *err)
+{
+    const ps_scene_defaults *def = ps_scene_get_defaults(scene);
+    ps_render_options ro;
+    memset(&ro, 0, sizeof ro);
+    ro.width = o->width ? o->width : def->width;
+    ro.height = o->height ? o->height : def->height;
+    ro.spp = (int)o->spp;
+    ro.light_samples = (int)o->light_samples;
+    ro.gather = (int)o->gather;
+    ro.seed = (uint64_t)o->seed;
+    ro.threads = ps_tracer_threads(r->tracer);
+    ro.component = (ps_component)o->component;
+    ro.caustic.k = ro.global.k = (size_t)o->k;
+    ro.caustic.kernel = ro.global.kernel = (ps_kernel)o->kernel;
+    ro.caustic.max_radius = o->max_radius > 0.0 ? o->max_radius : radius[PS_MAP_CAUSTIC];
+    ro.global.max_radius = o->max_radius > 0.0 ? o->max_radius : radius[PS_MAP_GLOBAL];
+    ro.irradiance_radius = ro.global.max_radius;
+
+    double t0 = now_seconds();
+    ps_status st = ps_light_sampler_create(scene, &r->lights, err);
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
+        st = ps_kdtree_build(r->maps[k].photons, r->maps[k].count, &r->trees[k], err);
+    ps_render_maps maps = {r->maps[PS_MAP_CAUSTIC].count ? r->trees[PS_MAP_CAUSTIC] : NULL, r->trees[PS_MAP_GLOBAL],
+                           NULL, NULL};
+    bool need_indirect = ro.component == PS_COMPONENT_ALL || ro.component == PS_COMPONENT_INDIRECT ||
+                         ro.component == PS_COMPONENT_SPECULAR;
+    if (st == PS_OK && ro.gather > 0 && need_indirect && ps_tracer_map_enabled(r->tracer, PS_MAP_GLOBAL) &&
+        global_photons > 0) {
+        ps_tracer_options full = *topt;
+        full.global_direct = true;
+        ps_photon_map_init(&r->full, PS_MAP_GLOBAL);
+        st = ps_tracer_create(r->world, &full, &r->full_tracer, err);
+        if (st == PS_OK)
+            st = ps_tracer_trace(r->full_tracer, PS_MAP_GLOBAL, 0, global_photons, global_photons, &r->full, err);
+        if (st == PS_OK)
+            st = ps_kdtree_build(r->full.photons, r->full.count, &r->full_tree, err);
+        if (st == PS_OK)
+            st = ps_irradiance_precompute(r->full_tree, &ro.global, REF_IRRADIANCE_STRIDE, ro.threads,
+                                                 &r->irradiance, err);
+        maps.full = r->full_tree;
+        maps.irradiance = r->irradiance;
+        rs->rays += r->full.counters.rays;
+    }
+    double t_prep = now_seconds() - t0;
+    progress pr = {now_seconds(), 0.0};
+    if (isatty(STDERR_FILENO)) {
+        ro.progress = show_progress;
+        ro.progress_user = &pr;
+    }
+    ps_render_stats stats = {0, 0.0};
+    if (st == PS_OK)
+        st = ps_render(r->world, r->lights, &maps, &ro, &r->image, &stats, err);
+    if (st == PS_OK && o->out_hdr)
+        st = ps_pfm_write(&r->image, o->out_hdr, err);
+    if (st == PS_OK && o->out_png)
+        st = ps_png_write(&r->image, o->out_png, (float)o->exposure, err);
+    rs->rays += stats.rays;
+    rs->ray_seconds = rs->trace_seconds + t_prep + stats.seconds;
+    ps_stats_add(rs, "maps_seconds", t_prep);
+    ps_stats_add(rs, "render_seconds", stats.seconds);
+    ps_stats_add(rs, "render_rays", (double)stats.rays);
+    ps_stats_add(rs, "width", ro.width);
+    ps_stats_add(rs, "height", ro.height);
+    ps_stats_add(rs, "spp", ro.spp);
+    ps_stats_add(rs, "k", (double)ro.caustic.k);
+    ps_stats_add(rs, "gather", ro.gather);
+    ps_stats_add(rs, "caustic_radius", ro.caustic.max_radius);
+    ps_stats_add(rs, "global_radius", ro.global.max_radius);
+    return st;
+}
+
+/* Traces both maps, renders unless --photons-only, writes what was asked for. */
 static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
 {
     static const ps_accel_kind kinds[] = {PS_ACCEL_AUTO, PS_ACCEL_OCTREE, PS_ACCEL_BRUTE};
     ps_accel_options aopt = {0};
     aopt.kind = kinds[o->accel];
-    ps_world *world = NULL;
-    ps_tracer *tracer = NULL;
-    ps_photon_map maps[PS_MAP_COUNT];
+    ref_run r;
+    memset(&r, 0, sizeof r);
     for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_init(&maps[k], (ps_map_kind)k);
+        ps_photon_map_init(&r.maps[k], (ps_map_kind)k);
+    ps_photon_map_init(&r.full, PS_MAP_GLOBAL);
 
     double t_build = now_seconds();
-    ps_status st = ps_world_create(scene, &aopt, &world, err);
+    ps_status st = ps_world_create(scene, &aopt, &r.world, err);
     t_build = now_seconds() - t_build;
     ps_tracer_options topt = ps_tracer_default_options();
     topt.seed = (uint64_t)o->seed;
@@ -169,63 +321,67 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
     topt.caustic_cones = o->cones;
     topt.first_hit_test = o->first_hit;
     if (st == PS_OK)
-        st = ps_tracer_create(world, &topt, &tracer, err);
+        st = ps_tracer_create(r.world, &topt, &r.tracer, err);
 
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
     int64_t want[PS_MAP_COUNT] = {o->photons[PS_MAP_CAUSTIC] >= 0 ? o->photons[PS_MAP_CAUSTIC] : def->caustic_photons,
                                   o->photons[PS_MAP_GLOBAL] >= 0 ? o->photons[PS_MAP_GLOBAL] : def->global_photons};
+    double radius[PS_MAP_COUNT] = {o->radius[PS_MAP_CAUSTIC] > 0 ? o->radius[PS_MAP_CAUSTIC] : def->caustic_radius,
+                                   o->radius[PS_MAP_GLOBAL] > 0 ? o->radius[PS_MAP_GLOBAL] : def->global_radius};
     double t_trace = now_seconds();
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
-        if (!ps_tracer_map_enabled(tracer, (ps_map_kind)k))
+        if (!ps_tracer_map_enabled(r.tracer, (ps_map_kind)k))
             continue;
         if (want[k] == 0) {
-            st = ps_tracer_note_skip(tracer, ps_map_name((ps_map_kind)k), "0 photons requested");
+            st = ps_tracer_note_skip(r.tracer, ps_map_name((ps_map_kind)k), "0 photons requested");
             if (st != PS_OK)
                 ps_error_set(err, st, "photosplat-ref: out of memory");
             continue;
         }
-        st = ps_tracer_trace(tracer, (ps_map_kind)k, 0, (uint64_t)want[k], (uint64_t)want[k], &maps[k], err);
+        st = ps_tracer_trace(r.tracer, (ps_map_kind)k, 0, (uint64_t)want[k], (uint64_t)want[k], &r.maps[k], err);
     }
     t_trace = now_seconds() - t_trace;
 
+    ps_run_stats rs;
+    memset(&rs, 0, sizeof rs);
     if (st == PS_OK && o->dump)
-        st = write_dump(o->dump, maps, err);
+        st = write_dump(o->dump, r.maps, err);
     if (st == PS_OK) {
-        ps_run_stats rs;
-        memset(&rs, 0, sizeof rs);
         for (int k = 0; k < PS_MAP_COUNT; k++) {
-            rs.emitted[k] = maps[k].counters.emitted;
-            rs.stored[k] = maps[k].counters.stored;
-            rs.rays += maps[k].counters.rays;
+            rs.emitted[k] = r.maps[k].counters.emitted;
+            rs.stored[k] = r.maps[k].counters.stored;
+            rs.rays += r.maps[k].counters.rays;
         }
         rs.trace_seconds = t_trace;
-        rs.skips = ps_tracer_skips(tracer, &rs.skip_count);
+        rs.skips = ps_tracer_skips(r.tracer, &rs.skip_count);
         ps_accel_stats as;
-        ps_accel_get_stats(ps_world_accel(world), &as);
-        ps_stats_add(&rs, "threads", ps_tracer_threads(tracer));
+        ps_accel_get_stats(ps_world_accel(r.world), &as);
+        ps_stats_add(&rs, "threads", ps_tracer_threads(r.tracer));
         ps_stats_add(&rs, "seed", (double)o->seed);
         ps_stats_add(&rs, "accel_build_seconds", t_build);
         ps_stats_add(&rs, "accel_nodes", (double)as.nodes);
-        ps_stats_add(&rs, "escaped", (double)(maps[0].counters.escaped + maps[1].counters.escaped));
-        ps_stats_add(&rs, "absorbed", (double)(maps[0].counters.absorbed + maps[1].counters.absorbed));
-        ps_stats_add(&rs, "discarded_caustic", (double)maps[PS_MAP_CAUSTIC].counters.discarded);
-        ps_stats_add(&rs, "truncated", (double)(maps[0].counters.truncated + maps[1].counters.truncated));
-        if (o->stats)
-            st = ps_stats_write(o->stats, &rs, err);
-        if (st == PS_OK) {
-            printf("caustic: %llu emitted, %llu stored; global: %llu emitted, %llu stored; %llu rays in %.3f s "
-                   "(%d threads)\n",
-                   (unsigned long long)rs.emitted[0], (unsigned long long)rs.stored[0],
-                   (unsigned long long)rs.emitted[1], (unsigned long long)rs.stored[1], (unsigned long long)rs.rays,
-                   t_trace, ps_tracer_threads(tracer));
-            for (size_t k = 0; k < rs.skip_count; k++)
-                printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
-        }
+        ps_stats_add(&rs, "escaped", (double)(r.maps[0].counters.escaped + r.maps[1].counters.escaped));
+        ps_stats_add(&rs, "absorbed", (double)(r.maps[0].counters.absorbed + r.maps[1].counters.absorbed));
+        ps_stats_add(&rs, "discarded_caustic", (double)r.maps[PS_MAP_CAUSTIC].counters.discarded);
+        ps_stats_add(&rs, "truncated", (double)(r.maps[0].counters.truncated + r.maps[1].counters.truncated));
     }
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_free(&maps[k]);
-    ps_tracer_destroy(tracer);
-    ps_world_destroy(world);
+    if (st == PS_OK && !o->photons_only)
+        st = render_image(o, scene, &r, &topt, (uint64_t)want[PS_MAP_GLOBAL], radius, &rs, err);
+    if (st == PS_OK && o->stats)
+        st = ps_stats_write(o->stats, &rs, err);
+    if (st == PS_OK) {
+        printf("caustic: %llu emitted, %llu stored; global: %llu emitted, %llu stored; traced in %.3f s; %llu rays "
+               "(%d threads)\n",
+               (unsigned long long)rs.emitted[0], (unsigned long long)rs.stored[0], (unsigned long long)rs.emitted[1],
+               (unsigned long long)rs.stored[1], t_trace, (unsigned long long)rs.rays, ps_tracer_threads(r.tracer));
+        for (size_t k = 0; k < rs.skip_count; k++)
+            printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
+        if (o->out_png)
+            printf("wrote %s\n", o->out_png);
+        if (o->out_hdr)
+            printf("wrote %s\n", o->out_hdr);
+    }
+    ref_run_free(&r);
     return st;
 }
 

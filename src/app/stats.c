@@ -46,7 +46,7 @@ void ps_stats_print(FILE *f, const ps_run_stats *s)
     fprintf(f, "  \"frames\": %llu,\n", (unsigned long long)s->frames);
     fprintf(f, "  \"photons_per_second\": %.6g,\n", finite_or_zero(rate((double)emitted, s->trace_seconds)));
     fprintf(f, "  \"rays_traced\": %llu,\n", (unsigned long long)s->rays);
-    fprintf(f, "  \"rays_per_second\": %.6g,\n", finite_or_zero(rate((double)s->rays, s->trace_seconds)));
+    fprintf(f, "  \"rays_per_second\": %.6g,\n", finite_or_zero(rate((double)s->rays, s->ray_seconds > 0.0 ? s->ray_seconds : s->trace_seconds)));
     for (size_t k = 0; k < s->extra_count; k++) {
         fprintf(f, "  ");
         ps_json_string(f, s->extra[k].key);

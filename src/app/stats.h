@@ -19,6 +19,7 @@ typedef struct ps_run_stats {
     double trace_seconds, splat_seconds;
     uint64_t frames;
     uint64_t rays;
+    double ray_seconds; /* the time those rays took (0: trace_seconds) */
     const ps_skip *skips;
     size_t skip_count;
     /* Further numeric keys, e.g. {"threads", 2}. */

@@ -216,6 +216,11 @@ static void sample_area(const ps_light_sampler *ls, const ps_light *L, uint32_t 
     }
 }
 
+void ps_light_sample_point(const ps_light_sampler *ls, uint32_t l, double u0, double u1, ps_vec3 *p, ps_vec3 *n)
+{
+    sample_area(ls, light_at(ls, l), l, u0, u1, p, n);
+}
+
 bool ps_light_emit(const ps_light_sampler *ls, uint32_t l, const ps_cone *cone, const double u[4], ps_emission *out)
 {
     const ps_light *L = light_at(ls, l);

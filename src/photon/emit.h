@@ -65,4 +65,9 @@ double ps_light_cone_share(const ps_light_sampler *ls, uint32_t l, const ps_cone
  * emitted, which is what keeps the estimate unbiased. */
 bool ps_light_emit(const ps_light_sampler *ls, uint32_t l, const ps_cone *cone, const double u[4], ps_emission *out);
 
+/* A point on area light l (quad, disc, sphere, mesh) and the unit normal of
+ * its emitting side there, uniform over its area, from u0, u1 in [0, 1). For
+ * the reference renderer's shadow rays: density 1 / light area. */
+void ps_light_sample_point(const ps_light_sampler *ls, uint32_t l, double u0, double u1, ps_vec3 *p, ps_vec3 *n);
+
 #endif

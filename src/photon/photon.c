@@ -6,9 +6,14 @@
 /* RGBE exponents are stored biased by 128 in one byte (Ward, Graphics Gems II). */
 #define RGBE_BIAS 128
 #define RGBE_MANTISSA 256.0 /* 8-bit mantissas: values are m * 2^(e - 8) */
-/* Octahedral coordinates in [-1, 1] quantised to 8 bits each; an even number
- * of steps so that 0 (the axes and the fold lines) is exact. */
-#define OCT_LEVELS 254.0
+/* Octahedral coordinates in [-1, 1] are quantised to `bits` bits each, over
+ * an even number of steps (2^bits - 2) so that 0 (the axes and the fold
+ * lines) is exact. */
+static double oct_levels(int bits) { return (double)((1u << bits) - 2u); }
+/* The normal shares its 16 bits with the flags: 7 + 7 bits, flags on top. */
+#define NORMAL_BITS 7
+#define NORMAL_MASK 0x3fffu
+#define FLAGS_SHIFT 14
 
 const char *ps_map_name(ps_map_kind k) { return k == PS_MAP_CAUSTIC ? "caustic" : "global"; }
 
@@ -55,8 +60,9 @@ ps_rgb ps_rgbe_decode(const uint8_t in[4])
     return ps_rgb_make(in[0] * f, in[1] * f, in[2] * f);
 }
 
-uint16_t ps_oct_encode(ps_vec3 v)
+uint16_t ps_oct_encode_bits(ps_vec3 v, int bits)
 {
+    const double levels = oct_levels(bits);
     double l1 = fabs(v.x) + fabs(v.y) + fabs(v.z);
     if (!(l1 > 0.0) || !isfinite(l1))
         v = ps_v3(0.0, 0.0, 1.0), l1 = 1.0;
@@ -70,15 +76,15 @@ uint16_t ps_oct_encode(ps_vec3 v)
     }
     /* Of the four codes around (x, y), keep the one that decodes closest to v
      * (Cigolle et al. 2014): worst error 0.7 instead of 0.95 degrees. */
-    double gx = fmin(fmax((x * 0.5 + 0.5) * OCT_LEVELS, 0.0), OCT_LEVELS);
-    double gy = fmin(fmax((y * 0.5 + 0.5) * OCT_LEVELS, 0.0), OCT_LEVELS);
+    double gx = fmin(fmax((x * 0.5 + 0.5) * levels, 0.0), levels);
+    double gy = fmin(fmax((y * 0.5 + 0.5) * levels, 0.0), levels);
     ps_vec3 unit = ps_v3_norm(v);
     uint16_t best = 0;
     double best_dot = -2.0;
     for (int k = 0; k < 4; k++) {
         double qx = (k & 1) ? ceil(gx) : floor(gx), qy = (k & 2) ? ceil(gy) : floor(gy);
-        uint16_t code = (uint16_t)((unsigned)qx << 8 | (unsigned)qy);
-        double d = ps_v3_dot(ps_oct_decode(code), unit);
+        uint16_t code = (uint16_t)((unsigned)qx << bits | (unsigned)qy);
+        double d = ps_v3_dot(ps_oct_decode_bits(code, bits), unit);
         if (d > best_dot) {
             best_dot = d;
             best = code;
@@ -87,10 +93,11 @@ uint16_t ps_oct_encode(ps_vec3 v)
     return best;
 }
 
-ps_vec3 ps_oct_decode(uint16_t code)
+ps_vec3 ps_oct_decode_bits(uint16_t code, int bits)
 {
-    double x = (code >> 8) / OCT_LEVELS * 2.0 - 1.0;
-    double y = (code & 0xff) / OCT_LEVELS * 2.0 - 1.0;
+    const double levels = oct_levels(bits);
+    double x = (code >> bits) / levels * 2.0 - 1.0;
+    double y = (code & ((1u << bits) - 1u)) / levels * 2.0 - 1.0;
     double z = 1.0 - fabs(x) - fabs(y);
     if (z < 0.0) {
         double fx = (1.0 - fabs(y)) * (x >= 0.0 ? 1.0 : -1.0);
@@ -108,11 +115,19 @@ ps_photon ps_photon_pack(ps_vec3 pos, ps_rgb power, ps_vec3 dir, ps_vec3 normal,
     p.pos[1] = (float)pos.y;
     p.pos[2] = (float)pos.z;
     ps_rgbe_encode(power, dither, p.rgbe);
-    p.dir = ps_oct_encode(dir);
-    p.normal = ps_oct_encode(normal);
+    p.dir = ps_oct_encode_bits(dir, PS_OCT_DIR_BITS);
+    p.normal_flags = ps_oct_encode_bits(normal, NORMAL_BITS); /* flags 0 */
     return p;
 }
 
 ps_rgb ps_photon_power(const ps_photon *p) { return ps_rgbe_decode(p->rgbe); }
-ps_vec3 ps_photon_dir(const ps_photon *p) { return ps_oct_decode(p->dir); }
-ps_vec3 ps_photon_normal(const ps_photon *p) { return ps_oct_decode(p->normal); }
+ps_vec3 ps_photon_dir(const ps_photon *p) { return ps_oct_decode_bits(p->dir, PS_OCT_DIR_BITS); }
+ps_vec3 ps_photon_normal(const ps_photon *p)
+{
+    return ps_oct_decode_bits((uint16_t)(p->normal_flags & NORMAL_MASK), NORMAL_BITS);
+}
+unsigned ps_photon_flags(const ps_photon *p) { return (unsigned)p->normal_flags >> FLAGS_SHIFT; }
+void ps_photon_set_flags(ps_photon *p, unsigned flags)
+{
+    p->normal_flags = (uint16_t)((p->normal_flags & NORMAL_MASK) | (flags & 3u) << FLAGS_SHIFT);
+}

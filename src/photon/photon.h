@@ -4,13 +4,18 @@
  *     float    pos[3]   12  where it landed (single precision: 1e-7 relative,
  *                           far below any splat or search radius)
  *     uint8_t  rgbe[4]   4  power in watts, Ward's shared-exponent RGBE
- *     uint16_t dir       2  direction of travel (into the surface), octahedral
- *     uint16_t normal    2  surface normal on the side the photon came from
+ *     uint16_t dir       2  direction of travel (into the surface), octahedral 8+8 bits
+ *     uint16_t normal_flags 2  bits 0-13: surface normal on the side the photon
+ *                           came from, octahedral 7+7 bits; bits 14-15: flags
+ *                           (the kd-tree keeps a node's split axis there, as
+ *                           the thesis' photon keeps it in its flag field)
  *
  * Departure from the thesis: it packs directions as 8-bit (theta, phi); we use
- * the octahedral map (Meyer et al. 2010) at 8+8 bits, whose error is nearly
- * uniform over the sphere (at most 0.75 degrees) instead of crowding at the
- * poles. RGBE mantissas are rounded with a per-photon dither: photons of
+ * the octahedral map (Meyer et al. 2010), whose error is nearly uniform over
+ * the sphere instead of crowding at the poles: at most 0.75 degrees for the
+ * direction (8+8 bits, used by glossy estimates) and 1.5 degrees for the
+ * normal (7+7 bits, used to orient splats and to reject photons of a surface
+ * facing the other way). RGBE mantissas are rounded with a per-photon dither: photons of
  * one light often carry identical power, and plain rounding would bias all of
  * them the same way (up to 0.2 %); dithered, the error of each photon is below
  * 1/256 of its largest channel and the expected stored power is exact. */
@@ -25,8 +30,10 @@ typedef struct ps_photon {
     float pos[3];
     uint8_t rgbe[4];
     uint16_t dir;
-    uint16_t normal;
+    uint16_t normal_flags;
 } ps_photon;
+
+#define PS_OCT_DIR_BITS 8
 
 _Static_assert(sizeof(ps_photon) <= 20, "the photon record must stay within 20 bytes");
 
@@ -47,12 +54,17 @@ static inline ps_vec3 ps_photon_position(const ps_photon *p) { return ps_v3(p->p
 ps_rgb ps_photon_power(const ps_photon *p);
 ps_vec3 ps_photon_dir(const ps_photon *p);
 ps_vec3 ps_photon_normal(const ps_photon *p);
+/* Two bits of flags, 0 when packed. */
+unsigned ps_photon_flags(const ps_photon *p);
+void ps_photon_set_flags(ps_photon *p, unsigned flags);
 
 /* The encodings on their own, for tests and the GL module. */
 /* Mantissas are floor(value + dither) in units of the shared exponent. */
 void ps_rgbe_encode(ps_rgb c, double dither, uint8_t out[4]);
 ps_rgb ps_rgbe_decode(const uint8_t in[4]);
-uint16_t ps_oct_encode(ps_vec3 unit);
-ps_vec3 ps_oct_decode(uint16_t code);
+/* Octahedral codes of `bits` bits per coordinate (2 <= bits <= 8); the
+ * encoder picks, of the four codes around v, the one decoding closest to it. */
+uint16_t ps_oct_encode_bits(ps_vec3 unit, int bits);
+ps_vec3 ps_oct_decode_bits(uint16_t code, int bits);
 
 #endif

@@ -480,7 +480,7 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
                 store(out, sp.p, power, d, ns, ps_rng_uniform(&rng));
                 return;
             }
-            if (diffuse_seen)
+            if (diffuse_seen || t->opt.global_direct)
                 store(out, sp.p, power, d, ns, ps_rng_uniform(&rng));
             /* Russian roulette on the albedo: the expected power leaving is the
              * power arriving times the albedo, with no photon made heavier than

@@ -39,6 +39,10 @@ typedef struct ps_tracer_options {
     bool caustic_cones;  /* aim caustic photons only at specular objects (default true) */
     bool first_hit_test; /* discard a cone's photon whose first hit is another object
                           * (default true; off only to show the double counting it prevents) */
+    bool global_direct;  /* the global map also keeps each path's first diffuse hit, as
+                          * Jensen's global map does (default false: the preview draws
+                          * direct light itself). The reference renderer's precomputed
+                          * irradiance for final gathering needs all of the light. */
 } ps_tracer_options;
 
 /* seed 0, all cores, cones and the first-hit test on. */

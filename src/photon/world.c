@@ -80,6 +80,8 @@ bool ps_world_intersect(const ps_world *w, ps_ray r, double tmax, ps_surface *ou
     return true;
 }
 
+bool ps_world_occluded(const ps_world *w, ps_ray r, double tmax) { return ps_accel_occluded(w->accel, r, 0.0, tmax); }
+
 ps_ray ps_world_spawn(const ps_world *w, const ps_surface *sp, ps_vec3 dir)
 {
     double side = ps_v3_dot(dir, sp->ng) >= 0.0 ? w->epsilon : -w->epsilon;

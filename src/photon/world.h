@@ -41,6 +41,9 @@ double ps_world_epsilon(const ps_world *w);
 /* The nearest surface along r with t in (0, tmax). */
 bool ps_world_intersect(const ps_world *w, ps_ray r, double tmax, ps_surface *out);
 
+/* Whether anything lies on r with t in (0, tmax): a shadow ray. */
+bool ps_world_occluded(const ps_world *w, ps_ray r, double tmax);
+
 /* A ray leaving surface point sp in direction dir: its origin is pushed off
  * the surface along the geometric normal, to the side dir goes. */
 ps_ray ps_world_spawn(const ps_world *w, const ps_surface *sp, ps_vec3 dir);

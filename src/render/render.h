@@ -1,0 +1,78 @@
+/* render.h: the reference renderer's image: a Monte Carlo ray tracer over
+ * the photon maps (thesis 2.2, eq. 6), the truth the preview is judged by.
+ *
+ * At the first diffuse or glossy surface an eye ray meets, the radiance is
+ * split as in the thesis: direct light (shadow rays to every light; point and
+ * spot exact, area lights sampled), caustics (the caustic map's radiance
+ * estimate), and indirect diffuse light (final gathering on precomputed
+ * irradiance, Christensen 1999, or the global map's estimate directly). Eye
+ * rays that meet mirrors and glass first are followed (Fresnel) and all they
+ * then see is the `specular` term. The four terms partition the image:
+ * all = direct + caustic + indirect + specular. */
+#ifndef PS_RENDER_RENDER_H
+#define PS_RENDER_RENDER_H
+
+#include <stdint.h>
+
+#include "core/status.h"
+#include "image/image.h"
+#include "photon/emit.h"
+#include "photon/estimate.h"
+#include "photon/kdtree.h"
+#include "photon/world.h"
+
+typedef enum ps_component {
+    PS_COMPONENT_ALL,
+    PS_COMPONENT_DIRECT,   /* lights seen by the first diffuse/glossy surface (and emitters seen directly) */
+    PS_COMPONENT_CAUSTIC,  /* light through mirrors and glass onto that surface */
+    PS_COMPONENT_INDIRECT, /* light from other diffuse surfaces onto it */
+    PS_COMPONENT_SPECULAR, /* everything seen through mirrors and glass */
+    PS_COMPONENT_COUNT
+} ps_component;
+
+const char *ps_component_name(ps_component c);
+
+/* Eye paths end after this many mirror/glass bounces. */
+#define PS_RENDER_MAX_SPECULAR 16
+/* Through the first this many glass surfaces an eye ray follows both the
+ * reflected and the refracted ray (weighted by Fresnel); deeper, one of them
+ * chosen with those probabilities. Splitting where the weight is largest
+ * takes most of the noise out of glass for little cost. */
+#define PS_RENDER_SPLIT_DEPTH 2
+/* Final gather rays that meet mirrors or glass follow at most this many bounces. */
+#define PS_RENDER_GATHER_SPECULAR 4
+
+typedef struct ps_render_maps {
+    const ps_kdtree *caustic;    /* NULL: no caustic term */
+    const ps_kdtree *global;     /* the global map, for gather == 0 */
+    const ps_kdtree *full;       /* the global map with direct hits too, for gather > 0 */
+    const ps_kdtree *irradiance; /* irradiance precomputed at the full map's photons */
+} ps_render_maps;
+
+typedef struct ps_render_options {
+    int width, height;
+    int spp;                 /* eye samples per pixel (stratified) */
+    int light_samples;       /* shadow rays per area light per eye sample */
+    int gather;              /* final gather rays per indirect estimate; 0: the global map directly */
+    uint64_t seed;
+    int threads;             /* >= 1 */
+    ps_component component;
+    ps_estimate_options caustic, global;
+    double irradiance_radius; /* how far a gather ray's hit may be from a precomputed irradiance */
+    /* Called now and then from one thread with the fraction done (may be NULL). */
+    void (*progress)(void *user, double fraction);
+    void *progress_user;
+} ps_render_options;
+
+typedef struct ps_render_stats {
+    uint64_t rays;
+    double seconds;
+} ps_render_stats;
+
+/* Renders the image into out (created here; the caller destroys it). Pixel
+ * (x, y) depends only on (scene, maps, options, seed, x, y): the image is the
+ * same for any thread count. */
+ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_render_maps *maps,
+                    const ps_render_options *o, ps_image *out, ps_render_stats *stats, ps_error *err);
+
+#endif
