@@ -87,4 +87,20 @@ expect_success "render 2 threads" "$ref" "$scene" --hdr "$cli_tmp/t2.pfm" --size
     --threads 2 "${small[@]}"
 cmp -s "$cli_tmp/t1.pfm" "$cli_tmp/t2.pfm" && ok || bad "images differ between 1 and 2 threads"
 
+# The golden image (scripts/regen-golden.sh remakes it, on purpose only). The
+# renderer is deterministic, so the tolerance only absorbs compiler-level
+# rounding; it is far tighter than the noise: another seed must fail it.
+golden=tests/data/golden/cornell-caustic-ref
+# shellcheck disable=SC2046
+expect_success "golden render" "$ref" $(cat "$golden.args") --hdr "$cli_tmp/g.pfm"
+# shellcheck disable=SC2046
+expect_success "other seed" "$ref" $(cat "$golden.args") --seed 2 --hdr "$cli_tmp/g2.pfm"
+within_golden() { # image: relMSE below 1e-4 and means within 0.2 %
+    "$bin/photosplat-compare" "$1" "$golden.pfm" |
+        awk '{for (i = 1; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] } }
+             END { exit !(v["relmse"] < 1e-4 && (v["mean_a"] - v["mean_b"])^2 < (0.002 * v["mean_b"])^2) }'
+}
+within_golden "$cli_tmp/g.pfm" && ok || bad "the default scene's image moved from the golden one: $("$bin/photosplat-compare" "$cli_tmp/g.pfm" "$golden.pfm")"
+within_golden "$cli_tmp/g2.pfm" && bad "the golden tolerance passes another seed's noise" || ok
+
 cli_summary

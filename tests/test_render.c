@@ -230,6 +230,34 @@ static void furnace_sphere(void **state)
     rig_free(&r);
 }
 
+/* A small glossy quad (albedo 0, specular 0.5, exponent 4) inside the
+ * furnace sphere, seen head-on: the walls send radiance 1 from everywhere, and
+ * the normalised Phong lobe reflects all of it at normal incidence, so the
+ * quad shows 0.5, all of it `indirect` (the light is behind it). It is small
+ * enough that its shadow on the wall changes this by under 0.2 %. */
+static void glossy_in_furnace(void **state)
+{
+    (void)state;
+    const char *text = "camera eye 0 0 0.6 target 0 0 0.5 fov 3\n"
+                       "material wall diffuse albedo 0.5 0.5 0.5\n"
+                       "material gloss glossy albedo 0 0 0 specular 0.5 0.5 0.5 exponent 4\n"
+                       "sphere center 0 0 0 radius 1 material wall\n"
+                       "quad corner -0.005 -0.005 0.5 edge1 0.01 0 0 edge2 0 0.01 0 material gloss\n"
+                       "light point position 0 0 0 power 39.47841760435743 39.47841760435743 39.47841760435743\n";
+    ps_estimate_options est = {100, 0.3, PS_KERNEL_BOX};
+    rig r = rig_make(text, 0, 200000, &est, true);
+    ps_render_options o = options(4, 4, 16, PS_COMPONENT_ALL, &est, 64);
+    ps_image img = render(&r, &o);
+    printf("glossy quad in the furnace: radiance %.4f, expected 0.5\n", image_mean(&img, 1));
+    assert_near(image_mean(&img, 1), 0.5, 0.01);
+    ps_image_destroy(&img);
+    o.component = PS_COMPONENT_DIRECT;
+    img = render(&r, &o);
+    assert_true(image_mean(&img, 1) == 0.0);
+    ps_image_destroy(&img);
+    rig_free(&r);
+}
+
 /* The caustic of a mirror quad on the floor: the light of the mirror image of
  * the source (height 3), L = rho / pi * I * 3 / (9 + x^2)^(3/2), within 3 %
  * away from the edges of the lit square. */
@@ -350,7 +378,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(camera_matches_projection), cmocka_unit_test(direct_on_plane),
         cmocka_unit_test(disc_light),
-        cmocka_unit_test(furnace_sphere),            cmocka_unit_test(mirror_caustic_image),
+        cmocka_unit_test(furnace_sphere),
+        cmocka_unit_test(glossy_in_furnace),            cmocka_unit_test(mirror_caustic_image),
         cmocka_unit_test(components_add_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -56,7 +56,15 @@ double ps_kernel_mean(ps_kernel k)
     }
 }
 
-/* The neighbours of p facing n, and 1 / (C pi r^2) for them; 0 found: none. */
+/* The neighbours of p facing n, and 1 / (C pi r^2) for them; 0 found: none.
+ *
+ * Departure from the thesis' eq. 9 (and Jensen's code): when k photons were
+ * found, r is the distance to the k-th, which lies on the boundary. Counting
+ * it overestimates by k / (k - 1) (for a Poisson density, pi lambda r_k^2 is
+ * Gamma(k) distributed, and E[1 / Gamma(k)] = 1 / (k - 1)), 1 % at k = 100.
+ * The smooth kernels give it weight g(1) = 0 anyway; with the box kernel we
+ * drop it (out[0], the heap's farthest), which makes the estimate unbiased
+ * where the density is uniform. */
 static size_t gather(const ps_kdtree *map, ps_vec3 p, ps_vec3 n, const ps_estimate_options *o, ps_neighbor *scratch,
                      double *r2, double *norm)
 {
@@ -64,6 +72,10 @@ static size_t gather(const ps_kdtree *map, ps_vec3 p, ps_vec3 n, const ps_estima
     size_t found = ps_kdtree_knn(map, &q, scratch, r2);
     if (found == 0 || !(*r2 > 0.0))
         return 0;
+    if (found == o->k && o->kernel == PS_KERNEL_BOX && found > 1) {
+        scratch[0] = scratch[found - 1];
+        found--;
+    }
     *norm = 1.0 / (ps_kernel_mean(o->kernel) * PS_PI * *r2);
     return found;
 }

@@ -53,7 +53,8 @@ const ps_photon *ps_kdtree_photons(const ps_kdtree *t);
 ps_aabb ps_kdtree_bounds(const ps_kdtree *t);
 
 /* The up to q->k photons nearest to q->p (ties broken arbitrarily) into out,
- * which holds at least q->k entries, in no particular order; returns how many.
+ * which holds at least q->k entries, as a max-heap on d2: out[0] is the
+ * farthest, the rest in no particular order; returns how many.
  * *r2 (may be NULL) receives the squared radius the result covers: the
  * farthest found when k were found, max_radius^2 otherwise (the region whose
  * area the density estimate divides by). */

@@ -157,6 +157,13 @@ static ps_rgb gather_ray(worker *wk, ps_ray r, ps_rng *rng)
     return ps_rgb_gray(0.0);
 }
 
+/* Light from other surfaces reflected at sp towards wo. With final
+ * gathering, the BRDF is split into its two terms and each is sampled with
+ * its own rays (no weighting needed: the terms add): cosine-distributed rays
+ * for albedo / pi, whose estimate is pi f_d L = albedo L, and rays in the
+ * Phong lobe for the glossy term, whose estimate is f_s L cos / pdf =
+ * specular (e + 2) / (e + 1) cos(theta) L. Both are stratified in their
+ * first dimension. */
 static ps_rgb indirect_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec3 wo, const ps_material *m,
                              ps_rng *rng)
 {
@@ -167,19 +174,33 @@ static ps_rgb indirect_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec
                                  : ps_rgb_gray(0.0);
     if (!job->maps->irradiance || !job->maps->full)
         return ps_rgb_gray(0.0);
-    /* Cosine-distributed gather rays, stratified in the first dimension:
-     * f L cos / (cos / pi) = pi f L. */
     ps_rgb sum = ps_rgb_gray(0.0);
-    for (int k = 0; k < g; k++) {
-        double u1 = (k + ps_rng_uniform(rng)) / g, u2 = ps_rng_uniform(rng);
-        ps_vec3 dir = ps_sample_cosine(u1, u2, n);
-        if (ps_v3_dot(dir, sp->ng) * ps_v3_dot(n, sp->ng) <= 0.0)
-            continue; /* an interpolated normal pointed it into the surface */
-        ps_rgb li = gather_ray(wk, ps_world_spawn(job->world, sp, dir), rng);
-        ps_rgb f = ps_bsdf_eval(m, n, ps_v3_neg(dir), wo);
-        sum = ps_rgb_add(sum, ps_rgb_mul(f, li));
+    if (!ps_rgb_is_black(m->albedo)) {
+        ps_rgb acc = ps_rgb_gray(0.0);
+        for (int k = 0; k < g; k++) {
+            double u1 = (k + ps_rng_uniform(rng)) / g, u2 = ps_rng_uniform(rng);
+            ps_vec3 dir = ps_sample_cosine(u1, u2, n);
+            if (ps_v3_dot(dir, sp->ng) * ps_v3_dot(n, sp->ng) <= 0.0)
+                continue; /* an interpolated normal pointed it into the surface */
+            acc = ps_rgb_add(acc, gather_ray(wk, ps_world_spawn(job->world, sp, dir), rng));
+        }
+        sum = ps_rgb_mul(m->albedo, ps_rgb_scale(acc, 1.0 / g));
     }
-    return ps_rgb_scale(sum, PS_PI / g);
+    if (m->type == PS_MAT_GLOSSY && !ps_rgb_is_black(m->specular)) {
+        ps_vec3 mirror = ps_reflect(ps_v3_neg(wo), n);
+        ps_rgb acc = ps_rgb_gray(0.0);
+        for (int k = 0; k < g; k++) {
+            double u1 = (k + ps_rng_uniform(rng)) / g, u2 = ps_rng_uniform(rng);
+            ps_vec3 dir = ps_sample_phong(u1, u2, mirror, m->exponent);
+            double cos_t = ps_v3_dot(dir, n);
+            if (cos_t <= 0.0 || ps_v3_dot(dir, sp->ng) * ps_v3_dot(n, sp->ng) <= 0.0)
+                continue; /* the lobe reaches below the surface: no light from there */
+            acc = ps_rgb_add(acc, ps_rgb_scale(gather_ray(wk, ps_world_spawn(job->world, sp, dir), rng), cos_t));
+        }
+        double lobe = (m->exponent + 2.0) / (m->exponent + 1.0) / g;
+        sum = ps_rgb_add(sum, ps_rgb_mul(m->specular, ps_rgb_scale(acc, lobe)));
+    }
+    return sum;
 }
 
 /* ---- emitters seen directly ---------------------------------------------- */
