@@ -117,9 +117,16 @@ bench: deps
 	@scripts/bench.sh
 
 SCENE ?= data/scenes/cornell-caustic.scn
-# Until the preview window exists this prints what the default scene holds.
+# The default scene's walls reflect radiance of about 1-3 W sr^-1 m^-2; this
+# exposure maps them into the PNG's range.
+EXPOSURE ?= 0.3
+RUN_PNG ?= out/default.png
+# Until the preview window exists (issue 6), `make run` renders the scene with
+# the reference renderer, headless, and says where the PNG went.
 run-built:
-	bin/photosplat-info $(SCENE)
+	@mkdir -p $(dir $(RUN_PNG))
+	bin/photosplat-ref $(SCENE) -o $(RUN_PNG) --exposure $(EXPOSURE)
+	@echo "make run: the default scene, rendered headless by the reference renderer, is in $(RUN_PNG)"
 
 clean:
 	rm -rf build bin

@@ -309,7 +309,8 @@ static rig rig_file(const char *path, const ps_tracer_options *opt)
 
 static bool maps_equal(const ps_photon_map *a, const ps_photon_map *b)
 {
-    return a->count == b->count && memcmp(a->photons, b->photons, a->count * sizeof *a->photons) == 0;
+    return a->count == b->count && memcmp(a->photons, b->photons, a->count * sizeof *a->photons) == 0 &&
+           (a->count == 0 || memcmp(a->materials, b->materials, a->count * sizeof *a->materials) == 0);
 }
 
 /* Photon i depends on (scene, seed, i) only: 1, 2 and 5 threads, and one
@@ -459,12 +460,47 @@ static void skips(void **state)
     rig_free(&r);
 }
 
+/* Each photon's material is that of the surface it landed on: in a box whose
+ * walls each have their own material, the wall a photon lies on tells it. */
+static void photon_materials(void **state)
+{
+    (void)state;
+    const char *text = "camera eye 0 1 3.4 target 0 1 0 fov 40\n"
+                       "material floor diffuse albedo 0.7 0.7 0.7\n"
+                       "material ceiling diffuse albedo 0.6 0.6 0.6\n"
+                       "material left diffuse albedo 0.5 0.2 0.2\n"
+                       "material glass dielectric ior 1.5\n"
+                       "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material floor\n"
+                       "quad corner -1 2 -1 edge1 2 0 0 edge2 0 0 2 material ceiling\n"
+                       "quad corner -1 0 -1 edge1 0 2 0 edge2 0 0 2 material left\n"
+                       "sphere center 0.3 0.5 0 radius 0.3 material glass\n"
+                       "light point position 0 1.5 0 power 10 10 10\n";
+    ps_tracer_options o = options(2);
+    rig r = rig_make(text, "", &o, PS_ACCEL_AUTO);
+    int seen[3] = {0, 0, 0};
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        ps_photon_map m = trace(&r, (ps_map_kind)k, 20000);
+        assert_true(m.count > 1000);
+        for (size_t i = 0; i < m.count; i++) {
+            const float *p = m.photons[i].pos;
+            int expect = fabsf(p[1]) < 1e-4f ? 0 : fabsf(p[1] - 2.0f) < 1e-4f ? 1 : fabsf(p[0] + 1.0f) < 1e-4f ? 2 : -1;
+            assert_true(expect >= 0); /* only the three walls store */
+            assert_int_equal(m.materials[i], expect);
+            seen[expect]++;
+        }
+        ps_photon_map_free(&m);
+    }
+    assert_true(seen[0] > 0 && seen[1] > 0 && seen[2] > 0);
+    rig_free(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(furnace_box),    cmocka_unit_test(photons_per_light), cmocka_unit_test(mirror_caustic),
         cmocka_unit_test(overlapping_cones), cmocka_unit_test(no_leaks),      cmocka_unit_test(determinism),
         cmocka_unit_test(scale_invariance), cmocka_unit_test(skips),
+        cmocka_unit_test(photon_materials),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

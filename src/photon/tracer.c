@@ -74,6 +74,7 @@ void ps_photon_map_free(ps_photon_map *m)
 {
     ps_map_kind kind = m->kind;
     free(m->photons);
+    free(m->materials);
     ps_photon_map_init(m, kind);
 }
 
@@ -401,18 +402,21 @@ uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light,
 
 typedef struct chunk_out {
     ps_photon *photons;
-    size_t count, cap;
+    uint16_t *materials; /* parallel to photons */
+    size_t count, cap, mcap;
     ps_trace_counters c;
     bool failed;
 } chunk_out;
 
-static void store(chunk_out *out, ps_vec3 p, ps_rgb power, ps_vec3 d, ps_vec3 n, double dither)
+static void store(chunk_out *out, const ps_surface *sp, ps_rgb power, ps_vec3 d, ps_vec3 n, double dither)
 {
-    if (!PS_RESERVE(out->photons, out->cap, out->count + 1)) {
+    if (!PS_RESERVE(out->photons, out->cap, out->count + 1) ||
+        !PS_RESERVE(out->materials, out->mcap, out->count + 1)) {
         out->failed = true;
         return;
     }
-    out->photons[out->count++] = ps_photon_pack(p, power, d, n, dither);
+    out->materials[out->count] = (uint16_t)sp->material;
+    out->photons[out->count++] = ps_photon_pack(sp->p, power, d, n, dither);
     out->c.stored++;
 }
 
@@ -477,11 +481,11 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
         case PS_MAT_DIFFUSE:
         case PS_MAT_GLOSSY: {
             if (kind == PS_MAP_CAUSTIC) { /* light, specular bounces, here: a caustic */
-                store(out, sp.p, power, d, ns, ps_rng_uniform(&rng));
+                store(out, &sp, power, d, ns, ps_rng_uniform(&rng));
                 return;
             }
             if (diffuse_seen || t->opt.global_direct)
-                store(out, sp.p, power, d, ns, ps_rng_uniform(&rng));
+                store(out, &sp, power, d, ns, ps_rng_uniform(&rng));
             /* Russian roulette on the albedo: the expected power leaving is the
              * power arriving times the albedo, with no photon made heavier than
              * the albedo's colour ratio. */
@@ -624,16 +628,18 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
             st = PS_ERR_NOMEM;
         need += job.outs[k].count;
     }
-    if (st == PS_OK && !PS_RESERVE(m->photons, m->cap, need))
+    if (st == PS_OK && (!PS_RESERVE(m->photons, m->cap, need) || !PS_RESERVE(m->materials, m->mcap, need)))
         st = PS_ERR_NOMEM;
     for (size_t k = 0; k < job.chunks; k++) {
         if (st == PS_OK && job.outs[k].count) {
             memcpy(m->photons + m->count, job.outs[k].photons, job.outs[k].count * sizeof *m->photons);
+            memcpy(m->materials + m->count, job.outs[k].materials, job.outs[k].count * sizeof *m->materials);
             m->count += job.outs[k].count;
         }
         if (st == PS_OK)
             add_counters(&m->counters, &job.outs[k].c);
         free(job.outs[k].photons);
+        free(job.outs[k].materials);
     }
     free(job.outs);
     if (st != PS_OK)

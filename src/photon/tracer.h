@@ -68,11 +68,14 @@ typedef struct ps_trace_counters {
     uint64_t empty;            /* emitted samples that carried no power (outside a spot or behind a light) */
 } ps_trace_counters;
 
-/* The photons of one map, in index order. */
+/* The photons of one map, in index order, and beside each the material of
+ * the surface it landed on (the splats need its BRDF; the 20-byte record has
+ * no room, and the kd-tree does not need it: a query knows its surface). */
 typedef struct ps_photon_map {
     ps_map_kind kind;
     ps_photon *photons;
-    size_t count, cap;
+    uint16_t *materials;
+    size_t count, cap, mcap;
     ps_trace_counters counters;
 } ps_photon_map;
 

@@ -18,7 +18,7 @@
 /* Limits that keep absurd input from exhausting memory; each is refused with
  * PS_ERR_LIMIT and a message, never by a failed allocation midway. */
 #define PS_SCENE_MAX_LIGHTS 100000
-#define PS_SCENE_MAX_MATERIALS 65536
+#define PS_SCENE_MAX_MATERIALS 65536 /* indices fit the photon maps' 16-bit material ids */
 #define PS_SCENE_MAX_OBJECTS 1000000
 #define PS_SCENE_MAX_TRIANGLES 50000000
 #define PS_SCENE_MAX_IMAGE_SIDE 16384
