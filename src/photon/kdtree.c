@@ -25,8 +25,11 @@ static double coord(const ps_photon *p, int axis) { return p->pos[axis]; }
 
 /* How many of a segment's n photons go into the left subtree so that the
  * tree stays left-balanced (every level full but the last, which fills from
- * the left); Jensen's rule. m is the largest power of two with 4m <= n: the
- * left subtree's last level holds up to m nodes. */
+ * the left); Jensen's rule. m ends as the largest power of two with 2m <= n,
+ * the most nodes the left subtree's last level can hold: when the tree's last
+ * level reaches past the left half, the left subtree is complete (2m - 1
+ * nodes); else the right one holds only its full levels (m - 1 nodes) and the
+ * left the rest, n - m. */
 static size_t left_size(size_t n)
 {
     size_t m = 1;
