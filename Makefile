@@ -33,17 +33,28 @@ OPT_asan := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-san
 LDOPT_release :=
 LDOPT_asan := -fsanitize=address,undefined
 
-LIB_C := $(filter-out src/app/%_main.c,$(wildcard src/*/*.c))
+# src/gl/ is the second library, libpsgl.a: plain gl* drawing code with no
+# context of its own. A program links it with exactly one GL implementation:
+# photosplat-snap with OSMesa, the window with libGL (never both: platform
+# notes). GL_PROGS lists the OSMesa programs, GL tests are tests/test_gl*.c.
+LIB_C := $(filter-out src/app/%_main.c src/gl/%,$(wildcard src/*/*.c))
 LIB_CXX := $(wildcard src/*/*.cpp)
+GL_C := $(wildcard src/gl/*.c)
 MAINS := $(wildcard src/app/*_main.c)
 PROGS := $(patsubst src/app/%_main.c,photosplat-%,$(MAINS))
+GL_PROGS := photosplat-snap
 TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c))
+GL_TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_gl*.c))
+OSMESA_CFLAGS := $(shell pkg-config --cflags osmesa 2>/dev/null) -DGL_GLEXT_PROTOTYPES
+OSMESA_LIBS := $(shell pkg-config --libs osmesa 2>/dev/null)
 
 # variant-rules(VARIANT): objects, library, programs and tests of one variant.
 define variant-rules
 B_$(1) := build/$(1)
 OBJ_$(1) := $$(patsubst src/%.c,build/$(1)/obj/%.o,$$(LIB_C)) $$(patsubst src/%.cpp,build/$(1)/obj/%.o,$$(LIB_CXX))
 LIB_$(1) := build/$(1)/libphotosplat.a
+GLOBJ_$(1) := $$(patsubst src/%.c,build/$(1)/obj/%.o,$$(GL_C))
+GLLIB_$(1) := build/$(1)/libpsgl.a
 build/$(1)/obj/%.o: src/%.c
 	@mkdir -p $$(@D)
 	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc $$(PKG_CFLAGS) -MMD -MP -c $$< -o $$@
@@ -53,13 +64,28 @@ build/$(1)/obj/%.o: src/%.cpp
 $$(LIB_$(1)): $$(OBJ_$(1))
 	@rm -f $$@
 	ar rcs $$@ $$^
+$$(GLLIB_$(1)): $$(GLOBJ_$(1))
+	@rm -f $$@
+	ar rcs $$@ $$^
+build/$(1)/obj/gl/%.o: src/gl/%.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc $$(OSMESA_CFLAGS) -MMD -MP -c $$< -o $$@
+build/$(1)/bin/photosplat-snap: build/$(1)/obj/app/snap_main.o $$(GLLIB_$(1)) $$(LIB_$(1))
+	@mkdir -p $$(@D)
+	$$(CC) $$(LDOPT_$(1)) $$^ -o $$@ $$(OSMESA_LIBS) $$(LIBS)
+build/$(1)/obj/app/snap_main.o: src/app/snap_main.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc $$(PKG_CFLAGS) $$(OSMESA_CFLAGS) -MMD -MP -c $$< -o $$@
+$$(patsubst %,build/$(1)/tests/%,$$(GL_TESTS)): build/$(1)/tests/%: tests/%.c $$(GLLIB_$(1)) $$(LIB_$(1))
+	@mkdir -p $$(@D)
+	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc -Itests $$(TEST_CFLAGS) $$(OSMESA_CFLAGS) -MMD -MP $$< -o $$@ $$(LDOPT_$(1)) $$(GLLIB_$(1)) $$(LIB_$(1)) $$(TEST_LIBS) $$(OSMESA_LIBS) $$(LIBS)
 build/$(1)/bin/photosplat-%: build/$(1)/obj/app/%_main.o $$(LIB_$(1))
 	@mkdir -p $$(@D)
 	$$(CC) $$(LDOPT_$(1)) $$^ -o $$@ $$(LIBS)
 build/$(1)/tests/%: tests/%.c $$(LIB_$(1))
 	@mkdir -p $$(@D)
 	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc -Itests $$(TEST_CFLAGS) -MMD -MP $$< -o $$@ $$(LDOPT_$(1)) $$(LIB_$(1)) $$(TEST_LIBS) $$(LIBS)
--include $$(OBJ_$(1):.o=.d) $$(patsubst %,build/$(1)/tests/%.d,$$(TESTS))
+-include $$(OBJ_$(1):.o=.d) $$(GLOBJ_$(1):.o=.d) $$(patsubst %,build/$(1)/tests/%.d,$$(TESTS))
 endef
 $(eval $(call variant-rules,release))
 $(eval $(call variant-rules,asan))

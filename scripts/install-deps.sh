@@ -18,6 +18,8 @@ need_cmd pkg-config pkg-config
 need_pc libpng libpng-dev
 need_pc tinyobjloader libtinyobjloader-dev
 need_pc cmocka libcmocka-dev
+# photosplat-snap draws with OSMesa (libosmesa6-dev brings the GL headers too).
+need_pc osmesa libosmesa6-dev
 # The sanitizer runtimes come with gcc on Debian but may be trimmed from images.
 [ -e "$(gcc -print-file-name=libasan.so 2>/dev/null)" ] && gcc -print-file-name=libasan.so | grep -q / || missing+=(libasan8)
 [ -e "$(gcc -print-file-name=libubsan.so 2>/dev/null)" ] && gcc -print-file-name=libubsan.so | grep -q / || missing+=(libubsan1)

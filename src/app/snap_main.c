@@ -1,0 +1,612 @@
+/* snap_main.c: photosplat-snap, the preview headless: OSMesa (never libGL),
+ * the photon tracer feeding splats to src/gl, one snapshot written as PNG
+ * and/or PFM. The same frame the window shows, for tests and benchmarks. */
+#include <GL/osmesa.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "app/cli.h"
+#include "app/stats.h"
+#include "core/array.h"
+#include "core/fileio.h"
+#include "gl/gl_render.h"
+#include "photon/tracer.h"
+#include "photon/world.h"
+#include "preview/mesh.h"
+#include "preview/splat.h"
+#include "scene/scene.h"
+
+/* Photons traced per map between hand-overs to the GL thread in progressive
+ * mode: large enough to keep the tracer's threads busy, small enough that a
+ * refresh every tau sees recent ones. */
+#define SNAP_BATCH 16384
+/* The error counter's default: stop shooting once this fraction of a
+ * refresh's splat energy rounds away in the 8-bit buffer. */
+#define SNAP_COUNTER_THRESHOLD 0.1
+#define SNAP_DEFAULT_TAU 0.1
+#define SNAP_DEFAULT_POINT_SIZE 1.0
+
+enum { LAYER_DIRECT = 1, LAYER_CAUSTIC = 2, LAYER_GLOBAL = 4, LAYER_ALL = 7 };
+
+static const char usage[] =
+    "usage: photosplat-snap SCENE.scn -o OUT.png [options]\n"
+    "\n"
+    "The interactive preview, headless (OSMesa): traces photons, draws the scene\n"
+    "with OpenGL lights and the photons as splats, and writes one snapshot.\n"
+    "Without --time it traces the maps' full photon counts and draws once; with\n"
+    "--time it refines progressively, refreshing every --tau seconds.\n"
+    "\n"
+    "options:\n"
+    "  -o FILE.png              8-bit PNG, sRGB after exposure\n"
+    "  --hdr FILE.pfm           linear radiance (W sr^-1 m^-2), little-endian PFM\n"
+    "  --size WxH               image size (default from the scene)\n"
+    "  --exposure E             radiance multiplier before encoding (default 1)\n"
+    "  --caustic-photons N      caustic photons (the cap, in progressive mode)\n"
+    "  --global-photons N       global photons (the cap, in progressive mode)\n"
+    "  --caustic-radius R       caustic splat radius, scene units\n"
+    "  --global-radius R        global splat radius, scene units\n"
+    "  --seed S                 photon i depends only on (scene, seed, i) (default 0)\n"
+    "  --threads N              tracing threads (default: all cores)\n"
+    "  --stats FILE.json        figures of the run\n"
+    "  --dump-photons FILE      every stored photon: map x y z r g b dx dy dz nx ny nz\n"
+    "  --time SECONDS           progressive mode: trace and refine this long\n"
+    "  --tau SECONDS            time between refreshes (default 0.1)\n"
+    "  --splat points|triangles|sprites  splat primitive (default triangles)\n"
+    "  --kernel box|cone|gauss|epanechnikov  splat kernel (default cone)\n"
+    "  --layers LIST            comma list of direct,caustic,global (default all)\n"
+    "  --color-depth 8|float    colour buffer precision (default 8)\n"
+    "  --precision none|diffusion|counter  8-bit handling (default diffusion)\n"
+    "  --counter-threshold F    counter: stop when this fraction rounds away (default 0.1)\n"
+    "  --point-size N           points: side in pixels (default 1)\n"
+    "  --shadows on|off         shadow maps for the direct layer (default on)\n"
+    "  --help                   this text\n";
+
+typedef struct snap_options {
+    const char *scene, *out_png, *out_hdr, *stats, *dump;
+    int64_t photons[PS_MAP_COUNT];
+    double radius[PS_MAP_COUNT];
+    int width, height;
+    double exposure, time, tau, counter_threshold, point_size;
+    int64_t seed, threads;
+    int splat, kernel, color_depth, precision, shadows;
+    unsigned layers;
+} snap_options;
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static ps_status parse_layers(const char *text, unsigned *out, ps_error *err)
+{
+    static const char *const names[3] = {"direct", "caustic", "global"};
+    *out = 0;
+    const char *p = text;
+    while (*p) {
+        const char *end = strchr(p, ',');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        int found = -1;
+        for (int k = 0; k < 3; k++)
+            if (strlen(names[k]) == len && strncmp(p, names[k], len) == 0)
+                found = k;
+        if (found < 0)
+            return ps_error_set(err, PS_ERR_PARSE,
+                                "photosplat-snap: --layers: '%.*s' is not direct, caustic or global", (int)len, p);
+        *out |= 1u << found;
+        if (!end)
+            break;
+        p = end + 1;
+        if (!*p)
+            return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --layers: empty name after ','");
+    }
+    if (!*out)
+        return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --layers: no layer named");
+    return PS_OK;
+}
+
+static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, ps_error *err)
+{
+    static const char *const splats[] = {"points", "triangles", "sprites", NULL};
+    static const char *const kernels[] = {"box", "cone", "gauss", "epanechnikov", NULL};
+    static const char *const depths[] = {"8", "float", NULL};
+    static const char *const precisions[] = {"none", "diffusion", "counter", NULL};
+    static const char *const on_off[] = {"off", "on", NULL};
+    ps_cli cli = ps_cli_begin("photosplat-snap", argc, argv);
+    memset(o, 0, sizeof *o);
+    o->photons[PS_MAP_CAUSTIC] = o->photons[PS_MAP_GLOBAL] = -1;
+    o->exposure = 1.0;
+    o->tau = SNAP_DEFAULT_TAU;
+    o->counter_threshold = SNAP_COUNTER_THRESHOLD;
+    o->point_size = SNAP_DEFAULT_POINT_SIZE;
+    o->splat = PS_SPLAT_TRIANGLES;
+    o->kernel = PS_KERNEL_CONE;
+    o->precision = PS_PRECISION_DIFFUSION;
+    o->shadows = 1;
+    o->layers = LAYER_ALL;
+    ps_status st = PS_OK;
+    const char *layers;
+    while (st == PS_OK && ps_cli_next(&cli)) {
+        if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "-h")) {
+            *help = true;
+            return PS_OK;
+        } else if (ps_cli_positional(&cli)) {
+            if (o->scene)
+                return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: more than one scene given ('%s')",
+                                    ps_cli_arg(&cli));
+            o->scene = ps_cli_arg(&cli);
+        } else if (ps_cli_is(&cli, "-o")) {
+            st = ps_cli_string(&cli, &o->out_png, err);
+        } else if (ps_cli_is(&cli, "--hdr")) {
+            st = ps_cli_string(&cli, &o->out_hdr, err);
+        } else if (ps_cli_is(&cli, "--stats")) {
+            st = ps_cli_string(&cli, &o->stats, err);
+        } else if (ps_cli_is(&cli, "--dump-photons")) {
+            st = ps_cli_string(&cli, &o->dump, err);
+        } else if (ps_cli_is(&cli, "--size")) {
+            st = ps_cli_size(&cli, PS_SCENE_MAX_IMAGE_SIDE, &o->width, &o->height, err);
+        } else if (ps_cli_is(&cli, "--exposure")) {
+            st = ps_cli_double(&cli, 0.0, 1e30, &o->exposure, err);
+        } else if (ps_cli_is(&cli, "--caustic-photons")) {
+            st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_CAUSTIC], err);
+        } else if (ps_cli_is(&cli, "--global-photons")) {
+            st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_GLOBAL], err);
+        } else if (ps_cli_is(&cli, "--caustic-radius")) {
+            st = ps_cli_double(&cli, 1e-300, 1e300, &o->radius[PS_MAP_CAUSTIC], err);
+        } else if (ps_cli_is(&cli, "--global-radius")) {
+            st = ps_cli_double(&cli, 1e-300, 1e300, &o->radius[PS_MAP_GLOBAL], err);
+        } else if (ps_cli_is(&cli, "--seed")) {
+            st = ps_cli_int(&cli, 0, INT64_MAX, &o->seed, err);
+        } else if (ps_cli_is(&cli, "--threads")) {
+            st = ps_cli_int(&cli, 1, PS_TRACER_MAX_THREADS, &o->threads, err);
+        } else if (ps_cli_is(&cli, "--time")) {
+            st = ps_cli_double(&cli, 1e-3, 1e6, &o->time, err);
+        } else if (ps_cli_is(&cli, "--tau")) {
+            st = ps_cli_double(&cli, 1e-3, 1e6, &o->tau, err);
+        } else if (ps_cli_is(&cli, "--splat")) {
+            st = ps_cli_choice(&cli, splats, &o->splat, err);
+        } else if (ps_cli_is(&cli, "--kernel")) {
+            st = ps_cli_choice(&cli, kernels, &o->kernel, err);
+        } else if (ps_cli_is(&cli, "--color-depth")) {
+            st = ps_cli_choice(&cli, depths, &o->color_depth, err);
+        } else if (ps_cli_is(&cli, "--precision")) {
+            st = ps_cli_choice(&cli, precisions, &o->precision, err);
+        } else if (ps_cli_is(&cli, "--counter-threshold")) {
+            st = ps_cli_double(&cli, 1e-9, 1.0, &o->counter_threshold, err);
+        } else if (ps_cli_is(&cli, "--point-size")) {
+            st = ps_cli_double(&cli, 1.0, 64.0, &o->point_size, err);
+        } else if (ps_cli_is(&cli, "--shadows")) {
+            st = ps_cli_choice(&cli, on_off, &o->shadows, err);
+        } else if (ps_cli_is(&cli, "--layers")) {
+            st = ps_cli_string(&cli, &layers, err);
+            if (st == PS_OK)
+                st = parse_layers(layers, &o->layers, err);
+        } else {
+            return ps_cli_unknown(&cli, err);
+        }
+    }
+    if (st != PS_OK)
+        return st;
+    if (!o->scene)
+        return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: no scene given (see --help)");
+    if (!o->out_png && !o->out_hdr)
+        return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: nothing to write: give -o FILE.png or --hdr FILE.pfm");
+    return PS_OK;
+}
+
+/* ---- photons: traced in the background, handed over under a lock ---------- */
+
+typedef struct feed {
+    ps_tracer *tracer;
+    uint64_t cap[PS_MAP_COUNT]; /* N: photons each map is normalised for */
+    bool active[PS_MAP_COUNT];
+    pthread_mutex_t lock;
+    ps_photon_map maps[PS_MAP_COUNT]; /* under lock: what has arrived */
+    bool stop, done;                  /* under lock */
+    ps_status status;
+    ps_error err;
+    double trace_seconds;
+} feed;
+
+/* Appends photons [first, first + count) of map k, traced outside the lock. */
+static ps_status feed_batch(feed *f, int k, uint64_t first, uint64_t count, ps_error *err)
+{
+    ps_photon_map local;
+    ps_photon_map_init(&local, (ps_map_kind)k);
+    ps_status st = ps_tracer_trace(f->tracer, (ps_map_kind)k, first, count, f->cap[k], &local, err);
+    pthread_mutex_lock(&f->lock);
+    ps_photon_map *m = &f->maps[k];
+    if (st == PS_OK && (!PS_RESERVE(m->photons, m->cap, m->count + local.count) ||
+                        !PS_RESERVE(m->materials, m->mcap, m->count + local.count)))
+        st = ps_error_set(err, PS_ERR_NOMEM, "photosplat-snap: out of memory for photons");
+    if (st == PS_OK) {
+        memcpy(m->photons + m->count, local.photons, local.count * sizeof *m->photons);
+        memcpy(m->materials + m->count, local.materials, local.count * sizeof *m->materials);
+        m->count += local.count;
+        ps_trace_counters *a = &m->counters, *b = &local.counters;
+        a->emitted += b->emitted, a->stored += b->stored, a->rays += b->rays, a->escaped += b->escaped;
+        a->absorbed += b->absorbed, a->discarded += b->discarded, a->truncated += b->truncated, a->empty += b->empty;
+    }
+    pthread_mutex_unlock(&f->lock);
+    ps_photon_map_free(&local);
+    return st;
+}
+
+/* Traces every active map up to its cap, in rounds that keep the maps'
+ * emitted counts in proportion, until done or told to stop. */
+static void *feed_run(void *arg)
+{
+    feed *f = arg;
+    double t0 = now_seconds();
+    uint64_t next[PS_MAP_COUNT] = {0, 0};
+    uint64_t biggest = f->cap[0] > f->cap[1] ? f->cap[0] : f->cap[1];
+    ps_status st = PS_OK;
+    for (uint64_t round = 0; st == PS_OK; round++) {
+        bool more = false;
+        for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
+            if (!f->active[k] || next[k] >= f->cap[k])
+                continue;
+            /* This map's share of the round, so that all maps finish together. */
+            uint64_t until = biggest ? (uint64_t)((double)f->cap[k] * (double)((round + 1) * SNAP_BATCH) / (double)biggest) : 0;
+            if (until > f->cap[k])
+                until = f->cap[k];
+            if (until <= next[k])
+                until = next[k] + 1;
+            st = feed_batch(f, k, next[k], until - next[k], &f->err);
+            next[k] = until;
+            more = more || next[k] < f->cap[k];
+        }
+        pthread_mutex_lock(&f->lock);
+        bool stop = f->stop;
+        pthread_mutex_unlock(&f->lock);
+        if (!more || stop)
+            break;
+    }
+    pthread_mutex_lock(&f->lock);
+    f->status = st;
+    f->done = true;
+    f->trace_seconds = now_seconds() - t0;
+    pthread_mutex_unlock(&f->lock);
+    return NULL;
+}
+
+/* ---- frames ----------------------------------------------------------------- */
+
+typedef struct snap_run {
+    const snap_options *o;
+    const ps_scene *scene;
+    ps_camera_frame cam;
+    ps_gl_renderer *gl;
+    ps_kernel_texture kernel;
+    ps_splat_batch batch[PS_MAP_COUNT];
+    double radius[PS_MAP_COUNT];
+    uint64_t frames;
+    double splat_seconds;
+    /* The counter, for the last refresh. */
+    double lost_fraction;
+    uint64_t splats;
+} snap_run;
+
+/* Builds the splats of every shown map from the photons that have arrived
+ * (call under the feed's lock: the arrays must not move while read). CPU
+ * only, so the lock is held briefly; drawing comes after, unlocked. */
+static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
+{
+    const snap_options *o = s->o;
+    double t0 = now_seconds();
+    size_t nmat;
+    const ps_material *materials = ps_scene_materials(s->scene, &nmat);
+    double wanted = 0.0, lost = 0.0;
+    s->splats = 0;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        const ps_photon_map *m = &f->maps[k];
+        ps_splat_batch *b = &s->batch[k];
+        unsigned layer = k == PS_MAP_CAUSTIC ? LAYER_CAUSTIC : LAYER_GLOBAL;
+        ps_splat_batch_clear(b);
+        /* Each frame is built whole, so its round-off carry starts afresh:
+         * the same photons give the same picture. */
+        b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
+        b->wanted = b->lost = 0.0;
+        if (!(o->layers & layer) || m->count == 0 || m->counters.emitted == 0)
+            continue;
+        ps_splat_params p;
+        memset(&p, 0, sizeof p);
+        p.mode = (ps_splat_mode)o->splat;
+        p.radius = s->radius[k];
+        p.kernel_mean = s->kernel.mean;
+        /* Powers are normalised for the cap N; n have been emitted so far. */
+        p.scale = o->exposure * (double)f->cap[k] / (double)m->counters.emitted;
+        p.point_size = o->point_size;
+        p.precision = (ps_precision)o->precision;
+        p.levels = o->color_depth == 0 ? 255 : 0;
+        p.materials = materials;
+        p.cam = s->cam;
+        ps_status st = ps_splat_build(m->photons, m->materials, m->count, &p, b, err);
+        if (st != PS_OK)
+            return st;
+        wanted += b->wanted;
+        lost += b->lost;
+        s->splats += b->splats;
+    }
+    s->lost_fraction = wanted > 0.0 ? lost / wanted : 0.0;
+    s->splat_seconds += now_seconds() - t0;
+    return PS_OK;
+}
+
+/* Draws the frame: the scene (direct layer or black), then the splats. */
+static void draw_frame(snap_run *s)
+{
+    const snap_options *o = s->o;
+    double t0 = now_seconds();
+    ps_gl_begin_frame(s->gl, &s->cam, o->exposure, (o->layers & LAYER_DIRECT) != 0);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_gl_draw_splats(s->gl, &s->batch[k], (ps_splat_mode)o->splat, s->radius[k], o->point_size);
+    s->frames++;
+    s->splat_seconds += now_seconds() - t0;
+}
+
+static ps_status write_outputs(snap_run *s, ps_error *err)
+{
+    const snap_options *o = s->o;
+    ps_image img;
+    ps_status st = ps_gl_read(s->gl, &img, err);
+    if (st != PS_OK)
+        return st;
+    /* The buffer holds radiance times exposure: the PNG takes it as it is,
+     * the PFM the radiance. */
+    if (o->out_png)
+        st = ps_png_write(&img, o->out_png, 1.0f, err);
+    if (st == PS_OK && o->out_hdr) {
+        float inv = o->exposure > 0.0 ? (float)(1.0 / o->exposure) : 0.0f;
+        size_t n = 3 * (size_t)img.width * (size_t)img.height;
+        for (size_t i = 0; i < n; i++)
+            img.rgb[i] *= inv;
+        st = ps_pfm_write(&img, o->out_hdr, err);
+    }
+    ps_image_destroy(&img);
+    return st;
+}
+
+static ps_status write_dump(const char *path, const ps_photon_map maps[PS_MAP_COUNT], ps_error *err)
+{
+    ps_outfile *out = ps_outfile_open(path, err);
+    if (!out)
+        return err->status;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_write_text(ps_outfile_stream(out), &maps[k]);
+    return ps_outfile_commit(out, err);
+}
+
+/* The photons, the frames, the files. */
+static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext ctx, void *buffer, ps_error *err)
+{
+    const ps_scene_defaults *def = ps_scene_get_defaults(scene);
+    int width = o->width ? o->width : def->width, height = o->height ? o->height : def->height;
+    GLenum type = o->color_depth == 0 ? GL_UNSIGNED_BYTE : GL_FLOAT;
+    if (!OSMesaMakeCurrent(ctx, buffer, type, width, height))
+        return ps_error_set(err, PS_ERR_LIMIT, "photosplat-snap: OSMesa cannot draw a %dx%d %s buffer", width, height,
+                            o->color_depth == 0 ? "8-bit" : "float");
+    snap_run s;
+    memset(&s, 0, sizeof s);
+    s.o = o;
+    s.scene = scene;
+    s.cam = ps_camera_frame_make(ps_scene_camera(scene), width, height);
+    s.radius[PS_MAP_CAUSTIC] = o->radius[PS_MAP_CAUSTIC] > 0 ? o->radius[PS_MAP_CAUSTIC] : def->caustic_radius;
+    s.radius[PS_MAP_GLOBAL] = o->radius[PS_MAP_GLOBAL] > 0 ? o->radius[PS_MAP_GLOBAL] : def->global_radius;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_splat_batch_init(&s.batch[k]);
+
+    feed f;
+    memset(&f, 0, sizeof f);
+    pthread_mutex_init(&f.lock, NULL);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_init(&f.maps[k], (ps_map_kind)k);
+
+    ps_world *world = NULL;
+    ps_preview_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    ps_status st = ps_world_create(scene, NULL, &world, err);
+    ps_tracer_options topt = ps_tracer_default_options();
+    topt.seed = (uint64_t)o->seed;
+    topt.threads = (int)o->threads;
+    if (st == PS_OK)
+        st = ps_tracer_create(world, &topt, &f.tracer, err);
+    ps_mesh_options mopt = ps_mesh_default_options(scene);
+    if (st == PS_OK)
+        st = ps_preview_mesh_build(scene, &mopt, &mesh, err);
+    if (st == PS_OK)
+        st = ps_kernel_texture_make((ps_kernel)o->kernel, PS_KERNEL_TEXTURE_SIZE, &s.kernel, err);
+    ps_gl_options gopt = {o->shadows != 0, o->color_depth != 0};
+    if (st == PS_OK)
+        st = ps_gl_renderer_create(scene, &mesh, &s.kernel, &gopt, &s.gl, err);
+
+    /* Which maps to trace: a layer that is off, or 0 photons, is skipped. */
+    int64_t want[PS_MAP_COUNT] = {o->photons[0] >= 0 ? o->photons[0] : def->caustic_photons,
+                                  o->photons[1] >= 0 ? o->photons[1] : def->global_photons};
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
+        unsigned layer = k == PS_MAP_CAUSTIC ? LAYER_CAUSTIC : LAYER_GLOBAL;
+        const char *name = ps_map_name((ps_map_kind)k);
+        f.cap[k] = (uint64_t)want[k];
+        f.active[k] = false;
+        if (!ps_tracer_map_enabled(f.tracer, (ps_map_kind)k))
+            continue;
+        if (!(o->layers & layer))
+            st = ps_tracer_note_skip(f.tracer, name, "layer not shown (--layers)");
+        else if (want[k] == 0)
+            st = ps_tracer_note_skip(f.tracer, name, "0 photons requested");
+        else
+            f.active[k] = true;
+        if (st != PS_OK)
+            ps_error_set(err, st, "photosplat-snap: out of memory");
+    }
+    if (st == PS_OK && !(o->layers & LAYER_DIRECT))
+        st = ps_tracer_note_skip(f.tracer, "direct", "layer not shown (--layers)");
+
+    double t_start = now_seconds(), first_frame = -1.0;
+    bool counter_stopped = false;
+    uint64_t counter_at = 0;
+    if (st == PS_OK && o->time <= 0.0) {
+        /* A fixed photon count: trace everything, then draw once. */
+        feed_run(&f);
+        st = f.status;
+        if (st != PS_OK)
+            *err = f.err;
+        if (st == PS_OK)
+            st = build_splats(&s, &f, err);
+        if (st == PS_OK)
+            draw_frame(&s);
+        first_frame = now_seconds() - t_start;
+    } else if (st == PS_OK) {
+        /* Progressive: trace in the background, refresh every tau. */
+        pthread_t tid;
+        bool threaded = pthread_create(&tid, NULL, feed_run, &f) == 0;
+        if (!threaded)
+            feed_run(&f);
+        double next = t_start + o->tau, end = t_start + o->time;
+        for (;;) {
+            double t = now_seconds();
+            double until = next < end ? next : end;
+            if (t < until) {
+                struct timespec ts = {(time_t)(until - t), (long)((until - t - (double)(time_t)(until - t)) * 1e9)};
+                nanosleep(&ts, NULL);
+            }
+            pthread_mutex_lock(&f.lock);
+            bool done = f.done;
+            st = build_splats(&s, &f, err);
+            /* Thesis 5.1: once a refresh loses this much to round-off, more
+             * photons only add noise; stop shooting. */
+            if (st == PS_OK && o->precision == PS_PRECISION_COUNTER && o->color_depth == 0 && !counter_stopped &&
+                s.lost_fraction > o->counter_threshold) {
+                counter_stopped = true;
+                counter_at = f.maps[0].counters.emitted + f.maps[1].counters.emitted;
+                f.stop = true;
+            }
+            pthread_mutex_unlock(&f.lock);
+            if (st == PS_OK)
+                draw_frame(&s);
+            if (first_frame < 0.0)
+                first_frame = now_seconds() - t_start;
+            next += o->tau;
+            if (st != PS_OK || done || now_seconds() >= end)
+                break;
+        }
+        pthread_mutex_lock(&f.lock);
+        f.stop = true;
+        pthread_mutex_unlock(&f.lock);
+        if (threaded)
+            pthread_join(tid, NULL);
+        if (st == PS_OK && f.status != PS_OK) {
+            st = f.status;
+            *err = f.err;
+        }
+        /* The snapshot: everything that arrived, drawn once more. */
+        if (st == PS_OK)
+            st = build_splats(&s, &f, err);
+        if (st == PS_OK)
+            draw_frame(&s);
+    }
+    if (st == PS_OK && (o->out_png || o->out_hdr))
+        st = write_outputs(&s, err);
+    if (st == PS_OK && o->dump)
+        st = write_dump(o->dump, f.maps, err);
+
+    ps_run_stats rs;
+    memset(&rs, 0, sizeof rs);
+    if (st == PS_OK) {
+        for (int k = 0; k < PS_MAP_COUNT; k++) {
+            rs.emitted[k] = f.maps[k].counters.emitted;
+            rs.stored[k] = f.maps[k].counters.stored;
+            rs.rays += f.maps[k].counters.rays;
+        }
+        rs.trace_seconds = f.trace_seconds;
+        rs.splat_seconds = s.splat_seconds;
+        rs.frames = s.frames;
+        rs.skips = ps_tracer_skips(f.tracer, &rs.skip_count);
+        ps_gl_stats gs = ps_gl_get_stats(s.gl);
+        ps_stats_add(&rs, "threads", ps_tracer_threads(f.tracer));
+        ps_stats_add(&rs, "seed", (double)o->seed);
+        ps_stats_add(&rs, "width", width);
+        ps_stats_add(&rs, "height", height);
+        ps_stats_add(&rs, "seconds", now_seconds() - t_start);
+        ps_stats_add(&rs, "first_frame_seconds", first_frame);
+        ps_stats_add(&rs, "splats", (double)s.splats);
+        ps_stats_add(&rs, "kernel_mean", s.kernel.mean);
+        ps_stats_add(&rs, "caustic_radius", s.radius[PS_MAP_CAUSTIC]);
+        ps_stats_add(&rs, "global_radius", s.radius[PS_MAP_GLOBAL]);
+        ps_stats_add(&rs, "gl_lights", gs.virtual_lights);
+        ps_stats_add(&rs, "shadow_maps", gs.shadow_maps);
+        ps_stats_add(&rs, "round_off_fraction", s.lost_fraction);
+        ps_stats_add(&rs, "counter_stopped", counter_stopped ? 1.0 : 0.0);
+        ps_stats_add(&rs, "counter_stopped_at_photons", (double)counter_at);
+        ps_stats_add(&rs, "counter_threshold", o->counter_threshold);
+        if (o->stats)
+            st = ps_stats_write(o->stats, &rs, err);
+    }
+    if (st == PS_OK) {
+        printf("caustic: %llu emitted, %llu stored; global: %llu emitted, %llu stored; %llu frames; %s splats, %s\n",
+               (unsigned long long)rs.emitted[0], (unsigned long long)rs.stored[0], (unsigned long long)rs.emitted[1],
+               (unsigned long long)rs.stored[1], (unsigned long long)s.frames,
+               ps_splat_mode_name((ps_splat_mode)o->splat), o->color_depth == 0 ? "8-bit" : "float buffer");
+        if (counter_stopped)
+            printf("error counter: stopped shooting at %llu photons: %.1f %% of a refresh's splat energy rounded "
+                   "away in the 8-bit buffer (threshold %.1f %%)\n",
+                   (unsigned long long)counter_at, 100.0 * s.lost_fraction, 100.0 * o->counter_threshold);
+        for (size_t k = 0; k < rs.skip_count; k++)
+            printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
+        if (o->out_png)
+            printf("wrote %s\n", o->out_png);
+        if (o->out_hdr)
+            printf("wrote %s\n", o->out_hdr);
+    }
+    ps_gl_renderer_destroy(s.gl);
+    ps_kernel_texture_free(&s.kernel);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_splat_batch_free(&s.batch[k]);
+    ps_preview_mesh_free(&mesh);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_free(&f.maps[k]);
+    ps_tracer_destroy(f.tracer);
+    ps_world_destroy(world);
+    pthread_mutex_destroy(&f.lock);
+    return st;
+}
+
+int main(int argc, char **argv)
+{
+    ps_error err;
+    ps_error_clear(&err);
+    snap_options o;
+    bool help = false;
+    if (parse_args(argc, argv, &o, &help, &err) != PS_OK)
+        return ps_cli_fail(&err);
+    if (help) {
+        fputs(usage, stdout);
+        return PS_EXIT_OK;
+    }
+    ps_scene *scene;
+    if (ps_scene_load(o.scene, NULL, &scene, &err) != PS_OK)
+        return ps_cli_fail(&err);
+    const ps_scene_defaults *def = ps_scene_get_defaults(scene);
+    int width = o.width ? o.width : def->width, height = o.height ? o.height : def->height;
+    /* RGBA, 24-bit depth, 8-bit stencil, no accumulation buffer (platform
+     * notes: it wraps above 1.0 and is no place for photon sums). */
+    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    size_t bytes = (size_t)width * (size_t)height * 4 * (o.color_depth == 0 ? 1 : sizeof(float));
+    void *buffer = ctx ? malloc(bytes) : NULL;
+    ps_status st;
+    if (!ctx)
+        st = ps_error_set(&err, PS_ERR_IO, "photosplat-snap: OSMesa could not create a context");
+    else if (!buffer)
+        st = ps_error_set(&err, PS_ERR_NOMEM, "photosplat-snap: out of memory for a %dx%d buffer", width, height);
+    else
+        st = run(&o, scene, ctx, buffer, &err);
+    if (ctx)
+        OSMesaDestroyContext(ctx);
+    free(buffer);
+    ps_scene_destroy(scene);
+    return st == PS_OK ? PS_EXIT_OK : ps_cli_fail(&err);
+}

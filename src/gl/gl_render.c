@@ -1,0 +1,671 @@
+/* gl_render.c: scene, lights, shadow maps and splats in fixed-function GL. */
+#include "gl/gl_render.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/sampling.h"
+#include "gl/gl_api.h"
+
+/* The near plane of a shadow cube, as a fraction of the scene's diagonal. */
+#define SHADOW_NEAR_FRACTION 1e-4
+/* The camera's near plane: never nearer than this fraction of its far plane,
+ * which keeps 24-bit depth fine enough for the depth prepass and the splats. */
+#define CAMERA_DEPTH_RATIO 4096.0
+/* Depth offsets: shadow maps are pushed back against self-shadowing (acne);
+ * the depth prepass is pushed back so that later passes of the same surface
+ * pass GL_LEQUAL even where a clip plane re-rasterises it; triangle splats are
+ * pulled forward (thesis 4.2). In glPolygonOffset's (factor, units). */
+#define SHADOW_OFFSET_FACTOR 2.0f
+#define SHADOW_OFFSET_UNITS 4.0f
+#define PREPASS_OFFSET 1.0f
+#define SPLAT_OFFSET -1.0f
+/* Blinn's (n.h)^s is about Phong's cos^e(alpha) when s = 4e; GL caps s at 128. */
+#define BLINN_PER_PHONG 4.0
+#define GL_MAX_SHININESS 128.0
+
+/* A GL light: a scene light, or one virtual point light of an area light. */
+typedef struct vlight {
+    ps_vec3 pos;
+    ps_vec3 dir;       /* unit axis of a spot or cosine emitter; zero when omnidirectional */
+    double cutoff_deg; /* 180: omnidirectional */
+    double exponent;   /* GL_SPOT_EXPONENT: 0 constant, 1 Lambertian */
+    ps_rgb intensity;  /* W/sr along dir (all directions when omnidirectional) */
+    unsigned faces;    /* the cube faces that can see light (bit per face) */
+    GLuint shadow[6];
+} vlight;
+
+struct ps_gl_renderer {
+    const ps_scene *scene;
+    const ps_preview_mesh *mesh;
+    const ps_material *materials;
+    ps_gl_options opt;
+    vlight *lights;
+    size_t light_count;
+    bool shadows_valid;
+    GLuint fbo, kernel_tex;
+    double scene_diag;
+    ps_aabb bounds;
+    int width, height;
+    double view[16], proj[16];
+    ps_gl_stats stats;
+};
+
+/* ---- matrices (column-major, as GL) --------------------------------------- */
+
+static void mat_identity(double m[16])
+{
+    memset(m, 0, 16 * sizeof *m);
+    m[0] = m[5] = m[10] = m[15] = 1.0;
+}
+
+static void mat_mul(const double a[16], const double b[16], double out[16])
+{
+    double r[16];
+    for (int c = 0; c < 4; c++)
+        for (int rr = 0; rr < 4; rr++) {
+            double s = 0.0;
+            for (int k = 0; k < 4; k++)
+                s += a[k * 4 + rr] * b[c * 4 + k];
+            r[c * 4 + rr] = s;
+        }
+    memcpy(out, r, sizeof r);
+}
+
+/* gluLookAt with an orthonormal frame (right, up, -forward). */
+static void mat_look(ps_vec3 eye, ps_vec3 forward, ps_vec3 right, ps_vec3 up, double m[16])
+{
+    mat_identity(m);
+    m[0] = right.x, m[4] = right.y, m[8] = right.z, m[12] = -ps_v3_dot(right, eye);
+    m[1] = up.x, m[5] = up.y, m[9] = up.z, m[13] = -ps_v3_dot(up, eye);
+    m[2] = -forward.x, m[6] = -forward.y, m[10] = -forward.z, m[14] = ps_v3_dot(forward, eye);
+}
+
+/* gluPerspective from tan(fov_y / 2). */
+static void mat_perspective(double tan_half, double aspect, double znear, double zfar, double m[16])
+{
+    memset(m, 0, 16 * sizeof *m);
+    double f = 1.0 / tan_half;
+    m[0] = f / aspect;
+    m[5] = f;
+    m[10] = (zfar + znear) / (znear - zfar);
+    m[11] = -1.0;
+    m[14] = 2.0 * zfar * znear / (znear - zfar);
+}
+
+/* Distances from p to the nearest and farthest points of box b. */
+static void box_range(ps_aabb b, ps_vec3 p, double *nearest, double *farthest)
+{
+    double n2 = 0.0, f2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        double v = ps_v3_get(p, a), lo = ps_v3_get(b.lo, a), hi = ps_v3_get(b.hi, a);
+        double d = v < lo ? lo - v : v > hi ? v - hi : 0.0;
+        double far = fmax(fabs(v - lo), fabs(v - hi));
+        n2 += d * d;
+        f2 += far * far;
+    }
+    *nearest = sqrt(n2);
+    *farthest = sqrt(f2);
+}
+
+/* ---- lights ---------------------------------------------------------------- */
+
+static const ps_vec3 face_dirs[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+
+static void face_frame(int f, ps_vec3 *forward, ps_vec3 *right, ps_vec3 *up)
+{
+    *forward = face_dirs[f];
+    ps_vec3 hint = fabs(forward->y) > 0.5 ? ps_v3(0, 0, 1) : ps_v3(0, 1, 0);
+    *right = ps_v3_norm(ps_v3_cross(*forward, hint));
+    *up = ps_v3_cross(*right, *forward);
+}
+
+/* Which cube faces can receive light from v: a face is skipped only when all
+ * of its directions lie outside the cone (a face's directions are within
+ * acos(1/sqrt(3)) = 54.7 degrees of its axis). */
+static unsigned lit_faces(const vlight *v)
+{
+    if (ps_v3_len2(v->dir) == 0.0 || v->cutoff_deg >= 180.0)
+        return 0x3f;
+    const double face_radius_deg = 54.7356103172;
+    unsigned mask = 0;
+    for (int f = 0; f < 6; f++) {
+        double angle = acos(fmax(-1.0, fmin(1.0, ps_v3_dot(face_dirs[f], v->dir)))) * 180.0 / PS_PI;
+        if (angle < v->cutoff_deg + face_radius_deg)
+            mask |= 1u << f;
+    }
+    return mask;
+}
+
+static bool push_light(ps_gl_renderer *r, size_t *cap, vlight v)
+{
+    if (r->light_count == *cap) {
+        size_t n = *cap ? 2 * *cap : 16;
+        vlight *p = realloc(r->lights, n * sizeof *p);
+        if (!p)
+            return false;
+        r->lights = p;
+        *cap = n;
+    }
+    v.faces = lit_faces(&v);
+    memset(v.shadow, 0, sizeof v.shadow);
+    r->lights[r->light_count++] = v;
+    return true;
+}
+
+/* Virtual point lights of an area light: stratified points (grid cells'
+ * centres) over the area, each a cosine emitter of power / (pi * count). */
+static bool add_area_light(ps_gl_renderer *r, size_t *cap, const ps_light *L)
+{
+    const int side = 4; /* 4 x 4 = PS_GL_AREA_SAMPLES */
+    const int count = side * side;
+    ps_rgb each = ps_rgb_scale(L->power, PS_INV_PI / count);
+    if (L->type == PS_LIGHT_SPHERE) {
+        /* Outside it, a Lambertian sphere lights like a point at its centre. */
+        vlight v = {L->position, {0, 0, 0}, 180.0, 0.0, ps_rgb_scale(L->power, 0.25 * PS_INV_PI), 0, {0}};
+        return push_light(r, cap, v);
+    }
+    size_t ntri = 0, nem = 0;
+    const ps_triangle *tris = ps_scene_triangles(r->scene, &ntri);
+    const ps_vec3 *pos = ps_scene_positions(r->scene, &ntri);
+    const uint32_t *emitters = ps_scene_emitters(r->scene, &nem);
+    (void)tris;
+    double total_area = 0.0;
+    if (L->type == PS_LIGHT_MESH)
+        for (uint32_t k = 0; k < L->emitter_count; k++)
+            total_area += ps_scene_triangle_area(r->scene, emitters[L->first_emitter + k]);
+    for (int j = 0; j < side; j++)
+        for (int i = 0; i < side; i++) {
+            double u = (i + 0.5) / side, w = (j + 0.5) / side;
+            vlight v = {{0, 0, 0}, L->direction, 90.0, 1.0, each, 0, {0}};
+            if (L->type == PS_LIGHT_QUAD) {
+                v.pos = ps_v3_add(L->position, ps_v3_add(ps_v3_scale(L->edge1, u), ps_v3_scale(L->edge2, w)));
+            } else if (L->type == PS_LIGHT_DISC) {
+                double x, y;
+                ps_sample_disc(u, w, &x, &y);
+                ps_vec3 a, b;
+                ps_v3_basis(L->direction, &a, &b);
+                v.pos = ps_v3_add(L->position, ps_v3_add(ps_v3_scale(a, x * L->radius), ps_v3_scale(b, y * L->radius)));
+            } else { /* a mesh light: the face at area fraction (j * side + i + 0.5) / count */
+                double target = (j * side + i + 0.5) / count * total_area, run = 0.0;
+                uint32_t t = emitters[L->first_emitter];
+                for (uint32_t k = 0; k < L->emitter_count; k++) {
+                    t = emitters[L->first_emitter + k];
+                    run += ps_scene_triangle_area(r->scene, t);
+                    if (run >= target)
+                        break;
+                }
+                const ps_triangle *tri = &tris[t];
+                v.pos = ps_v3_scale(ps_v3_add(ps_v3_add(pos[tri->v[0]], pos[tri->v[1]]), pos[tri->v[2]]), 1.0 / 3.0);
+                v.dir = ps_scene_triangle_normal(r->scene, t);
+            }
+            if (!push_light(r, cap, v))
+                return false;
+        }
+    return true;
+}
+
+static void free_shadows(ps_gl_renderer *r)
+{
+    for (size_t i = 0; i < r->light_count; i++)
+        for (int f = 0; f < 6; f++)
+            if (r->lights[i].shadow[f]) {
+                glDeleteTextures(1, &r->lights[i].shadow[f]);
+                r->lights[i].shadow[f] = 0;
+            }
+    r->shadows_valid = false;
+}
+
+static ps_status build_lights(ps_gl_renderer *r, ps_error *err)
+{
+    free_shadows(r);
+    r->light_count = 0;
+    size_t cap = 0, n;
+    const ps_light *lights = ps_scene_lights(r->scene, &n);
+    free(r->lights);
+    r->lights = NULL;
+    for (size_t l = 0; l < n; l++) {
+        const ps_light *L = &lights[l];
+        bool ok;
+        if (L->type == PS_LIGHT_POINT) {
+            vlight v = {L->position, {0, 0, 0}, 180.0, 0.0, ps_rgb_scale(L->power, 0.25 * PS_INV_PI), 0, {0}};
+            ok = push_light(r, &cap, v);
+        } else if (L->type == PS_LIGHT_SPOT) {
+            double solid = 2.0 * PS_PI * (1.0 - L->cos_angle);
+            vlight v = {L->position, L->direction, L->angle_deg, 0.0, ps_rgb_scale(L->power, 1.0 / solid), 0, {0}};
+            ok = push_light(r, &cap, v);
+        } else {
+            ok = add_area_light(r, &cap, L);
+        }
+        if (!ok)
+            return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for GL lights", ps_scene_path(r->scene));
+    }
+    r->stats.virtual_lights = (unsigned)r->light_count;
+    return PS_OK;
+}
+
+/* ---- drawing the mesh ----------------------------------------------------- */
+
+/* The exposure is in the lights' intensities, not here. */
+static void draw_mesh(const ps_gl_renderer *r, bool with_materials)
+{
+    const ps_preview_mesh *m = r->mesh;
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, m->positions);
+    if (with_materials) {
+        glEnableClientState(GL_NORMAL_ARRAY);
+        glNormalPointer(GL_FLOAT, 0, m->normals);
+    }
+    for (size_t i = 0; i < m->range_count; i++) {
+        const ps_mesh_range *rg = &m->ranges[i];
+        if (with_materials) {
+            const ps_material *mat = &r->materials[rg->material];
+            GLfloat diffuse[4] = {0, 0, 0, 1}, specular[4] = {0, 0, 0, 1};
+            GLfloat shininess = 0.0f;
+            if (mat->type == PS_MAT_DIFFUSE || mat->type == PS_MAT_GLOSSY) {
+                diffuse[0] = (GLfloat)(mat->albedo.r * PS_INV_PI);
+                diffuse[1] = (GLfloat)(mat->albedo.g * PS_INV_PI);
+                diffuse[2] = (GLfloat)(mat->albedo.b * PS_INV_PI);
+            }
+            if (mat->type == PS_MAT_GLOSSY) {
+                double k = (mat->exponent + 2.0) * 0.5 * PS_INV_PI;
+                specular[0] = (GLfloat)(mat->specular.r * k);
+                specular[1] = (GLfloat)(mat->specular.g * k);
+                specular[2] = (GLfloat)(mat->specular.b * k);
+                shininess = (GLfloat)fmin(BLINN_PER_PHONG * mat->exponent, GL_MAX_SHININESS);
+            }
+            glMaterialfv(GL_FRONT_AND_BACK, GL_DIFFUSE, diffuse);
+            glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, specular);
+            glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, shininess);
+        }
+        glDrawArrays(GL_TRIANGLES, (GLint)rg->first, (GLsizei)rg->count);
+    }
+    glDisableClientState(GL_NORMAL_ARRAY);
+    glDisableClientState(GL_VERTEX_ARRAY);
+}
+
+/* Emissive faces (MTL Ke) as their own radiance, front side only. */
+static void draw_emission(const ps_gl_renderer *r, double exposure)
+{
+    const ps_preview_mesh *m = r->mesh;
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, m->positions);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    for (size_t i = 0; i < m->range_count; i++) {
+        const ps_material *mat = &r->materials[m->ranges[i].material];
+        if (ps_rgb_is_black(mat->emission))
+            continue;
+        glColor4f((GLfloat)(mat->emission.r * exposure), (GLfloat)(mat->emission.g * exposure),
+                  (GLfloat)(mat->emission.b * exposure), 1.0f);
+        glDrawArrays(GL_TRIANGLES, (GLint)m->ranges[i].first, (GLsizei)m->ranges[i].count);
+    }
+    glDisable(GL_CULL_FACE);
+    glDisableClientState(GL_VERTEX_ARRAY);
+}
+
+/* ---- shadow maps ------------------------------------------------------------ */
+
+static void light_face_matrices(const ps_gl_renderer *r, const vlight *v, int f, double proj[16], double view[16])
+{
+    ps_vec3 fw, rt, up;
+    face_frame(f, &fw, &rt, &up);
+    double nearest, farthest;
+    box_range(r->bounds, v->pos, &nearest, &farthest);
+    double znear = fmax(SHADOW_NEAR_FRACTION * r->scene_diag, 1e-300);
+    mat_perspective(1.0, 1.0, znear, fmax(farthest * 1.01, 2.0 * znear), proj);
+    mat_look(v->pos, fw, rt, up, view);
+}
+
+static void make_shadow_maps(ps_gl_renderer *r)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+    glViewport(0, 0, PS_GL_SHADOW_SIZE, PS_GL_SHADOW_SIZE);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(SHADOW_OFFSET_FACTOR, SHADOW_OFFSET_UNITS);
+    for (size_t i = 0; i < r->light_count; i++) {
+        vlight *v = &r->lights[i];
+        for (int f = 0; f < 6; f++) {
+            if (!(v->faces & (1u << f)))
+                continue;
+            if (!v->shadow[f]) {
+                glGenTextures(1, &v->shadow[f]);
+                glBindTexture(GL_TEXTURE_2D, v->shadow[f]);
+                glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, PS_GL_SHADOW_SIZE, PS_GL_SHADOW_SIZE, 0,
+                             GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, NULL);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+                /* Outside the face's square: depth 0 at the border, so the
+                 * compare fails there and the neighbouring face lights it. */
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+                const GLfloat border[4] = {0, 0, 0, 0};
+                glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_R_TO_TEXTURE);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+                glTexParameteri(GL_TEXTURE_2D, GL_DEPTH_TEXTURE_MODE, GL_INTENSITY);
+            }
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, v->shadow[f], 0);
+            glClear(GL_DEPTH_BUFFER_BIT);
+            double proj[16], view[16];
+            light_face_matrices(r, v, f, proj, view);
+            glMatrixMode(GL_PROJECTION);
+            glLoadMatrixd(proj);
+            glMatrixMode(GL_MODELVIEW);
+            glLoadMatrixd(view);
+            draw_mesh(r, false);
+            r->stats.shadow_maps++;
+        }
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    glDrawBuffer(old_fbo ? GL_COLOR_ATTACHMENT0 : GL_BACK);
+    glReadBuffer(old_fbo ? GL_COLOR_ATTACHMENT0 : GL_BACK);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    r->shadows_valid = true;
+}
+
+/* ---- the frame ---------------------------------------------------------------- */
+
+static void set_gl_light(const vlight *v, double exposure)
+{
+    GLfloat pos[4] = {(GLfloat)v->pos.x, (GLfloat)v->pos.y, (GLfloat)v->pos.z, 1.0f};
+    GLfloat col[4] = {(GLfloat)(v->intensity.r * exposure), (GLfloat)(v->intensity.g * exposure),
+                      (GLfloat)(v->intensity.b * exposure), 1.0f};
+    GLfloat black[4] = {0, 0, 0, 1};
+    glLightfv(GL_LIGHT0, GL_POSITION, pos);
+    glLightfv(GL_LIGHT0, GL_AMBIENT, black);
+    glLightfv(GL_LIGHT0, GL_DIFFUSE, col);
+    glLightfv(GL_LIGHT0, GL_SPECULAR, col);
+    glLightf(GL_LIGHT0, GL_CONSTANT_ATTENUATION, 0.0f);
+    glLightf(GL_LIGHT0, GL_LINEAR_ATTENUATION, 0.0f);
+    glLightf(GL_LIGHT0, GL_QUADRATIC_ATTENUATION, 1.0f);
+    if (v->cutoff_deg < 180.0) {
+        GLfloat dir[3] = {(GLfloat)v->dir.x, (GLfloat)v->dir.y, (GLfloat)v->dir.z};
+        glLightfv(GL_LIGHT0, GL_SPOT_DIRECTION, dir);
+        glLightf(GL_LIGHT0, GL_SPOT_CUTOFF, (GLfloat)v->cutoff_deg);
+        glLightf(GL_LIGHT0, GL_SPOT_EXPONENT, (GLfloat)v->exponent);
+    } else {
+        glLightf(GL_LIGHT0, GL_SPOT_CUTOFF, 180.0f);
+        glLightf(GL_LIGHT0, GL_SPOT_EXPONENT, 0.0f);
+    }
+}
+
+/* Texgen planes that take world points to the shadow map's [0,1]^3 (the
+ * rows of bias * projection * view), set while the modelview is the camera's
+ * view so that GL's eye-linear planes see world coordinates. */
+static void set_shadow_texgen(const double light_proj[16], const double light_view[16])
+{
+    static const double bias[16] = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 0.5, 0.5, 0.5, 1};
+    double t[16];
+    mat_mul(bias, light_proj, t);
+    mat_mul(t, light_view, t);
+    const GLenum coords[4] = {GL_S, GL_T, GL_R, GL_Q};
+    const GLenum gens[4] = {GL_TEXTURE_GEN_S, GL_TEXTURE_GEN_T, GL_TEXTURE_GEN_R, GL_TEXTURE_GEN_Q};
+    for (int k = 0; k < 4; k++) {
+        GLdouble plane[4] = {t[k], t[4 + k], t[8 + k], t[12 + k]};
+        glTexGeni(coords[k], GL_TEXTURE_GEN_MODE, GL_EYE_LINEAR);
+        glTexGendv(coords[k], GL_EYE_PLANE, plane);
+        glEnable(gens[k]);
+    }
+}
+
+static void disable_texgen(void)
+{
+    glDisable(GL_TEXTURE_GEN_S);
+    glDisable(GL_TEXTURE_GEN_T);
+    glDisable(GL_TEXTURE_GEN_R);
+    glDisable(GL_TEXTURE_GEN_Q);
+}
+
+static void draw_direct(ps_gl_renderer *r, double exposure)
+{
+    glEnable(GL_LIGHTING);
+    glEnable(GL_LIGHT0);
+    glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
+    glLightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, GL_TRUE);
+    const GLfloat no_ambient[4] = {0, 0, 0, 1};
+    glLightModelfv(GL_LIGHT_MODEL_AMBIENT, no_ambient);
+    glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT, no_ambient);
+    glMaterialfv(GL_FRONT_AND_BACK, GL_EMISSION, no_ambient);
+    for (size_t i = 0; i < r->light_count; i++) {
+        const vlight *v = &r->lights[i];
+        set_gl_light(v, exposure);
+        if (!r->opt.shadows) {
+            draw_mesh(r, true);
+            r->stats.light_passes++;
+            continue;
+        }
+        glEnable(GL_TEXTURE_2D);
+        glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+        glEnable(GL_CLIP_PLANE0);
+        for (int f = 0; f < 6; f++) {
+            if (!(v->faces & (1u << f)))
+                continue;
+            double proj[16], view[16];
+            light_face_matrices(r, v, f, proj, view);
+            set_shadow_texgen(proj, view);
+            /* Only the half-space in front of the face: behind the light the
+             * projection would fold points back into the map. */
+            GLdouble plane[4] = {face_dirs[f].x, face_dirs[f].y, face_dirs[f].z, -ps_v3_dot(face_dirs[f], v->pos)};
+            glClipPlane(GL_CLIP_PLANE0, plane);
+            glBindTexture(GL_TEXTURE_2D, v->shadow[f]);
+            draw_mesh(r, true);
+            r->stats.light_passes++;
+        }
+        glDisable(GL_CLIP_PLANE0);
+        disable_texgen();
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glDisable(GL_TEXTURE_2D);
+    }
+    glDisable(GL_LIGHT0);
+    glDisable(GL_LIGHTING);
+    draw_emission(r, exposure);
+}
+
+void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
+{
+    r->stats.light_passes = 0;
+    if (direct && r->opt.shadows && !r->shadows_valid)
+        make_shadow_maps(r);
+    r->width = cam->width;
+    r->height = cam->height;
+    glViewport(0, 0, cam->width, cam->height);
+    if (r->opt.float_buffer) {
+        glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
+        glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    }
+    glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
+    glClearColor(0, 0, 0, 0);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+
+    double nearest, farthest;
+    box_range(r->bounds, cam->eye, &nearest, &farthest);
+    double zfar = fmax(farthest * 1.01, 1e-300);
+    double znear = fmax(nearest * 0.5, zfar / CAMERA_DEPTH_RATIO);
+    mat_perspective(cam->tan_half_fov, cam->aspect, znear, zfar, r->proj);
+    mat_look(cam->eye, cam->forward, cam->right, cam->up, r->view);
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(r->proj);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(r->view);
+
+    /* Depth first, pushed back a little (see PREPASS_OFFSET). */
+    glDisable(GL_BLEND);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(PREPASS_OFFSET, PREPASS_OFFSET);
+    draw_mesh(r, false);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    if (!direct)
+        return;
+    /* Each light adds its pass on top. */
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_LEQUAL);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    draw_direct(r, exposure);
+    glDisable(GL_BLEND);
+}
+
+void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode mode, double radius,
+                       double point_size)
+{
+    if (b->vertex_count == 0)
+        return;
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(r->proj);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(r->view);
+    glDisable(GL_LIGHTING);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glEnableClientState(GL_COLOR_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, b->positions);
+    glColorPointer(4, GL_FLOAT, 0, b->colors);
+    if (mode == PS_SPLAT_POINTS) {
+        glBlendFunc(GL_ONE, GL_ONE);
+        glPointSize((GLfloat)point_size);
+        glDrawArrays(GL_POINTS, 0, (GLsizei)b->vertex_count);
+    } else {
+        glEnable(GL_TEXTURE_2D);
+        glBindTexture(GL_TEXTURE_2D, r->kernel_tex);
+        glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+        glBlendFunc(GL_SRC_ALPHA, GL_ONE);
+        if (mode == PS_SPLAT_TRIANGLES) {
+            glEnableClientState(GL_TEXTURE_COORD_ARRAY);
+            glTexCoordPointer(2, GL_FLOAT, 0, b->texcoords);
+            glEnable(GL_POLYGON_OFFSET_FILL);
+            glPolygonOffset(SPLAT_OFFSET, SPLAT_OFFSET);
+            glDrawArrays(GL_TRIANGLES, 0, (GLsizei)b->vertex_count);
+            glDisable(GL_POLYGON_OFFSET_FILL);
+            glDisableClientState(GL_TEXTURE_COORD_ARRAY);
+        } else {
+            /* Point sprites whose side is the disc's diameter in pixels at
+             * distance d: 2 r f / d, f the focal length in pixels
+             * (GL_POINT_DISTANCE_ATTENUATION {0, 0, 1} divides by d). */
+            double focal = 0.5 * r->height / (r->proj[5] > 0.0 ? 1.0 / r->proj[5] : 1.0);
+            const GLfloat atten[3] = {0.0f, 0.0f, 1.0f};
+            GLfloat range[2] = {1.0f, 64.0f};
+            glGetFloatv(GL_ALIASED_POINT_SIZE_RANGE, range);
+            glPointParameterfv(GL_POINT_DISTANCE_ATTENUATION, atten);
+            glPointParameterf(GL_POINT_SIZE_MIN, 1.0f);
+            glPointParameterf(GL_POINT_SIZE_MAX, range[1]);
+            glEnable(GL_POINT_SPRITE);
+            glTexEnvi(GL_POINT_SPRITE, GL_COORD_REPLACE, GL_TRUE);
+            glPointSize((GLfloat)(2.0 * radius * focal));
+            glDrawArrays(GL_POINTS, 0, (GLsizei)b->vertex_count);
+            glTexEnvi(GL_POINT_SPRITE, GL_COORD_REPLACE, GL_FALSE);
+            glDisable(GL_POINT_SPRITE);
+            const GLfloat none[3] = {1.0f, 0.0f, 0.0f};
+            glPointParameterfv(GL_POINT_DISTANCE_ATTENUATION, none);
+        }
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glDisable(GL_TEXTURE_2D);
+    }
+    glDisableClientState(GL_COLOR_ARRAY);
+    glDisableClientState(GL_VERTEX_ARRAY);
+    glDisable(GL_BLEND);
+}
+
+ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err)
+{
+    ps_status st = ps_image_create(r->width, r->height, out, err);
+    if (st != PS_OK)
+        return st;
+    float *rows = malloc(sizeof(float) * 3 * (size_t)r->width * (size_t)r->height);
+    if (!rows) {
+        ps_image_destroy(out);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory reading the picture back");
+    }
+    glFinish();
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, r->width, r->height, GL_RGB, GL_FLOAT, rows);
+    /* GL's row 0 is the bottom; ours the top. */
+    for (int y = 0; y < r->height; y++)
+        memcpy(ps_image_at(out, 0, y), rows + 3 * (size_t)(r->height - 1 - y) * (size_t)r->width,
+               sizeof(float) * 3 * (size_t)r->width);
+    free(rows);
+    return PS_OK;
+}
+
+static void upload_kernel(ps_gl_renderer *r, const ps_kernel_texture *k)
+{
+    if (!r->kernel_tex)
+        glGenTextures(1, &r->kernel_tex);
+    glBindTexture(GL_TEXTURE_2D, r->kernel_tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_ALPHA8, k->size, k->size, 0, GL_ALPHA, GL_UNSIGNED_BYTE, k->alpha);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTexture(GL_TEXTURE_2D, 0);
+}
+
+void ps_gl_renderer_set_kernel(ps_gl_renderer *r, const ps_kernel_texture *kernel) { upload_kernel(r, kernel); }
+
+ps_status ps_gl_renderer_create(const ps_scene *s, const ps_preview_mesh *mesh, const ps_kernel_texture *kernel,
+                                const ps_gl_options *o, ps_gl_renderer **out, ps_error *err)
+{
+    *out = NULL;
+    ps_gl_renderer *r = calloc(1, sizeof *r);
+    if (!r)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the GL renderer");
+    r->scene = s;
+    r->mesh = mesh;
+    size_t n;
+    r->materials = ps_scene_materials(s, &n);
+    r->opt = *o;
+    r->bounds = ps_scene_bounds(s);
+    r->scene_diag = ps_v3_len(ps_aabb_diag(r->bounds));
+    if (!(r->scene_diag > 0.0) || !isfinite(r->scene_diag))
+        r->scene_diag = 1.0;
+    ps_status st = build_lights(r, err);
+    if (st != PS_OK) {
+        ps_gl_renderer_destroy(r);
+        return st;
+    }
+    glGenFramebuffers(1, &r->fbo);
+    upload_kernel(r, kernel);
+    *out = r;
+    return PS_OK;
+}
+
+void ps_gl_renderer_lights_changed(ps_gl_renderer *r)
+{
+    ps_error err;
+    if (build_lights(r, &err) != PS_OK)
+        r->light_count = 0; /* out of memory: draw unlit rather than fail a frame */
+}
+
+ps_gl_stats ps_gl_get_stats(const ps_gl_renderer *r) { return r->stats; }
+
+void ps_gl_renderer_destroy(ps_gl_renderer *r)
+{
+    if (!r)
+        return;
+    free_shadows(r);
+    if (r->fbo)
+        glDeleteFramebuffers(1, &r->fbo);
+    if (r->kernel_tex)
+        glDeleteTextures(1, &r->kernel_tex);
+    free(r->lights);
+    free(r);
+}

@@ -1,0 +1,50 @@
+/* mesh.h: the scene as flat triangle arrays for OpenGL, fine enough that
+ * per-vertex (Gouraud) lighting matches the reference renderer.
+ *
+ * Fixed-function GL evaluates lights only at vertices and interpolates
+ * between them, so a 2 m wall drawn as two triangles would show the inverse-
+ * square falloff of a point light as a linear ramp. Every triangle is
+ * therefore cut into n x n similar ones with no edge longer than max_edge
+ * (the interpolation error of I h / (h^2 + x^2)^(3/2) shrinks with the edge
+ * squared: about 0.1 % at a twentieth of the light's height), and spheres are
+ * tessellated within a sagitta tolerance. GL-free, so it is tested without a
+ * context; src/gl draws it. */
+#ifndef PS_PREVIEW_MESH_H
+#define PS_PREVIEW_MESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/status.h"
+#include "scene/scene.h"
+
+/* Subdivision stops here whatever max_edge asks: 2 * 256^2 triangles a face. */
+#define PS_MESH_MAX_SPLIT 256
+
+/* A run of triangles of one object and one material. */
+typedef struct ps_mesh_range {
+    uint32_t object, material;
+    size_t first, count; /* in vertices (3 per triangle) */
+} ps_mesh_range;
+
+typedef struct ps_preview_mesh {
+    size_t vertex_count;  /* 3 per triangle, nothing shared: ready for glDrawArrays */
+    float *positions;     /* xyz per vertex */
+    float *normals;       /* unit xyz per vertex, on the side of the winding's normal */
+    ps_mesh_range *ranges;
+    size_t range_count;
+} ps_preview_mesh;
+
+typedef struct ps_mesh_options {
+    double max_edge;         /* longest edge after subdivision (scene units, > 0) */
+    double sphere_tolerance; /* sagitta / radius for spheres (tessellate.h) */
+} ps_mesh_options;
+
+/* max_edge a 64th of the scene's bounding-box diagonal, spheres at the
+ * tessellation default. */
+ps_mesh_options ps_mesh_default_options(const ps_scene *s);
+
+ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_preview_mesh *out, ps_error *err);
+void ps_preview_mesh_free(ps_preview_mesh *m); /* and zero it; accepts a zeroed one */
+
+#endif

@@ -1,0 +1,182 @@
+/* splat.c: kernel textures and the splat vertex arrays. */
+#include "preview/splat.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/array.h"
+#include "scene/bsdf.h"
+
+static const char *const mode_names[PS_SPLAT_MODE_COUNT] = {"points", "triangles", "sprites"};
+static const char *const precision_names[PS_PRECISION_COUNT] = {"none", "diffusion", "counter"};
+
+const char *ps_splat_mode_name(ps_splat_mode m) { return (unsigned)m < PS_SPLAT_MODE_COUNT ? mode_names[m] : "?"; }
+const char *ps_precision_name(ps_precision p) { return (unsigned)p < PS_PRECISION_COUNT ? precision_names[p] : "?"; }
+
+/* ---- the kernel texture --------------------------------------------------- */
+
+ps_status ps_kernel_texture_make(ps_kernel k, int size, ps_kernel_texture *out, ps_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (size < 2 || size > 4096)
+        return ps_error_set(err, PS_ERR_RANGE, "kernel texture: size %d out of range", size);
+    out->alpha = malloc((size_t)size * (size_t)size);
+    if (!out->alpha)
+        return ps_error_set(err, PS_ERR_NOMEM, "kernel texture: out of memory");
+    out->size = size;
+    double sum = 0.0;
+    for (int j = 0; j < size; j++)
+        for (int i = 0; i < size; i++) {
+            /* Texel centres over [-1, 1]^2, in units of the radius. */
+            double x = 2.0 * (i + 0.5) / size - 1.0, y = 2.0 * (j + 0.5) / size - 1.0;
+            double a = ps_kernel_profile(k, sqrt(x * x + y * y));
+            uint8_t code = (uint8_t)lround(255.0 * fmin(fmax(a, 0.0), 1.0));
+            out->alpha[(size_t)j * (size_t)size + (size_t)i] = code;
+            sum += code / 255.0;
+        }
+    /* C: the stored weights' integral over the square, (2 / size)^2 per
+     * texel, divided by the unit disc's area. */
+    out->mean = sum * (4.0 / ((double)size * size)) / PS_PI;
+    return PS_OK;
+}
+
+void ps_kernel_texture_free(ps_kernel_texture *t)
+{
+    if (!t)
+        return;
+    free(t->alpha);
+    memset(t, 0, sizeof *t);
+}
+
+/* ---- batches -------------------------------------------------------------- */
+
+void ps_splat_batch_init(ps_splat_batch *b) { memset(b, 0, sizeof *b); }
+
+void ps_splat_batch_free(ps_splat_batch *b)
+{
+    if (!b)
+        return;
+    free(b->positions);
+    free(b->colors);
+    free(b->texcoords);
+    memset(b, 0, sizeof *b);
+}
+
+void ps_splat_batch_clear(ps_splat_batch *b)
+{
+    b->vertex_count = 0;
+    b->splats = 0;
+}
+
+void ps_splat_basis(ps_vec3 n, ps_vec3 *x, ps_vec3 *y)
+{
+    /* Zero the smallest component and swap the other two with one negated:
+     * perpendicular to n, and never near zero length for a unit n. */
+    double ax = fabs(n.x), ay = fabs(n.y), az = fabs(n.z);
+    ps_vec3 v;
+    if (ax <= ay && ax <= az)
+        v = ps_v3(0.0, -n.z, n.y);
+    else if (ay <= az)
+        v = ps_v3(-n.z, 0.0, n.x);
+    else
+        v = ps_v3(-n.y, n.x, 0.0);
+    *x = ps_v3_norm(v);
+    *y = ps_v3_norm(ps_v3_cross(n, *x));
+}
+
+/* The 8-bit handling of one colour channel: what is sent to GL. */
+static double quantise(ps_splat_batch *b, const ps_splat_params *p, int ch, double c)
+{
+    if (p->levels <= 0 || p->precision == PS_PRECISION_NONE)
+        return c;
+    double L = p->levels;
+    if (p->precision == PS_PRECISION_DIFFUSION) {
+        double want = c + b->carry[ch];
+        double q = fmax(round(want * L), 0.0) / L;
+        b->carry[ch] = want - q;
+        return q;
+    }
+    /* Counter: send as is, and count what the buffer will round away. */
+    double q = round(c * L) / L;
+    b->wanted += c;
+    b->lost += c - q;
+    return c;
+}
+
+ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
+                         ps_splat_batch *b, ps_error *err)
+{
+    size_t per = p->mode == PS_SPLAT_TRIANGLES ? 3 : 1;
+    if (count > (SIZE_MAX / 4 - b->vertex_count) / per ||
+        !PS_RESERVE(b->positions, b->cap_pos, 3 * (b->vertex_count + per * count)) ||
+        !PS_RESERVE(b->colors, b->cap_col, 4 * (b->vertex_count + per * count)) ||
+        (per == 3 && !PS_RESERVE(b->texcoords, b->cap_tex, 2 * (b->vertex_count + per * count))))
+        return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
+    const ps_camera_frame *cam = &p->cam;
+    double r = p->radius;
+    double disc = 1.0 / (p->kernel_mean * PS_PI * r * r);
+    /* World size of one pixel at unit depth along the view axis. */
+    double pixel = 2.0 * cam->tan_half_fov / cam->height;
+    for (size_t i = 0; i < count; i++) {
+        const ps_photon *ph = &photons[i];
+        ps_vec3 pos = ps_photon_position(ph), n = ps_photon_normal(ph);
+        ps_vec3 to_eye = ps_v3_sub(cam->eye, pos);
+        double dist = ps_v3_len(to_eye);
+        if (!(dist > 0.0))
+            continue;
+        ps_vec3 wo = ps_v3_scale(to_eye, 1.0 / dist);
+        double cos_v = ps_v3_dot(wo, n);
+        if (cos_v <= 0.0)
+            continue; /* the other face of a two-sided surface */
+        ps_rgb f = ps_bsdf_eval(&p->materials[materials[i]], n, ps_photon_dir(ph), wo);
+        ps_rgb c = ps_rgb_scale(ps_rgb_mul(f, ps_photon_power(ph)), p->scale);
+        if (p->mode == PS_SPLAT_POINTS) {
+            /* An unbiased one-pixel estimate: the power over the surface area
+             * the point covers. Its square of (side * pixel) at unit depth
+             * subtends side^2 pixel^2 cos^3(a) at angle a off the axis; at
+             * distance dist = depth / cos(a) that is side^2 pixel^2 depth^2
+             * cos(a) across the ray, and 1 / cos_v more along the surface. */
+            double depth = ps_v3_dot(ps_v3_neg(to_eye), cam->forward);
+            double side = p->point_size * pixel * depth;
+            double area = side * side * (depth / dist) / fmax(cos_v, PS_SPLAT_MIN_COS);
+            c = ps_rgb_scale(c, 1.0 / area);
+        } else {
+            c = ps_rgb_scale(c, disc);
+            /* A sprite faces the eye: its disc covers 1 / cos more pixels than
+             * the surface's disc would, so it carries cos of the colour. */
+            if (p->mode == PS_SPLAT_SPRITES)
+                c = ps_rgb_scale(c, cos_v);
+        }
+        float rgba[4] = {(float)quantise(b, p, 0, c.r), (float)quantise(b, p, 1, c.g), (float)quantise(b, p, 2, c.b),
+                         1.0f};
+        ps_vec3 centre = ps_v3_madd(pos, wo, PS_SPLAT_EYE_OFFSET * dist);
+        size_t v = b->vertex_count;
+        if (p->mode == PS_SPLAT_TRIANGLES) {
+            /* The equilateral triangle around the disc of radius r: corners
+             * at 2r, at 90, 210 and 330 degrees; the texture's unit square
+             * spans the disc's [-r, r]^2, so texcoords run 0.5 + cos, sin. */
+            static const double cs[3][2] = {{0.0, 1.0}, {-0.86602540378443865, -0.5}, {0.86602540378443865, -0.5}};
+            ps_vec3 x, y;
+            ps_splat_basis(n, &x, &y);
+            for (int k = 0; k < 3; k++) {
+                ps_vec3 q = ps_v3_add(centre, ps_v3_add(ps_v3_scale(x, 2.0 * r * cs[k][0]),
+                                                         ps_v3_scale(y, 2.0 * r * cs[k][1])));
+                b->positions[3 * (v + k)] = (float)q.x;
+                b->positions[3 * (v + k) + 1] = (float)q.y;
+                b->positions[3 * (v + k) + 2] = (float)q.z;
+                b->texcoords[2 * (v + k)] = (float)(0.5 + cs[k][0]);
+                b->texcoords[2 * (v + k) + 1] = (float)(0.5 + cs[k][1]);
+                memcpy(&b->colors[4 * (v + k)], rgba, sizeof rgba);
+            }
+        } else {
+            b->positions[3 * v] = (float)centre.x;
+            b->positions[3 * v + 1] = (float)centre.y;
+            b->positions[3 * v + 2] = (float)centre.z;
+            memcpy(&b->colors[4 * v], rgba, sizeof rgba);
+        }
+        b->vertex_count += per;
+        b->splats++;
+    }
+    return PS_OK;
+}

@@ -1,0 +1,108 @@
+/* splat.h: photons as splats (thesis 3.2.2, 4.2): the vertex arrays the GL
+ * module draws, the kernel texture, and the 8-bit precision handling (5.1).
+ * GL-free: everything here is tested without a context.
+ *
+ * A splat shows a photon's share of the radiance estimate (thesis eq. 13):
+ *     colour = dPhi * f(w_p, w_view) * scale / (C pi r^2)
+ * spread over a disc of radius r with the kernel's weights, C the mean weight
+ * of the kernel as rasterised. `scale` is the exposure times N / n: photon
+ * powers are normalised for the map's cap N, and n photons have been emitted
+ * so far (progressive refinement shows the estimate of the n it has). The
+ * BRDF uses the photon's own incoming direction and the direction to the eye,
+ * so glossy surfaces show the Phong lobe (Stuerzlinger) and a moved camera
+ * needs new colours, not new photons. */
+#ifndef PS_PREVIEW_SPLAT_H
+#define PS_PREVIEW_SPLAT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/status.h"
+#include "photon/estimate.h"
+#include "photon/photon.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+typedef enum ps_splat_mode {
+    PS_SPLAT_POINTS,    /* one glPoint a photon: the rough preview */
+    PS_SPLAT_TRIANGLES, /* a kernel-textured triangle in the surface's plane: the accurate one */
+    PS_SPLAT_SPRITES,   /* a kernel-textured point sprite sized by distance */
+    PS_SPLAT_MODE_COUNT
+} ps_splat_mode;
+
+typedef enum ps_precision {
+    PS_PRECISION_NONE,      /* colours as computed: an 8-bit buffer rounds faint ones away */
+    PS_PRECISION_DIFFUSION, /* each photon's round-off carried into the next, per channel */
+    PS_PRECISION_COUNTER,   /* count what rounds away; the caller stops shooting past a threshold */
+    PS_PRECISION_COUNT
+} ps_precision;
+
+const char *ps_splat_mode_name(ps_splat_mode m);
+const char *ps_precision_name(ps_precision p);
+
+/* The kernel as an alpha texture: size x size texels over the square around
+ * the unit disc (texel weights are 0 outside it, so clamping to the edge adds
+ * nothing), and C measured from the stored 8-bit texels, not the formula, so
+ * that the texture GL draws is what is normalised. */
+typedef struct ps_kernel_texture {
+    int size;
+    uint8_t *alpha;
+    double mean; /* C */
+} ps_kernel_texture;
+
+#define PS_KERNEL_TEXTURE_SIZE 64
+
+ps_status ps_kernel_texture_make(ps_kernel k, int size, ps_kernel_texture *out, ps_error *err);
+void ps_kernel_texture_free(ps_kernel_texture *t);
+
+typedef struct ps_splat_params {
+    ps_splat_mode mode;
+    double radius;      /* r, scene units (> 0) */
+    double kernel_mean; /* C of the kernel texture (triangles and sprites) */
+    double scale;       /* exposure * N / n */
+    double point_size;  /* points: their side in pixels */
+    ps_precision precision;
+    int levels;         /* the colour buffer's steps per unit: 255 for 8 bits, 0 for float */
+    const ps_material *materials; /* the scene's, indexed by the photons' material ids */
+    ps_camera_frame cam;
+} ps_splat_params;
+
+/* Points: at grazing view the footprint 1 / cos grows without bound; past
+ * this cosine it is held (a bias only where a surface is seen edge-on). */
+#define PS_SPLAT_MIN_COS 0.05
+/* Splats move this fraction of their distance toward the eye so that the
+ * depth test against their own surface never flickers (thesis 4.2). */
+#define PS_SPLAT_EYE_OFFSET 1e-3
+
+/* Vertex arrays for glDrawArrays, and the precision bookkeeping of the photons
+ * that went in. The carry persists across batches of the same map (clear it
+ * when the map restarts); wanted/lost add up until cleared. */
+typedef struct ps_splat_batch {
+    size_t vertex_count; /* 3 a photon for triangles, 1 otherwise */
+    float *positions;    /* xyz */
+    float *colors;       /* rgba, a = 1 */
+    float *texcoords;    /* uv (triangles only) */
+    size_t cap_pos, cap_col, cap_tex;
+    size_t splats;       /* photons drawn (those facing the eye) */
+    double carry[3];     /* diffusion: round-off not yet added */
+    double wanted, lost; /* counter: colour asked for, and what rounding took (summed over channels) */
+} ps_splat_batch;
+
+void ps_splat_batch_init(ps_splat_batch *b);
+void ps_splat_batch_free(ps_splat_batch *b);
+/* Empties the arrays; keeps carry and the counters. */
+void ps_splat_batch_clear(ps_splat_batch *b);
+
+/* Appends the splats of photons[0, count) (materials beside them). Photons on
+ * a surface facing away from the eye are skipped: two-sided surfaces keep
+ * photons on both faces at the same depth, and only the visible face's may
+ * show. */
+ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
+                         ps_splat_batch *b, ps_error *err);
+
+/* The thesis' numerically stable basis (Fig. 11): X perpendicular to unit n
+ * from n's two larger components (the smallest is zeroed), Y = n x X so that
+ * (X, Y, n) is right-handed (the figure's X x N is its mirror image); both unit. */
+void ps_splat_basis(ps_vec3 n, ps_vec3 *x, ps_vec3 *y);
+
+#endif
