@@ -92,9 +92,11 @@ $(eval $(call variant-rules,asan))
 # Programs' objects are not in the library; keep them when make would call them intermediate.
 .SECONDARY:
 
+# Copied then renamed: a running bin/ program (a benchmark, a window) keeps
+# its old file instead of failing the copy with "text file busy".
 bin/%: build/release/bin/%
 	@mkdir -p bin
-	cp $< $@
+	cp $< $@.tmp.$$$$ && mv -f $@.tmp.$$$$ $@
 
 .PHONY: all deps test check run run-built bench clean build-tests
 all: $(addprefix bin/,$(PROGS))

@@ -318,6 +318,7 @@ static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
         p.mode = (ps_splat_mode)o->splat;
         p.radius = s->radius[k];
         p.kernel_mean = s->kernel.mean;
+        p.kernel_extent = s->kernel.extent;
         /* Powers are normalised for the cap N; n have been emitted so far. */
         p.scale = o->exposure * (double)f->cap[k] / (double)m->counters.emitted;
         p.point_size = o->point_size;

@@ -45,6 +45,7 @@ struct ps_gl_renderer {
     size_t light_count;
     bool shadows_valid;
     GLuint fbo, kernel_tex;
+    double kernel_extent; /* the texture's half side in splat radii */
     double scene_diag;
     ps_aabb bounds;
     int width, height;
@@ -557,8 +558,8 @@ void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode
             glDisable(GL_POLYGON_OFFSET_FILL);
             glDisableClientState(GL_TEXTURE_COORD_ARRAY);
         } else {
-            /* Point sprites whose side is the disc's diameter in pixels at
-             * distance d: 2 r f / d, f the focal length in pixels
+            /* Point sprites whose side is the kernel square's in pixels at
+             * distance d: 2 extent r f / d, f the focal length in pixels
              * (GL_POINT_DISTANCE_ATTENUATION {0, 0, 1} divides by d). */
             double focal = 0.5 * r->height / (r->proj[5] > 0.0 ? 1.0 / r->proj[5] : 1.0);
             const GLfloat atten[3] = {0.0f, 0.0f, 1.0f};
@@ -569,7 +570,7 @@ void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode
             glPointParameterf(GL_POINT_SIZE_MAX, range[1]);
             glEnable(GL_POINT_SPRITE);
             glTexEnvi(GL_POINT_SPRITE, GL_COORD_REPLACE, GL_TRUE);
-            glPointSize((GLfloat)(2.0 * radius * focal));
+            glPointSize((GLfloat)(2.0 * r->kernel_extent * radius * focal));
             glDrawArrays(GL_POINTS, 0, (GLsizei)b->vertex_count);
             glTexEnvi(GL_POINT_SPRITE, GL_COORD_REPLACE, GL_FALSE);
             glDisable(GL_POINT_SPRITE);
@@ -607,6 +608,7 @@ ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err)
 
 static void upload_kernel(ps_gl_renderer *r, const ps_kernel_texture *k)
 {
+    r->kernel_extent = k->extent;
     if (!r->kernel_tex)
         glGenTextures(1, &r->kernel_tex);
     glBindTexture(GL_TEXTURE_2D, r->kernel_tex);

@@ -25,19 +25,21 @@ ps_status ps_kernel_texture_make(ps_kernel k, int size, ps_kernel_texture *out, 
     if (!out->alpha)
         return ps_error_set(err, PS_ERR_NOMEM, "kernel texture: out of memory");
     out->size = size;
+    out->extent = (double)size / (double)(size - 2);
     double sum = 0.0;
     for (int j = 0; j < size; j++)
         for (int i = 0; i < size; i++) {
-            /* Texel centres over [-1, 1]^2, in units of the radius. */
-            double x = 2.0 * (i + 0.5) / size - 1.0, y = 2.0 * (j + 0.5) / size - 1.0;
+            /* Texel centres over [-extent, extent]^2, in units of the radius. */
+            double x = out->extent * (2.0 * (i + 0.5) / size - 1.0), y = out->extent * (2.0 * (j + 0.5) / size - 1.0);
             double a = ps_kernel_profile(k, sqrt(x * x + y * y));
             uint8_t code = (uint8_t)lround(255.0 * fmin(fmax(a, 0.0), 1.0));
             out->alpha[(size_t)j * (size_t)size + (size_t)i] = code;
             sum += code / 255.0;
         }
-    /* C: the stored weights' integral over the square, (2 / size)^2 per
-     * texel, divided by the unit disc's area. */
-    out->mean = sum * (4.0 / ((double)size * size)) / PS_PI;
+    /* C: the stored weights' integral over the square, (2 extent / size)^2
+     * per texel, divided by the unit disc's area. */
+    double texel = 2.0 * out->extent / size;
+    out->mean = sum * texel * texel / PS_PI;
     return PS_OK;
 }
 
@@ -148,14 +150,24 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
             if (p->mode == PS_SPLAT_SPRITES)
                 c = ps_rgb_scale(c, cos_v);
         }
+        double lift = PS_SPLAT_EYE_OFFSET * dist;
+        if (p->mode == PS_SPLAT_SPRITES) {
+            double tan_v = sqrt(fmax(0.0, 1.0 - cos_v * cos_v)) / cos_v;
+            lift = fmax(lift, r * fmin(tan_v, PS_SPLAT_SPRITE_MAX_TAN));
+        }
+        ps_vec3 centre = ps_v3_madd(pos, wo, lift);
+        /* GL sizes a sprite by its own distance: lifted, it grows by
+         * dist / (dist - lift) a side, so its colour shrinks to match. */
+        if (p->mode == PS_SPLAT_SPRITES)
+            c = ps_rgb_scale(c, ((dist - lift) / dist) * ((dist - lift) / dist));
         float rgba[4] = {(float)quantise(b, p, 0, c.r), (float)quantise(b, p, 1, c.g), (float)quantise(b, p, 2, c.b),
                          1.0f};
-        ps_vec3 centre = ps_v3_madd(pos, wo, PS_SPLAT_EYE_OFFSET * dist);
         size_t v = b->vertex_count;
         if (p->mode == PS_SPLAT_TRIANGLES) {
             /* The equilateral triangle around the disc of radius r: corners
              * at 2r, at 90, 210 and 330 degrees; the texture's unit square
-             * spans the disc's [-r, r]^2, so texcoords run 0.5 + cos, sin. */
+             * spans [-extent r, extent r]^2, so texcoords run 0.5 + cos / extent. */
+            double tex = 1.0 / p->kernel_extent;
             static const double cs[3][2] = {{0.0, 1.0}, {-0.86602540378443865, -0.5}, {0.86602540378443865, -0.5}};
             ps_vec3 x, y;
             ps_splat_basis(n, &x, &y);
@@ -165,8 +177,8 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
                 b->positions[3 * (v + k)] = (float)q.x;
                 b->positions[3 * (v + k) + 1] = (float)q.y;
                 b->positions[3 * (v + k) + 2] = (float)q.z;
-                b->texcoords[2 * (v + k)] = (float)(0.5 + cs[k][0]);
-                b->texcoords[2 * (v + k) + 1] = (float)(0.5 + cs[k][1]);
+                b->texcoords[2 * (v + k)] = (float)(0.5 + cs[k][0] * tex);
+                b->texcoords[2 * (v + k) + 1] = (float)(0.5 + cs[k][1] * tex);
                 memcpy(&b->colors[4 * (v + k)], rgba, sizeof rgba);
             }
         } else {

@@ -40,14 +40,18 @@ typedef enum ps_precision {
 const char *ps_splat_mode_name(ps_splat_mode m);
 const char *ps_precision_name(ps_precision p);
 
-/* The kernel as an alpha texture: size x size texels over the square around
- * the unit disc (texel weights are 0 outside it, so clamping to the edge adds
- * nothing), and C measured from the stored 8-bit texels, not the formula, so
- * that the texture GL draws is what is normalised. */
+/* The kernel as an alpha texture: size x size texels over the square
+ * [-extent, extent]^2 around the unit disc, extent = size / (size - 2), so
+ * that the outermost texels lie wholly outside the disc and are 0: GL clamps
+ * texture coordinates beyond the square to those edge texels, and the
+ * triangle's corners reach well beyond. C is measured from the stored 8-bit
+ * texels, not the formula, so that the texture GL draws is what is
+ * normalised. */
 typedef struct ps_kernel_texture {
     int size;
+    double extent; /* half the square's side, in units of the radius */
     uint8_t *alpha;
-    double mean; /* C */
+    double mean;   /* C */
 } ps_kernel_texture;
 
 #define PS_KERNEL_TEXTURE_SIZE 64
@@ -58,7 +62,8 @@ void ps_kernel_texture_free(ps_kernel_texture *t);
 typedef struct ps_splat_params {
     ps_splat_mode mode;
     double radius;      /* r, scene units (> 0) */
-    double kernel_mean; /* C of the kernel texture (triangles and sprites) */
+    double kernel_mean;   /* C of the kernel texture (triangles and sprites) */
+    double kernel_extent; /* its half side in radii (texture coordinates of triangles) */
     double scale;       /* exposure * N / n */
     double point_size;  /* points: their side in pixels */
     ps_precision precision;
@@ -73,6 +78,10 @@ typedef struct ps_splat_params {
 /* Splats move this fraction of their distance toward the eye so that the
  * depth test against their own surface never flickers (thesis 4.2). */
 #define PS_SPLAT_EYE_OFFSET 1e-3
+/* A sprite faces the eye, so on a surface seen at angle theta half of it
+ * would lie behind the surface; it moves r tan(theta) toward the eye instead,
+ * tan held at this much (beyond, the surface is nearly edge-on). */
+#define PS_SPLAT_SPRITE_MAX_TAN 10.0
 
 /* Vertex arrays for glDrawArrays, and the precision bookkeeping of the photons
  * that went in. The carry persists across batches of the same map (clear it

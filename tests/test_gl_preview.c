@@ -1,0 +1,289 @@
+/* test_gl_preview.c: the OpenGL preview (src/gl under OSMesa) against closed
+ * forms and the reference renderer: the direct layer of a finely tessellated
+ * plane under a point light, and the caustic layer of a mirror quad. Float
+ * colour buffers, so that what is measured is the method, not 8-bit rounding
+ * (the command-line tests cover that). */
+#include "test.h"
+
+#include <GL/osmesa.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_render.h"
+#include "photon/estimate.h"
+#include "photon/kdtree.h"
+#include "photon/tracer.h"
+#include "photon/world.h"
+#include "preview/mesh.h"
+#include "preview/splat.h"
+#include "render/render.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+typedef struct preview {
+    ps_scene *scene;
+    ps_world *world;
+    ps_tracer *tracer;
+    ps_preview_mesh mesh;
+    ps_kernel_texture kernel;
+    OSMesaContext ctx;
+    float *buffer;
+    ps_gl_renderer *gl;
+    ps_camera_frame cam;
+    int w, h;
+} preview;
+
+/* Fills *out in place: the renderer keeps a pointer to the mesh inside it. */
+static void preview_make(preview *out, const char *text, int w, int h, ps_kernel kernel)
+{
+    preview *pp = out, p;
+    memset(&p, 0, sizeof p);
+    ps_error err;
+    if (ps_scene_load_text(text, "inline.scn", "", NULL, &p.scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    assert_int_equal(ps_world_create(p.scene, NULL, &p.world, &err), PS_OK);
+    ps_tracer_options o = ps_tracer_default_options();
+    o.seed = 11;
+    assert_int_equal(ps_tracer_create(p.world, &o, &p.tracer, &err), PS_OK);
+    ps_mesh_options mo = ps_mesh_default_options(p.scene);
+    assert_int_equal(ps_preview_mesh_build(p.scene, &mo, &p.mesh, &err), PS_OK);
+    assert_int_equal(ps_kernel_texture_make(kernel, PS_KERNEL_TEXTURE_SIZE, &p.kernel, &err), PS_OK);
+    p.w = w;
+    p.h = h;
+    p.ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    assert_non_null(p.ctx);
+    p.buffer = malloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
+    assert_true(OSMesaMakeCurrent(p.ctx, p.buffer, GL_FLOAT, w, h));
+    ps_gl_options go = {true, true};
+    *pp = p;
+    assert_int_equal(ps_gl_renderer_create(pp->scene, &pp->mesh, &pp->kernel, &go, &pp->gl, &err), PS_OK);
+    pp->cam = ps_camera_frame_make(ps_scene_camera(pp->scene), w, h);
+}
+
+static void preview_free(preview *p)
+{
+    ps_gl_renderer_destroy(p->gl);
+    OSMesaDestroyContext(p->ctx);
+    free(p->buffer);
+    ps_kernel_texture_free(&p->kernel);
+    ps_preview_mesh_free(&p->mesh);
+    ps_tracer_destroy(p->tracer);
+    ps_world_destroy(p->world);
+    ps_scene_destroy(p->scene);
+}
+
+static ps_image read_back(preview *p)
+{
+    ps_image img;
+    ps_error err;
+    assert_int_equal(ps_gl_read(p->gl, &img, &err), PS_OK);
+    return img;
+}
+
+/* The reference renderer's picture of one component. */
+static ps_image reference(preview *p, ps_component c, const ps_kdtree *caustic, double radius, int spp)
+{
+    ps_light_sampler *ls;
+    ps_error err;
+    assert_int_equal(ps_light_sampler_create(p->scene, &ls, &err), PS_OK);
+    ps_render_maps maps = {caustic, NULL, NULL, NULL};
+    ps_render_options o;
+    memset(&o, 0, sizeof o);
+    o.width = p->w;
+    o.height = p->h;
+    o.spp = spp;
+    o.light_samples = 1;
+    o.seed = 1;
+    o.threads = 2;
+    o.component = c;
+    o.caustic.k = 400;
+    o.caustic.max_radius = radius;
+    o.caustic.kernel = PS_KERNEL_BOX;
+    o.global = o.caustic;
+    ps_image img;
+    ps_render_stats st;
+    assert_int_equal(ps_render(p->world, ls, &maps, &o, &img, &st, &err), PS_OK);
+    ps_light_sampler_destroy(ls);
+    return img;
+}
+
+/* The point of the plane y = 0 that pixel position (x, y) sees. */
+static bool floor_point(const ps_camera_frame *cam, double x, double y, ps_vec3 *p)
+{
+    ps_ray r = ps_camera_ray(cam, x, y);
+    if (!(r.d.y < 0))
+        return false;
+    *p = ps_ray_at(r, -r.o.y / r.d.y);
+    return true;
+}
+
+/* A point light at height 1 over a diffuse plane: GL lights in physical units
+ * give rho / pi * I h / (h^2 + x^2)^(3/2) at every pixel centre (within 2 %:
+ * Gouraud interpolation over the fine mesh), and the reference renderer's
+ * `direct` component agrees within 2 % too. The exposure scales all of it. */
+static void direct_layer_on_plane(void **state)
+{
+    (void)state;
+    const char *text = "camera eye 0 3 0.01 target 0 0 0 up 0 0 -1 fov 50\n"
+                       "material floor diffuse albedo 0.5 0.5 0.5\n"
+                       "quad corner -2 0 2 edge1 4 0 0 edge2 0 0 -4 material floor\n"
+                       "light point position 0.3 1 -0.2 power 100 100 100\n";
+    preview p;
+    preview_make(&p, text, 48, 48, PS_KERNEL_BOX);
+    const double exposure = 0.25;
+    ps_gl_begin_frame(p.gl, &p.cam, exposure, true);
+    ps_image img = read_back(&p);
+    ps_image ref = reference(&p, PS_COMPONENT_DIRECT, NULL, 0.1, 16);
+    double intensity = 100.0 / (4.0 * PS_PI), worst = 0, worst_ref = 0;
+    int n = 0;
+    for (int y = 0; y < p.h; y++)
+        for (int x = 0; x < p.w; x++) {
+            ps_vec3 q;
+            if (!floor_point(&p.cam, x + 0.5, y + 0.5, &q) || fabs(q.x) > 1.9 || fabs(q.z) > 1.9)
+                continue;
+            double dx = q.x - 0.3, dz = q.z + 0.2;
+            double expect = 0.5 * PS_INV_PI * intensity / pow(1.0 + dx * dx + dz * dz, 1.5);
+            double got = ps_image_at(&img, x, y)[1] / exposure;
+            worst = fmax(worst, fabs(got - expect) / expect);
+            double r = ps_image_at(&ref, x, y)[1];
+            worst_ref = fmax(worst_ref, fabs(got - r) / r);
+            n++;
+        }
+    printf("direct layer: %d pixels, worst %.3f %% off the analytic value, %.3f %% off photosplat-ref\n", n,
+           100 * worst, 100 * worst_ref);
+    assert_true(n > 1000);
+    assert_true(worst < 0.02);
+    assert_true(worst_ref < 0.02);
+    ps_gl_stats gs = ps_gl_get_stats(p.gl);
+    assert_int_equal(gs.virtual_lights, 1);
+    assert_int_equal(gs.shadow_maps, 6); /* a point light: the whole cube */
+    ps_image_destroy(&ref);
+    ps_image_destroy(&img);
+    preview_free(&p);
+}
+
+/* Shadow maps: a 0.2 m square at half the light's height shades a 0.4 m
+ * square of the floor. Seen from above, the square itself hides the floor
+ * within 0.12 of the centre; between 0.13 and 0.18 the floor is seen and in
+ * shadow (black in the direct layer: the depth compare is per pixel), and
+ * beyond 0.25 it is lit as if the square were not there. */
+static void shadow_of_a_square(void **state)
+{
+    (void)state;
+    const char *text = "camera eye 0 3 0.01 target 0 0 0 up 0 0 -1 fov 40\n"
+                       "material floor diffuse albedo 0.5 0.5 0.5\n"
+                       "quad corner -2 0 2 edge1 4 0 0 edge2 0 0 -4 material floor\n"
+                       "quad corner -0.1 0.5 -0.1 edge1 0.2 0 0 edge2 0 0 0.2 material floor\n"
+                       "light point position 0 1 0 power 100 100 100\n";
+    preview p;
+    preview_make(&p, text, 96, 96, PS_KERNEL_BOX);
+    ps_gl_begin_frame(p.gl, &p.cam, 1.0, true);
+    ps_image img = read_back(&p);
+    double intensity = 100.0 / (4.0 * PS_PI), worst_lit = 0, brightest_shadow = 0;
+    int lit = 0, dark = 0;
+    for (int y = 0; y < p.h; y++)
+        for (int x = 0; x < p.w; x++) {
+            ps_vec3 q;
+            if (!floor_point(&p.cam, x + 0.5, y + 0.5, &q))
+                continue;
+            double m = fmax(fabs(q.x), fabs(q.z)), got = ps_image_at(&img, x, y)[1];
+            double expect = 0.5 * PS_INV_PI * intensity / pow(1.0 + q.x * q.x + q.z * q.z, 1.5);
+            if (m > 0.13 && m < 0.18) {
+                brightest_shadow = fmax(brightest_shadow, got);
+                dark++;
+            } else if (m > 0.25 && m < 1.0) {
+                worst_lit = fmax(worst_lit, fabs(got - expect) / expect);
+                lit++;
+            }
+        }
+    printf("shadow: %d lit pixels within %.3f %% of the unshadowed value; %d shadowed pixels, brightest %.4g\n", lit,
+           100 * worst_lit, dark, brightest_shadow);
+    assert_true(lit > 500 && dark > 20);
+    assert_true(worst_lit < 0.02);
+    assert_true(brightest_shadow == 0.0);
+    ps_image_destroy(&img);
+    preview_free(&p);
+}
+
+/* The caustic of a mirror quad: light at height 1, mirror 1 above it, so the
+ * floor sees the mirror image of the source at height 3 (reflectance 1):
+ * L = rho / pi * I * 3 / (9 + x^2)^(3/2). Triangle splats of the caustic map
+ * within 5 % of it away from the lit square's edges, and within 5 % of the
+ * reference renderer's `caustic` component, for two kernels. */
+static void caustic_layer_mirror_quad(void **state)
+{
+    (void)state;
+    const char *text = "camera eye 0 1.5 3 target 0 0 0 fov 40\n"
+                       "material floor diffuse albedo 0.5 0.5 0.5\n"
+                       "material mirror mirror reflectance 1 1 1\n"
+                       "quad corner -20 0 20 edge1 40 0 0 edge2 0 0 -40 material floor\n"
+                       "quad corner -0.5 2 -0.5 edge1 1 0 0 edge2 0 0 1 material mirror\n"
+                       "light point position 0 1 0 power 100 100 100\n";
+    const uint64_t photons = 400000;
+    const double radius = 0.15, exposure = 2.0;
+    ps_kernel kernels[2] = {PS_KERNEL_BOX, PS_KERNEL_EPANECHNIKOV};
+    for (int kk = 0; kk < 2; kk++) {
+        preview p;
+        preview_make(&p, text, 40, 40, kernels[kk]);
+        ps_photon_map m;
+        ps_photon_map_init(&m, PS_MAP_CAUSTIC);
+        ps_error err;
+        assert_int_equal(ps_tracer_trace(p.tracer, PS_MAP_CAUSTIC, 0, photons, photons, &m, &err), PS_OK);
+        size_t nmat;
+        ps_splat_params sp;
+        memset(&sp, 0, sizeof sp);
+        sp.mode = PS_SPLAT_TRIANGLES;
+        sp.radius = radius;
+        sp.kernel_mean = p.kernel.mean;
+        sp.kernel_extent = p.kernel.extent;
+        sp.scale = exposure;
+        sp.precision = PS_PRECISION_NONE;
+        sp.materials = ps_scene_materials(p.scene, &nmat);
+        sp.cam = p.cam;
+        ps_splat_batch b;
+        ps_splat_batch_init(&b);
+        assert_int_equal(ps_splat_build(m.photons, m.materials, m.count, &sp, &b, &err), PS_OK);
+        ps_gl_begin_frame(p.gl, &p.cam, exposure, false);
+        ps_gl_draw_splats(p.gl, &b, PS_SPLAT_TRIANGLES, radius, 1.0);
+        ps_image img = read_back(&p);
+        ps_kdtree *tree;
+        assert_int_equal(ps_kdtree_build(m.photons, m.count, &tree, &err), PS_OK);
+        ps_image ref = reference(&p, PS_COMPONENT_CAUSTIC, tree, radius, 4);
+        double intensity = 100.0 / (4.0 * PS_PI), worst = 0, sum = 0, sum_ref = 0;
+        int n = 0;
+        for (int y = 0; y < p.h; y++)
+            for (int x = 0; x < p.w; x++) {
+                ps_vec3 q;
+                if (!floor_point(&p.cam, x + 0.5, y + 0.5, &q) || fabs(q.x) > 1.2 || fabs(q.z) > 1.2)
+                    continue;
+                double expect = 0.5 * PS_INV_PI * intensity * 3.0 / pow(9.0 + q.x * q.x + q.z * q.z, 1.5);
+                double got = ps_image_at(&img, x, y)[1] / exposure;
+                worst = fmax(worst, fabs(got - expect) / expect);
+                sum += got / expect;
+                sum_ref += got / ps_image_at(&ref, x, y)[1];
+                n++;
+            }
+        printf("caustic layer (%s kernel): %d pixels, worst %.2f %% off the analytic value; mean ratio to it %.4f, "
+               "to photosplat-ref %.4f\n",
+               ps_kernel_name(kernels[kk]), n, 100 * worst, sum / n, sum_ref / n);
+        assert_true(n > 100);
+        assert_true(worst < 0.05);
+        assert_near(sum_ref / n, 1.0, 0.05);
+        ps_kdtree_destroy(tree);
+        ps_image_destroy(&ref);
+        ps_image_destroy(&img);
+        ps_splat_batch_free(&b);
+        ps_photon_map_free(&m);
+        preview_free(&p);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(direct_layer_on_plane),
+        cmocka_unit_test(shadow_of_a_square),
+        cmocka_unit_test(caustic_layer_mirror_quad),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
