@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# cli_snap.sh BIN_DIR: photosplat-snap from the outside: options and bad
+# input, golden pictures of the default scene, the same bytes for any number
+# of llvmpipe threads, progressive mode, the contract's --stats keys, and the
+# 8-bit precision stress (thesis 5.1): a caustic of millions of faint photons
+# that plain 8-bit loses, error diffusion keeps and the counter stops.
+set -u
+cd "$(dirname "$0")/.."
+bin=${1:-bin}
+. tests/cli_lib.sh
+snap=$bin/photosplat-snap
+scene=data/scenes/cornell-caustic.scn
+mirror=tests/data/good/mirror-caustic.scn
+small=(--size 48x48 --caustic-photons 20000 --global-photons 5000)
+# Image means from photosplat-compare's report of an image against itself.
+mean_of() { "$bin/photosplat-compare" "$1" "$1" | sed -n 's/.*mean_a=\([^ ]*\).*/\1/p'; }
+# awk_true EXPR: exit status 0 when the awk expression holds.
+awk_true() { awk "BEGIN { exit !($1) }"; }
+
+expect_success "--help" "$snap" --help
+expect_match "--help text" "$cli_out" '^usage: photosplat-snap SCENE'
+expect_usage_error "no arguments" "$snap"
+expect_usage_error "nothing to write" "$snap" "$scene"
+expect_usage_error "unknown option" "$snap" "$scene" -o "$cli_tmp/x.png" --frobnicate
+expect_usage_error "bad splat" "$snap" "$scene" -o "$cli_tmp/x.png" --splat quads
+expect_usage_error "bad kernel" "$snap" "$scene" -o "$cli_tmp/x.png" --kernel triangle
+expect_usage_error "bad layer" "$snap" "$scene" -o "$cli_tmp/x.png" --layers direct,glow
+expect_usage_error "empty layer" "$snap" "$scene" -o "$cli_tmp/x.png" --layers direct,
+expect_usage_error "bad depth" "$snap" "$scene" -o "$cli_tmp/x.png" --color-depth 16
+expect_usage_error "bad precision" "$snap" "$scene" -o "$cli_tmp/x.png" --precision dither
+expect_usage_error "zero tau" "$snap" "$scene" -o "$cli_tmp/x.png" --tau 0
+expect_usage_error "bad size" "$snap" "$scene" -o "$cli_tmp/x.png" --size 0x4
+expect_usage_error "missing scene" "$snap" "$cli_tmp/none.scn" -o "$cli_tmp/x.png"
+expect_match "names the file" "$cli_err" 'none\.scn'
+expect_usage_error "bad scene" "$snap" tests/data/bad/$(ls tests/data/bad | head -1) -o "$cli_tmp/x.png"
+expect_usage_error "unwritable png" "$snap" "$scene" "${small[@]}" -o /nonexistent/dir/x.png
+[ ! -e "$cli_tmp/x.png" ] && ok || bad "a failed run left x.png behind"
+
+# A run: PNG and PFM of the right size, the contract's stats keys.
+expect_success "snapshot" "$snap" "$scene" "${small[@]}" -o "$cli_tmp/s.png" --hdr "$cli_tmp/s.pfm" \
+    --stats "$cli_tmp/s.json" --dump-photons "$cli_tmp/s.txt"
+[ "$(head -c 8 "$cli_tmp/s.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a ] && ok || bad "s.png is not a PNG"
+[ "$(head -2 "$cli_tmp/s.pfm" | tr '\n' ' ')" = "PF 48 48 " ] && ok || bad "s.pfm is not a 48x48 PFM"
+for key in emitted_caustic emitted_global stored_caustic stored_global trace_seconds splat_seconds frames \
+    photons_per_second rays_traced rays_per_second skipped; do
+    grep -q "\"$key\":" "$cli_tmp/s.json" && ok || bad "stats lack $key"
+done
+grep -q '"emitted_caustic": 20000,' "$cli_tmp/s.json" && ok || bad "not 20000 caustic photons"
+[ "$(grep -c '^caustic ' "$cli_tmp/s.txt")" = "$(sed -n 's/.*"stored_caustic": \([0-9]*\).*/\1/p' "$cli_tmp/s.json")" ] &&
+    ok || bad "the dump and the stats disagree on the caustic photons"
+
+# Layers: one that is off is not traced and says so; the others still occlude.
+expect_success "direct only" "$snap" "$scene" "${small[@]}" --layers direct -o "$cli_tmp/d.png" --stats "$cli_tmp/d.json"
+grep -q '"pass": "caustic", "reason": "layer not shown (--layers)"' "$cli_tmp/d.json" && ok || bad "no skip for the caustic layer"
+grep -q '"emitted_caustic": 0,' "$cli_tmp/d.json" && ok || bad "a hidden layer's photons were traced"
+
+# Golden pictures (scripts/regen-golden.sh remakes them, on purpose only).
+# llvmpipe is deterministic, so the tolerance only absorbs rounding: an RMSE
+# of 2 codes in 255 on the stored values.
+for mode in triangles points; do
+    golden=tests/data/golden/cornell-caustic-snap-$mode
+    # shellcheck disable=SC2046
+    expect_success "golden $mode" "$snap" $(cut -d" " -f2- "$golden.args") -o "$cli_tmp/g-$mode.png"
+    rmse=$("$bin/photosplat-compare" "$cli_tmp/g-$mode.png" "$golden.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
+    awk_true "$rmse < 2.0 / 255" && ok || bad "$mode picture moved from the golden one: rmse $rmse"
+done
+# ... and the tolerance is tighter than the difference between the modes.
+rmse=$("$bin/photosplat-compare" "$cli_tmp/g-points.png" "$cli_tmp/g-triangles.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
+awk_true "$rmse > 4.0 / 255" && ok || bad "points and triangles are within the golden tolerance of each other"
+
+# The same bytes for any number of llvmpipe threads.
+for n in 1 2 3; do
+    expect_success "LP_NUM_THREADS=$n" env LP_NUM_THREADS=$n "$snap" "$scene" "${small[@]}" -o "$cli_tmp/lp$n.png"
+done
+cmp -s "$cli_tmp/lp1.png" "$cli_tmp/lp2.png" && cmp -s "$cli_tmp/lp1.png" "$cli_tmp/lp3.png" && ok ||
+    bad "the picture depends on LP_NUM_THREADS"
+
+# Progressive mode: several refreshes, photons up to the cap at most.
+expect_success "progressive" "$snap" "$scene" --size 32x32 --time 0.6 --tau 0.1 --caustic-photons 400000 \
+    --global-photons 100000 -o "$cli_tmp/p.png" --stats "$cli_tmp/p.json"
+frames=$(sed -n 's/.*"frames": \([0-9]*\).*/\1/p' "$cli_tmp/p.json")
+awk_true "$frames >= 2" && ok || bad "progressive mode refreshed $frames times in 0.6 s at tau 0.1"
+grep -q '"first_frame_seconds":' "$cli_tmp/p.json" && ok || bad "no first_frame_seconds"
+
+# The precision stress: a caustic of many faint photons (points, so that each
+# photon is one exact colour), with an exposure that keeps each photon under
+# half a code of the 8-bit buffer. The release build takes 5 million photons;
+# the sanitizer build a tenth, as faint.
+if [[ $bin == *asan* ]]; then n=500000 exposure=0.2; else n=5000000 exposure=2; fi
+stress=("$mirror" --layers caustic --splat points --caustic-photons $n --exposure $exposure)
+expect_success "stress float" "$snap" "${stress[@]}" --color-depth float --hdr "$cli_tmp/f.pfm"
+expect_success "stress none" "$snap" "${stress[@]}" --precision none --hdr "$cli_tmp/n.pfm"
+expect_success "stress diffusion" "$snap" "${stress[@]}" --precision diffusion --hdr "$cli_tmp/e.pfm"
+mf=$(mean_of "$cli_tmp/f.pfm") mn=$(mean_of "$cli_tmp/n.pfm") me=$(mean_of "$cli_tmp/e.pfm")
+echo "precision stress, $n photons: mean radiance float $mf, 8-bit none $mn, 8-bit diffusion $me"
+awk_true "$mf > 0.05" && ok || bad "the float caustic is dark ($mf)"
+awk_true "$mn < 0.1 * $mf" && ok || bad "plain 8-bit kept the caustic ($mn of $mf): the stress is not faint enough"
+awk_true "($me - $mf)^2 < (0.02 * $mf)^2" && ok || bad "error diffusion's mean $me is not within 2 % of the float buffer's $mf"
+# The counter, shooting progressively, stops once a refresh rounds too much away.
+expect_success "stress counter" "$snap" "${stress[@]}" --precision counter --time 60 --tau 0.05 \
+    --hdr "$cli_tmp/c.pfm" --stats "$cli_tmp/c.json"
+expect_match "counter says why" "$cli_out" 'error counter: stopped shooting at [0-9]+ photons'
+grep -q '"counter_stopped": 1,' "$cli_tmp/c.json" && ok || bad "stats do not say the counter stopped"
+emitted=$(sed -n 's/.*"emitted_caustic": \([0-9]*\).*/\1/p' "$cli_tmp/c.json")
+awk_true "$emitted < $n" && ok || bad "the counter let all $emitted photons through"
+
+cli_summary
