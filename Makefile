@@ -85,7 +85,7 @@ build/$(1)/bin/photosplat-%: build/$(1)/obj/app/%_main.o $$(LIB_$(1))
 build/$(1)/tests/%: tests/%.c $$(LIB_$(1))
 	@mkdir -p $$(@D)
 	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc -Itests $$(TEST_CFLAGS) -MMD -MP $$< -o $$@ $$(LDOPT_$(1)) $$(LIB_$(1)) $$(TEST_LIBS) $$(LIBS)
--include $$(OBJ_$(1):.o=.d) $$(GLOBJ_$(1):.o=.d) $$(patsubst %,build/$(1)/tests/%.d,$$(TESTS))
+-include $$(OBJ_$(1):.o=.d) $$(GLOBJ_$(1):.o=.d) $$(patsubst src/%.c,build/$(1)/obj/%.d,$$(MAINS)) $$(patsubst %,build/$(1)/tests/%.d,$$(TESTS))
 endef
 $(eval $(call variant-rules,release))
 $(eval $(call variant-rules,asan))
@@ -135,6 +135,11 @@ EMBREE_LIBS = $(if $(filter pc,$(EMBREE_HOW)),$(shell pkg-config --libs embree3)
 build/release/bench/%: bench/%.c $(LIB_release)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) -O2 -g -Isrc -Ibench $(EMBREE_CFLAGS) -MMD -MP $< -o $@ $(LIB_release) $(EMBREE_LIBS) $(LIBS)
+# GL benches (bench/bench_gl*.c) draw with OSMesa and the GL library.
+GL_BENCHES := $(patsubst bench/%.c,build/release/bench/%,$(wildcard bench/bench_gl*.c))
+$(GL_BENCHES): build/release/bench/%: bench/%.c $(GLLIB_release) $(LIB_release)
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(WARN) -O2 -g -Isrc -Ibench $(OSMESA_CFLAGS) -MMD -MP $< -o $@ $(GLLIB_release) $(LIB_release) $(OSMESA_LIBS) $(LIBS)
 -include $(BENCHES:=.d)
 
 .PHONY: build-bench

@@ -310,7 +310,8 @@ static rig rig_file(const char *path, const ps_tracer_options *opt)
 static bool maps_equal(const ps_photon_map *a, const ps_photon_map *b)
 {
     return a->count == b->count && memcmp(a->photons, b->photons, a->count * sizeof *a->photons) == 0 &&
-           (a->count == 0 || memcmp(a->materials, b->materials, a->count * sizeof *a->materials) == 0);
+           (a->count == 0 || (memcmp(a->materials, b->materials, a->count * sizeof *a->materials) == 0 &&
+                              memcmp(a->objects, b->objects, a->count * sizeof *a->objects) == 0));
 }
 
 /* Photon i depends on (scene, seed, i) only: 1, 2 and 5 threads, and one
@@ -460,8 +461,9 @@ static void skips(void **state)
     rig_free(&r);
 }
 
-/* Each photon's material is that of the surface it landed on: in a box whose
- * walls each have their own material, the wall a photon lies on tells it. */
+/* Each photon's material and object are those of the surface it landed on:
+ * in a box whose walls each have their own material, the wall a photon lies
+ * on tells both. */
 static void photon_materials(void **state)
 {
     (void)state;
@@ -486,6 +488,7 @@ static void photon_materials(void **state)
             int expect = fabsf(p[1]) < 1e-4f ? 0 : fabsf(p[1] - 2.0f) < 1e-4f ? 1 : fabsf(p[0] + 1.0f) < 1e-4f ? 2 : -1;
             assert_true(expect >= 0); /* only the three walls store */
             assert_int_equal(m.materials[i], expect);
+            assert_int_equal(m.objects[i], expect); /* the walls are objects 0, 1, 2 too */
             seen[expect]++;
         }
         ps_photon_map_free(&m);

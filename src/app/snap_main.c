@@ -62,6 +62,7 @@ static const char usage[] =
     "  --counter-threshold F    counter: stop when this fraction rounds away (default 0.1)\n"
     "  --point-size N           points: side in pixels (default 1)\n"
     "  --shadows on|off         shadow maps for the direct layer (default on)\n"
+    "  --stencil-clip on|off    clip each object's splats to its pixels (default on)\n"
     "  --help                   this text\n";
 
 typedef struct snap_options {
@@ -71,7 +72,7 @@ typedef struct snap_options {
     int width, height;
     double exposure, time, tau, counter_threshold, point_size;
     int64_t seed, threads;
-    int splat, kernel, color_depth, precision, shadows;
+    int splat, kernel, color_depth, precision, shadows, stencil_clip;
     unsigned layers;
 } snap_options;
 
@@ -127,6 +128,7 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
     o->kernel = PS_KERNEL_CONE;
     o->precision = PS_PRECISION_DIFFUSION;
     o->shadows = 1;
+    o->stencil_clip = 1;
     o->layers = LAYER_ALL;
     ps_status st = PS_OK;
     const char *layers;
@@ -181,6 +183,8 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
             st = ps_cli_double(&cli, 1.0, 64.0, &o->point_size, err);
         } else if (ps_cli_is(&cli, "--shadows")) {
             st = ps_cli_choice(&cli, on_off, &o->shadows, err);
+        } else if (ps_cli_is(&cli, "--stencil-clip")) {
+            st = ps_cli_choice(&cli, on_off, &o->stencil_clip, err);
         } else if (ps_cli_is(&cli, "--layers")) {
             st = ps_cli_string(&cli, &layers, err);
             if (st == PS_OK)
@@ -219,18 +223,8 @@ static ps_status feed_batch(feed *f, int k, uint64_t first, uint64_t count, ps_e
     ps_photon_map_init(&local, (ps_map_kind)k);
     ps_status st = ps_tracer_trace(f->tracer, (ps_map_kind)k, first, count, f->cap[k], &local, err);
     pthread_mutex_lock(&f->lock);
-    ps_photon_map *m = &f->maps[k];
-    if (st == PS_OK && (!PS_RESERVE(m->photons, m->cap, m->count + local.count) ||
-                        !PS_RESERVE(m->materials, m->mcap, m->count + local.count)))
+    if (st == PS_OK && !ps_photon_map_append(&f->maps[k], &local))
         st = ps_error_set(err, PS_ERR_NOMEM, "photosplat-snap: out of memory for photons");
-    if (st == PS_OK) {
-        memcpy(m->photons + m->count, local.photons, local.count * sizeof *m->photons);
-        memcpy(m->materials + m->count, local.materials, local.count * sizeof *m->materials);
-        m->count += local.count;
-        ps_trace_counters *a = &m->counters, *b = &local.counters;
-        a->emitted += b->emitted, a->stored += b->stored, a->rays += b->rays, a->escaped += b->escaped;
-        a->absorbed += b->absorbed, a->discarded += b->discarded, a->truncated += b->truncated, a->empty += b->empty;
-    }
     pthread_mutex_unlock(&f->lock);
     ps_photon_map_free(&local);
     return st;
@@ -325,6 +319,7 @@ static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
         p.precision = (ps_precision)o->precision;
         p.levels = o->color_depth == 0 ? 255 : 0;
         p.materials = materials;
+        p.objects = o->stencil_clip ? m->objects : NULL;
         p.cam = s->cam;
         ps_status st = ps_splat_build(m->photons, m->materials, m->count, &p, b, err);
         if (st != PS_OK)

@@ -248,8 +248,9 @@ static ps_status build_lights(ps_gl_renderer *r, ps_error *err)
 
 /* ---- drawing the mesh ----------------------------------------------------- */
 
-/* The exposure is in the lights' intensities, not here. */
-static void draw_mesh(const ps_gl_renderer *r, bool with_materials)
+/* The exposure is in the lights' intensities, not here. With `stencil`,
+ * each object writes its stencil value (ps_splat_stencil). */
+static void draw_mesh_stencil(const ps_gl_renderer *r, bool with_materials, bool stencil)
 {
     const ps_preview_mesh *m = r->mesh;
     glEnableClientState(GL_VERTEX_ARRAY);
@@ -280,11 +281,15 @@ static void draw_mesh(const ps_gl_renderer *r, bool with_materials)
             glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, specular);
             glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, shininess);
         }
+        if (stencil)
+            glStencilFunc(GL_ALWAYS, (GLint)ps_splat_stencil(rg->object), 0xff);
         glDrawArrays(GL_TRIANGLES, (GLint)rg->first, (GLsizei)rg->count);
     }
     glDisableClientState(GL_NORMAL_ARRAY);
     glDisableClientState(GL_VERTEX_ARRAY);
 }
+
+static void draw_mesh(const ps_gl_renderer *r, bool with_materials) { draw_mesh_stencil(r, with_materials, false); }
 
 /* Emissive faces (MTL Ke) as their own radiance, front side only. */
 static void draw_emission(const ps_gl_renderer *r, double exposure)
@@ -487,6 +492,10 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
     glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
     glClearColor(0, 0, 0, 0);
     glClearDepth(1.0);
+    /* glClear obeys the write masks, which the last frame's splats left off. */
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    glStencilMask(0xff);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
 
     double nearest, farthest;
@@ -508,7 +517,12 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(PREPASS_OFFSET, PREPASS_OFFSET);
-    draw_mesh(r, false);
+    /* Each visible pixel keeps its object's stencil value, for clipping splats. */
+    glEnable(GL_STENCIL_TEST);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+    glStencilMask(0xff);
+    draw_mesh_stencil(r, false, true);
+    glDisable(GL_STENCIL_TEST);
     glDisable(GL_POLYGON_OFFSET_FILL);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     if (!direct)
@@ -520,6 +534,29 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
     glBlendFunc(GL_ONE, GL_ONE);
     draw_direct(r, exposure);
     glDisable(GL_BLEND);
+}
+
+/* The batch's primitives; grouped, each group only where its object shows
+ * (the stencil test), else all at once. */
+static void draw_groups(const ps_splat_batch *b, GLenum prim)
+{
+    if (!b->grouped) {
+        glDrawArrays(prim, 0, (GLsizei)b->vertex_count);
+        return;
+    }
+    glEnable(GL_STENCIL_TEST);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    for (int g = 0; g < PS_SPLAT_GROUPS; g++) {
+        size_t first = b->group_first[g], n = b->group_first[g + 1] - first;
+        if (n == 0)
+            continue;
+        if (g == 0)
+            glStencilFunc(GL_ALWAYS, 0, 0xff);
+        else
+            glStencilFunc(GL_EQUAL, g, 0xff);
+        glDrawArrays(prim, (GLint)first, (GLsizei)n);
+    }
+    glDisable(GL_STENCIL_TEST);
 }
 
 void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode mode, double radius,
@@ -543,7 +580,7 @@ void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode
     if (mode == PS_SPLAT_POINTS) {
         glBlendFunc(GL_ONE, GL_ONE);
         glPointSize((GLfloat)point_size);
-        glDrawArrays(GL_POINTS, 0, (GLsizei)b->vertex_count);
+        draw_groups(b, GL_POINTS);
     } else {
         glEnable(GL_TEXTURE_2D);
         glBindTexture(GL_TEXTURE_2D, r->kernel_tex);
@@ -554,7 +591,7 @@ void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode
             glTexCoordPointer(2, GL_FLOAT, 0, b->texcoords);
             glEnable(GL_POLYGON_OFFSET_FILL);
             glPolygonOffset(SPLAT_OFFSET, SPLAT_OFFSET);
-            glDrawArrays(GL_TRIANGLES, 0, (GLsizei)b->vertex_count);
+            draw_groups(b, GL_TRIANGLES);
             glDisable(GL_POLYGON_OFFSET_FILL);
             glDisableClientState(GL_TEXTURE_COORD_ARRAY);
         } else {
@@ -571,7 +608,7 @@ void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode
             glEnable(GL_POINT_SPRITE);
             glTexEnvi(GL_POINT_SPRITE, GL_COORD_REPLACE, GL_TRUE);
             glPointSize((GLfloat)(2.0 * r->kernel_extent * radius * focal));
-            glDrawArrays(GL_POINTS, 0, (GLsizei)b->vertex_count);
+            draw_groups(b, GL_POINTS);
             glTexEnvi(GL_POINT_SPRITE, GL_COORD_REPLACE, GL_FALSE);
             glDisable(GL_POINT_SPRITE);
             const GLfloat none[3] = {1.0f, 0.0f, 0.0f};

@@ -75,7 +75,41 @@ void ps_photon_map_free(ps_photon_map *m)
     ps_map_kind kind = m->kind;
     free(m->photons);
     free(m->materials);
+    free(m->objects);
     ps_photon_map_init(m, kind);
+}
+
+static void add_counters(ps_trace_counters *a, const ps_trace_counters *b)
+{
+    a->emitted += b->emitted;
+    a->stored += b->stored;
+    a->rays += b->rays;
+    a->escaped += b->escaped;
+    a->absorbed += b->absorbed;
+    a->discarded += b->discarded;
+    a->truncated += b->truncated;
+    a->empty += b->empty;
+}
+
+/* Room for `need` photons in every array of m. */
+static bool reserve_map(ps_photon_map *m, size_t need)
+{
+    return PS_RESERVE(m->photons, m->cap, need) && PS_RESERVE(m->materials, m->mcap, need) &&
+           PS_RESERVE(m->objects, m->ocap, need);
+}
+
+bool ps_photon_map_append(ps_photon_map *dst, const ps_photon_map *src)
+{
+    if (!reserve_map(dst, dst->count + src->count))
+        return false;
+    if (src->count) {
+        memcpy(dst->photons + dst->count, src->photons, src->count * sizeof *dst->photons);
+        memcpy(dst->materials + dst->count, src->materials, src->count * sizeof *dst->materials);
+        memcpy(dst->objects + dst->count, src->objects, src->count * sizeof *dst->objects);
+    }
+    dst->count += src->count;
+    add_counters(&dst->counters, &src->counters);
+    return true;
 }
 
 ps_rgb ps_photon_map_power(const ps_photon_map *m)
@@ -403,7 +437,8 @@ uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light,
 typedef struct chunk_out {
     ps_photon *photons;
     uint16_t *materials; /* parallel to photons */
-    size_t count, cap, mcap;
+    uint32_t *objects;   /* parallel to photons */
+    size_t count, cap, mcap, ocap;
     ps_trace_counters c;
     bool failed;
 } chunk_out;
@@ -411,11 +446,13 @@ typedef struct chunk_out {
 static void store(chunk_out *out, const ps_surface *sp, ps_rgb power, ps_vec3 d, ps_vec3 n, double dither)
 {
     if (!PS_RESERVE(out->photons, out->cap, out->count + 1) ||
-        !PS_RESERVE(out->materials, out->mcap, out->count + 1)) {
+        !PS_RESERVE(out->materials, out->mcap, out->count + 1) ||
+        !PS_RESERVE(out->objects, out->ocap, out->count + 1)) {
         out->failed = true;
         return;
     }
     out->materials[out->count] = (uint16_t)sp->material;
+    out->objects[out->count] = sp->object;
     out->photons[out->count++] = ps_photon_pack(sp->p, power, d, n, dither);
     out->c.stored++;
 }
@@ -574,18 +611,6 @@ static void *worker(void *arg)
     }
 }
 
-static void add_counters(ps_trace_counters *a, const ps_trace_counters *b)
-{
-    a->emitted += b->emitted;
-    a->stored += b->stored;
-    a->rays += b->rays;
-    a->escaped += b->escaped;
-    a->absorbed += b->absorbed;
-    a->discarded += b->discarded;
-    a->truncated += b->truncated;
-    a->empty += b->empty;
-}
-
 ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
                           ps_photon_map *m, ps_error *err)
 {
@@ -628,18 +653,20 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
             st = PS_ERR_NOMEM;
         need += job.outs[k].count;
     }
-    if (st == PS_OK && (!PS_RESERVE(m->photons, m->cap, need) || !PS_RESERVE(m->materials, m->mcap, need)))
+    if (st == PS_OK && !reserve_map(m, need))
         st = PS_ERR_NOMEM;
     for (size_t k = 0; k < job.chunks; k++) {
         if (st == PS_OK && job.outs[k].count) {
             memcpy(m->photons + m->count, job.outs[k].photons, job.outs[k].count * sizeof *m->photons);
             memcpy(m->materials + m->count, job.outs[k].materials, job.outs[k].count * sizeof *m->materials);
+            memcpy(m->objects + m->count, job.outs[k].objects, job.outs[k].count * sizeof *m->objects);
             m->count += job.outs[k].count;
         }
         if (st == PS_OK)
             add_counters(&m->counters, &job.outs[k].c);
         free(job.outs[k].photons);
         free(job.outs[k].materials);
+        free(job.outs[k].objects);
     }
     free(job.outs);
     if (st != PS_OK)

@@ -68,19 +68,24 @@ typedef struct ps_trace_counters {
     uint64_t empty;            /* emitted samples that carried no power (outside a spot or behind a light) */
 } ps_trace_counters;
 
-/* The photons of one map, in index order, and beside each the material of
- * the surface it landed on (the splats need its BRDF; the 20-byte record has
- * no room, and the kd-tree does not need it: a query knows its surface). */
+/* The photons of one map, in index order, and beside each the material and
+ * object of the surface it landed on (the splats need the BRDF there and clip
+ * to the object's pixels; the 20-byte record has no room, and the kd-tree
+ * does not need them: a query knows its own surface). */
 typedef struct ps_photon_map {
     ps_map_kind kind;
     ps_photon *photons;
     uint16_t *materials;
-    size_t count, cap, mcap;
+    uint32_t *objects;
+    size_t count, cap, mcap, ocap;
     ps_trace_counters counters;
 } ps_photon_map;
 
 void ps_photon_map_init(ps_photon_map *m, ps_map_kind kind);
 void ps_photon_map_free(ps_photon_map *m); /* and reset to empty */
+/* Appends src's photons (with their materials and objects) and counters to
+ * dst; false, with dst unchanged, when out of memory. */
+bool ps_photon_map_append(ps_photon_map *dst, const ps_photon_map *src);
 /* Total power of all photons in the map. */
 ps_rgb ps_photon_map_power(const ps_photon_map *m);
 

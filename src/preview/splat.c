@@ -62,6 +62,7 @@ void ps_splat_batch_free(ps_splat_batch *b)
     free(b->positions);
     free(b->colors);
     free(b->texcoords);
+    free(b->group);
     memset(b, 0, sizeof *b);
 }
 
@@ -69,6 +70,47 @@ void ps_splat_batch_clear(ps_splat_batch *b)
 {
     b->vertex_count = 0;
     b->splats = 0;
+    b->grouped = false;
+}
+
+/* Reorders the splats [first, splats) by stencil value (a stable counting
+ * sort, so error diffusion's order within a group is kept) and records where
+ * each group starts. */
+static bool group_splats(ps_splat_batch *b, size_t first, size_t per)
+{
+    size_t n = b->splats - first;
+    size_t count[PS_SPLAT_GROUPS + 1] = {0};
+    for (size_t i = 0; i < n; i++)
+        count[b->group[first + i] + 1]++;
+    for (int g = 0; g < PS_SPLAT_GROUPS; g++)
+        count[g + 1] += count[g];
+    float *pos = malloc(n * per * 3 * sizeof *pos), *col = malloc(n * per * 4 * sizeof *col);
+    float *tex = per == 3 ? malloc(n * per * 2 * sizeof *tex) : NULL;
+    if (!pos || !col || (per == 3 && !tex)) {
+        free(pos), free(col), free(tex);
+        return false;
+    }
+    size_t v0 = first * per;
+    memcpy(pos, b->positions + 3 * v0, n * per * 3 * sizeof *pos);
+    memcpy(col, b->colors + 4 * v0, n * per * 4 * sizeof *col);
+    if (tex)
+        memcpy(tex, b->texcoords + 2 * v0, n * per * 2 * sizeof *tex);
+    size_t next[PS_SPLAT_GROUPS];
+    for (int g = 0; g < PS_SPLAT_GROUPS; g++) {
+        next[g] = count[g];
+        b->group_first[g] = v0 + count[g] * per;
+    }
+    b->group_first[PS_SPLAT_GROUPS] = v0 + n * per;
+    for (size_t i = 0; i < n; i++) {
+        size_t to = v0 + next[b->group[first + i]]++ * per, from = i * per;
+        memcpy(b->positions + 3 * to, pos + 3 * from, per * 3 * sizeof *pos);
+        memcpy(b->colors + 4 * to, col + 4 * from, per * 4 * sizeof *col);
+        if (tex)
+            memcpy(b->texcoords + 2 * to, tex + 2 * from, per * 2 * sizeof *tex);
+    }
+    free(pos), free(col), free(tex);
+    b->grouped = true;
+    return true;
 }
 
 void ps_splat_basis(ps_vec3 n, ps_vec3 *x, ps_vec3 *y)
@@ -113,8 +155,10 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
     if (count > (SIZE_MAX / 4 - b->vertex_count) / per ||
         !PS_RESERVE(b->positions, b->cap_pos, 3 * (b->vertex_count + per * count)) ||
         !PS_RESERVE(b->colors, b->cap_col, 4 * (b->vertex_count + per * count)) ||
-        (per == 3 && !PS_RESERVE(b->texcoords, b->cap_tex, 2 * (b->vertex_count + per * count))))
+        (per == 3 && !PS_RESERVE(b->texcoords, b->cap_tex, 2 * (b->vertex_count + per * count))) ||
+        (p->objects && !PS_RESERVE(b->group, b->cap_group, b->splats + count)))
         return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
+    size_t first_splat = b->splats;
     const ps_camera_frame *cam = &p->cam;
     double r = p->radius;
     double disc = 1.0 / (p->kernel_mean * PS_PI * r * r);
@@ -187,8 +231,12 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
             b->positions[3 * v + 2] = (float)centre.z;
             memcpy(&b->colors[4 * v], rgba, sizeof rgba);
         }
+        if (p->objects)
+            b->group[b->splats] = (uint8_t)ps_splat_stencil(p->objects[i]);
         b->vertex_count += per;
         b->splats++;
     }
+    if (p->objects && !group_splats(b, first_splat, per))
+        return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory grouping %zu photons", count);
     return PS_OK;
 }

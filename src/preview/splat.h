@@ -69,8 +69,20 @@ typedef struct ps_splat_params {
     ps_precision precision;
     int levels;         /* the colour buffer's steps per unit: 255 for 8 bits, 0 for float */
     const ps_material *materials; /* the scene's, indexed by the photons' material ids */
+    /* The photons' object ids, or NULL. Given, the splats come out grouped by
+     * stencil value (ps_splat_stencil) so that GL can clip each object's
+     * splats to that object's pixels: the cure for photon haze (thesis 5.2),
+     * where a flat splat on a curved or cornered surface would show on
+     * whatever lies behind its edge. */
+    const uint32_t *objects;
     ps_camera_frame cam;
 } ps_splat_params;
+
+/* Stencil values 1..255 stand for objects (0 is "no object"); with more than
+ * 255 objects some share a value, and clipping then only keeps a splat to
+ * either of them. */
+#define PS_SPLAT_GROUPS 256
+static inline unsigned ps_splat_stencil(uint32_t object) { return object % (PS_SPLAT_GROUPS - 1) + 1; }
 
 /* Points: at grazing view the footprint 1 / cos grows without bound; past
  * this cosine it is held (a bias only where a surface is seen edge-on). */
@@ -93,6 +105,12 @@ typedef struct ps_splat_batch {
     float *texcoords;    /* uv (triangles only) */
     size_t cap_pos, cap_col, cap_tex;
     size_t splats;       /* photons drawn (those facing the eye) */
+    /* With objects given: vertices [group_first[g], group_first[g + 1]) carry
+     * stencil value g (valid for the splats of the last build call). */
+    bool grouped;
+    size_t group_first[PS_SPLAT_GROUPS + 1];
+    uint8_t *group;      /* scratch: each splat's stencil value */
+    size_t cap_group;
     double carry[3];     /* diffusion: round-off not yet added */
     double wanted, lost; /* counter: colour asked for, and what rounding took (summed over channels) */
 } ps_splat_batch;
