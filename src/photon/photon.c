@@ -2,10 +2,12 @@
 #include "photon/photon.h"
 
 #include <math.h>
+#include <string.h>
 
 /* RGBE exponents are stored biased by 128 in one byte (Ward, Graphics Gems II). */
 #define RGBE_BIAS 128
 #define RGBE_MANTISSA 256.0 /* 8-bit mantissas: values are m * 2^(e - 8) */
+#define RGBE_MANTISSA_BITS 8
 /* Octahedral coordinates in [-1, 1] are quantised to `bits` bits each, over
  * an even number of steps (2^bits - 2) so that 0 (the axes and the fold
  * lines) is exact. */
@@ -56,7 +58,12 @@ ps_rgb ps_rgbe_decode(const uint8_t in[4])
 {
     if (in[3] == 0)
         return ps_rgb_gray(0.0);
-    double f = ldexp(1.0 / RGBE_MANTISSA, (int)in[3] - RGBE_BIAS);
+    /* 2^(e - 128 - 8), built from its bits rather than by ldexp (a library
+     * call on every photon of every splat and estimate): exponents 1..255
+     * give -135..119, all normal doubles. */
+    uint64_t bits = (uint64_t)((int)in[3] - RGBE_BIAS - RGBE_MANTISSA_BITS + 1023) << 52;
+    double f;
+    memcpy(&f, &bits, sizeof f);
     return ps_rgb_make(in[0] * f, in[1] * f, in[2] * f);
 }
 
