@@ -8,8 +8,8 @@
 #include <unistd.h>
 
 #include "app/cli.h"
+#include "app/options.h"
 #include "app/stats.h"
-#include "core/fileio.h"
 #include "photon/estimate.h"
 #include "photon/kdtree.h"
 #include "photon/tracer.h"
@@ -62,25 +62,14 @@ static const char usage[] =
     "  --help                   this text\n";
 
 typedef struct ref_options {
-    const char *scene, *out_png, *out_hdr, *stats, *dump;
-    int64_t photons[PS_MAP_COUNT]; /* -1: the scene's default */
-    double radius[PS_MAP_COUNT];   /* 0: the scene's default */
-    double max_radius;             /* 0: the radii */
-    int width, height;             /* 0: the scene's */
-    double exposure;
-    int64_t seed, threads, spp, k, gather, light_samples;
+    ps_shared_options c;
+    double max_radius; /* 0: the radii */
+    int64_t spp, k, gather, light_samples;
     int component, kernel;
     bool photons_only;
     bool cones, first_hit;
     int accel;
 } ref_options;
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, ps_error *err)
 {
@@ -90,9 +79,8 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
     static const char *const kernels[] = {"box", "cone", "gauss", "epanechnikov", NULL};
     ps_cli cli = ps_cli_begin("photosplat-ref", argc, argv);
     memset(o, 0, sizeof *o);
-    o->photons[PS_MAP_CAUSTIC] = o->photons[PS_MAP_GLOBAL] = -1;
+    ps_shared_options_init(&o->c);
     o->cones = o->first_hit = true;
-    o->exposure = 1.0;
     o->spp = REF_DEFAULT_SPP;
     o->k = REF_DEFAULT_K;
     o->gather = REF_DEFAULT_GATHER;
@@ -104,37 +92,10 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
         if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "-h")) {
             *help = true;
             return PS_OK;
-        } else if (ps_cli_positional(&cli)) {
-            if (o->scene)
-                return ps_error_set(err, PS_ERR_PARSE, "photosplat-ref: more than one scene given ('%s')",
-                                    ps_cli_arg(&cli));
-            o->scene = ps_cli_arg(&cli);
-        } else if (ps_cli_is(&cli, "-o")) {
-            st = ps_cli_string(&cli, &o->out_png, err);
-        } else if (ps_cli_is(&cli, "--hdr")) {
-            st = ps_cli_string(&cli, &o->out_hdr, err);
-        } else if (ps_cli_is(&cli, "--stats")) {
-            st = ps_cli_string(&cli, &o->stats, err);
-        } else if (ps_cli_is(&cli, "--dump-photons")) {
-            st = ps_cli_string(&cli, &o->dump, err);
-        } else if (ps_cli_is(&cli, "--size")) {
-            st = ps_cli_size(&cli, PS_SCENE_MAX_IMAGE_SIDE, &o->width, &o->height, err);
-        } else if (ps_cli_is(&cli, "--exposure")) {
-            st = ps_cli_double(&cli, 0.0, 1e30, &o->exposure, err);
-        } else if (ps_cli_is(&cli, "--caustic-photons")) {
-            st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_CAUSTIC], err);
-        } else if (ps_cli_is(&cli, "--global-photons")) {
-            st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_GLOBAL], err);
-        } else if (ps_cli_is(&cli, "--caustic-radius")) {
-            st = ps_cli_double(&cli, 1e-300, 1e300, &o->radius[PS_MAP_CAUSTIC], err);
-        } else if (ps_cli_is(&cli, "--global-radius")) {
-            st = ps_cli_double(&cli, 1e-300, 1e300, &o->radius[PS_MAP_GLOBAL], err);
+        } else if (ps_shared_option(&cli, "photosplat-ref", &o->c, &st, err)) {
+            continue;
         } else if (ps_cli_is(&cli, "--max-radius")) {
             st = ps_cli_double(&cli, 1e-300, 1e300, &o->max_radius, err);
-        } else if (ps_cli_is(&cli, "--seed")) {
-            st = ps_cli_int(&cli, 0, INT64_MAX, &o->seed, err);
-        } else if (ps_cli_is(&cli, "--threads")) {
-            st = ps_cli_int(&cli, 1, PS_TRACER_MAX_THREADS, &o->threads, err);
         } else if (ps_cli_is(&cli, "--spp")) {
             st = ps_cli_int(&cli, 1, 1000000, &o->spp, err);
         } else if (ps_cli_is(&cli, "--k")) {
@@ -163,22 +124,12 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
     }
     if (st != PS_OK)
         return st;
-    if (!o->scene)
+    if (!o->c.scene)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-ref: no scene given (see --help)");
-    if (!o->photons_only && !o->out_png && !o->out_hdr)
+    if (!o->photons_only && !o->c.out_png && !o->c.out_hdr)
         return ps_error_set(err, PS_ERR_PARSE,
                             "photosplat-ref: nothing to write: give -o FILE.png, --hdr FILE.pfm or --photons-only");
     return PS_OK;
-}
-
-static ps_status write_dump(const char *path, const ps_photon_map maps[PS_MAP_COUNT], ps_error *err)
-{
-    ps_outfile *out = ps_outfile_open(path, err);
-    if (!out)
-        return err->status;
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_write_text(ps_outfile_stream(out), &maps[k]);
-    return ps_outfile_commit(out, err);
 }
 
 /* A progress line on stderr when it is a terminal: percent, elapsed, left. */
@@ -189,7 +140,7 @@ typedef struct progress {
 static void show_progress(void *user, double fraction)
 {
     progress *p = user;
-    double t = now_seconds();
+    double t = ps_now_seconds();
     if (t - p->last < 0.25 && fraction < 1.0)
         return;
     p->last = t;
@@ -233,12 +184,12 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
     ps_render_options ro;
     memset(&ro, 0, sizeof ro);
-    ro.width = o->width ? o->width : def->width;
-    ro.height = o->height ? o->height : def->height;
+    ro.width = o->c.width ? o->c.width : def->width;
+    ro.height = o->c.height ? o->c.height : def->height;
     ro.spp = (int)o->spp;
     ro.light_samples = (int)o->light_samples;
     ro.gather = (int)o->gather;
-    ro.seed = (uint64_t)o->seed;
+    ro.seed = (uint64_t)o->c.seed;
     ro.threads = ps_tracer_threads(r->tracer);
     ro.component = (ps_component)o->component;
     ro.caustic.k = ro.global.k = (size_t)o->k;
@@ -247,7 +198,7 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
     ro.global.max_radius = o->max_radius > 0.0 ? o->max_radius : radius[PS_MAP_GLOBAL];
     ro.irradiance_radius = ro.global.max_radius;
 
-    double t0 = now_seconds();
+    double t0 = ps_now_seconds();
     ps_status st = ps_light_sampler_create(scene, &r->lights, err);
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
         st = ps_kdtree_build(r->maps[k].photons, r->maps[k].count, &r->trees[k], err);
@@ -272,8 +223,8 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
         maps.irradiance = r->irradiance;
         rs->rays += r->full.counters.rays;
     }
-    double t_prep = now_seconds() - t0;
-    progress pr = {now_seconds(), 0.0};
+    double t_prep = ps_now_seconds() - t0;
+    progress pr = {ps_now_seconds(), 0.0};
     if (isatty(STDERR_FILENO)) {
         ro.progress = show_progress;
         ro.progress_user = &pr;
@@ -281,10 +232,10 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
     ps_render_stats stats = {0, 0.0};
     if (st == PS_OK)
         st = ps_render(r->world, r->lights, &maps, &ro, &r->image, &stats, err);
-    if (st == PS_OK && o->out_hdr)
-        st = ps_pfm_write(&r->image, o->out_hdr, err);
-    if (st == PS_OK && o->out_png)
-        st = ps_png_write(&r->image, o->out_png, (float)o->exposure, err);
+    if (st == PS_OK && o->c.out_hdr)
+        st = ps_pfm_write(&r->image, o->c.out_hdr, err);
+    if (st == PS_OK && o->c.out_png)
+        st = ps_png_write(&r->image, o->c.out_png, (float)o->c.exposure, err);
     rs->rays += stats.rays;
     rs->ray_seconds = rs->trace_seconds + t_prep + stats.seconds;
     ps_stats_add(rs, "maps_seconds", t_prep);
@@ -312,23 +263,21 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
         ps_photon_map_init(&r.maps[k], (ps_map_kind)k);
     ps_photon_map_init(&r.full, PS_MAP_GLOBAL);
 
-    double t_build = now_seconds();
+    double t_build = ps_now_seconds();
     ps_status st = ps_world_create(scene, &aopt, &r.world, err);
-    t_build = now_seconds() - t_build;
+    t_build = ps_now_seconds() - t_build;
     ps_tracer_options topt = ps_tracer_default_options();
-    topt.seed = (uint64_t)o->seed;
-    topt.threads = (int)o->threads;
+    topt.seed = (uint64_t)o->c.seed;
+    topt.threads = (int)o->c.threads;
     topt.caustic_cones = o->cones;
     topt.first_hit_test = o->first_hit;
     if (st == PS_OK)
         st = ps_tracer_create(r.world, &topt, &r.tracer, err);
 
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
-    int64_t want[PS_MAP_COUNT] = {o->photons[PS_MAP_CAUSTIC] >= 0 ? o->photons[PS_MAP_CAUSTIC] : def->caustic_photons,
-                                  o->photons[PS_MAP_GLOBAL] >= 0 ? o->photons[PS_MAP_GLOBAL] : def->global_photons};
-    double radius[PS_MAP_COUNT] = {o->radius[PS_MAP_CAUSTIC] > 0 ? o->radius[PS_MAP_CAUSTIC] : def->caustic_radius,
-                                   o->radius[PS_MAP_GLOBAL] > 0 ? o->radius[PS_MAP_GLOBAL] : def->global_radius};
-    double t_trace = now_seconds();
+    uint64_t want[PS_MAP_COUNT] = {ps_shared_photons(&o->c, def, PS_MAP_CAUSTIC), ps_shared_photons(&o->c, def, PS_MAP_GLOBAL)};
+    double radius[PS_MAP_COUNT] = {ps_shared_radius(&o->c, def, PS_MAP_CAUSTIC), ps_shared_radius(&o->c, def, PS_MAP_GLOBAL)};
+    double t_trace = ps_now_seconds();
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
         if (!ps_tracer_map_enabled(r.tracer, (ps_map_kind)k))
             continue;
@@ -338,14 +287,14 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
                 ps_error_set(err, st, "photosplat-ref: out of memory");
             continue;
         }
-        st = ps_tracer_trace(r.tracer, (ps_map_kind)k, 0, (uint64_t)want[k], (uint64_t)want[k], &r.maps[k], err);
+        st = ps_tracer_trace(r.tracer, (ps_map_kind)k, 0, want[k], want[k], &r.maps[k], err);
     }
-    t_trace = now_seconds() - t_trace;
+    t_trace = ps_now_seconds() - t_trace;
 
     ps_run_stats rs;
     memset(&rs, 0, sizeof rs);
-    if (st == PS_OK && o->dump)
-        st = write_dump(o->dump, r.maps, err);
+    if (st == PS_OK && o->c.dump)
+        st = ps_write_photon_dump(o->c.dump, r.maps, err);
     if (st == PS_OK) {
         for (int k = 0; k < PS_MAP_COUNT; k++) {
             rs.emitted[k] = r.maps[k].counters.emitted;
@@ -357,7 +306,7 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
         ps_accel_stats as;
         ps_accel_get_stats(ps_world_accel(r.world), &as);
         ps_stats_add(&rs, "threads", ps_tracer_threads(r.tracer));
-        ps_stats_add(&rs, "seed", (double)o->seed);
+        ps_stats_add(&rs, "seed", (double)o->c.seed);
         ps_stats_add(&rs, "accel_build_seconds", t_build);
         ps_stats_add(&rs, "accel_nodes", (double)as.nodes);
         ps_stats_add(&rs, "escaped", (double)(r.maps[0].counters.escaped + r.maps[1].counters.escaped));
@@ -366,9 +315,9 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
         ps_stats_add(&rs, "truncated", (double)(r.maps[0].counters.truncated + r.maps[1].counters.truncated));
     }
     if (st == PS_OK && !o->photons_only)
-        st = render_image(o, scene, &r, &topt, (uint64_t)want[PS_MAP_GLOBAL], radius, &rs, err);
-    if (st == PS_OK && o->stats)
-        st = ps_stats_write(o->stats, &rs, err);
+        st = render_image(o, scene, &r, &topt, want[PS_MAP_GLOBAL], radius, &rs, err);
+    if (st == PS_OK && o->c.stats)
+        st = ps_stats_write(o->c.stats, &rs, err);
     if (st == PS_OK) {
         printf("caustic: %llu emitted, %llu stored; global: %llu emitted, %llu stored; traced in %.3f s; %llu rays "
                "(%d threads)\n",
@@ -376,10 +325,10 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
                (unsigned long long)rs.stored[1], t_trace, (unsigned long long)rs.rays, ps_tracer_threads(r.tracer));
         for (size_t k = 0; k < rs.skip_count; k++)
             printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
-        if (o->out_png)
-            printf("wrote %s\n", o->out_png);
-        if (o->out_hdr)
-            printf("wrote %s\n", o->out_hdr);
+        if (o->c.out_png)
+            printf("wrote %s\n", o->c.out_png);
+        if (o->c.out_hdr)
+            printf("wrote %s\n", o->c.out_hdr);
     }
     ref_run_free(&r);
     return st;
@@ -398,7 +347,7 @@ int main(int argc, char **argv)
         return PS_EXIT_OK;
     }
     ps_scene *scene;
-    if (ps_scene_load(o.scene, NULL, &scene, &err) != PS_OK)
+    if (ps_scene_load(o.c.scene, NULL, &scene, &err) != PS_OK)
         return ps_cli_fail(&err);
     ps_status st = run(&o, scene, &err);
     ps_scene_destroy(scene);

@@ -9,9 +9,8 @@
 #include <time.h>
 
 #include "app/cli.h"
+#include "app/options.h"
 #include "app/stats.h"
-#include "core/array.h"
-#include "core/fileio.h"
 #include "gl/gl_render.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
@@ -66,22 +65,11 @@ static const char usage[] =
     "  --help                   this text\n";
 
 typedef struct snap_options {
-    const char *scene, *out_png, *out_hdr, *stats, *dump;
-    int64_t photons[PS_MAP_COUNT];
-    double radius[PS_MAP_COUNT];
-    int width, height;
-    double exposure, time, tau, counter_threshold, point_size;
-    int64_t seed, threads;
+    ps_shared_options c;
+    double time, tau, counter_threshold, point_size;
     int splat, kernel, color_depth, precision, shadows, stencil_clip;
     unsigned layers;
 } snap_options;
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static ps_status parse_layers(const char *text, unsigned *out, ps_error *err)
 {
@@ -119,8 +107,7 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
     static const char *const on_off[] = {"off", "on", NULL};
     ps_cli cli = ps_cli_begin("photosplat-snap", argc, argv);
     memset(o, 0, sizeof *o);
-    o->photons[PS_MAP_CAUSTIC] = o->photons[PS_MAP_GLOBAL] = -1;
-    o->exposure = 1.0;
+    ps_shared_options_init(&o->c);
     o->tau = SNAP_DEFAULT_TAU;
     o->counter_threshold = SNAP_COUNTER_THRESHOLD;
     o->point_size = SNAP_DEFAULT_POINT_SIZE;
@@ -136,35 +123,8 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
         if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "-h")) {
             *help = true;
             return PS_OK;
-        } else if (ps_cli_positional(&cli)) {
-            if (o->scene)
-                return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: more than one scene given ('%s')",
-                                    ps_cli_arg(&cli));
-            o->scene = ps_cli_arg(&cli);
-        } else if (ps_cli_is(&cli, "-o")) {
-            st = ps_cli_string(&cli, &o->out_png, err);
-        } else if (ps_cli_is(&cli, "--hdr")) {
-            st = ps_cli_string(&cli, &o->out_hdr, err);
-        } else if (ps_cli_is(&cli, "--stats")) {
-            st = ps_cli_string(&cli, &o->stats, err);
-        } else if (ps_cli_is(&cli, "--dump-photons")) {
-            st = ps_cli_string(&cli, &o->dump, err);
-        } else if (ps_cli_is(&cli, "--size")) {
-            st = ps_cli_size(&cli, PS_SCENE_MAX_IMAGE_SIDE, &o->width, &o->height, err);
-        } else if (ps_cli_is(&cli, "--exposure")) {
-            st = ps_cli_double(&cli, 0.0, 1e30, &o->exposure, err);
-        } else if (ps_cli_is(&cli, "--caustic-photons")) {
-            st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_CAUSTIC], err);
-        } else if (ps_cli_is(&cli, "--global-photons")) {
-            st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_GLOBAL], err);
-        } else if (ps_cli_is(&cli, "--caustic-radius")) {
-            st = ps_cli_double(&cli, 1e-300, 1e300, &o->radius[PS_MAP_CAUSTIC], err);
-        } else if (ps_cli_is(&cli, "--global-radius")) {
-            st = ps_cli_double(&cli, 1e-300, 1e300, &o->radius[PS_MAP_GLOBAL], err);
-        } else if (ps_cli_is(&cli, "--seed")) {
-            st = ps_cli_int(&cli, 0, INT64_MAX, &o->seed, err);
-        } else if (ps_cli_is(&cli, "--threads")) {
-            st = ps_cli_int(&cli, 1, PS_TRACER_MAX_THREADS, &o->threads, err);
+        } else if (ps_shared_option(&cli, "photosplat-snap", &o->c, &st, err)) {
+            continue;
         } else if (ps_cli_is(&cli, "--time")) {
             st = ps_cli_double(&cli, 1e-3, 1e6, &o->time, err);
         } else if (ps_cli_is(&cli, "--tau")) {
@@ -195,9 +155,9 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
     }
     if (st != PS_OK)
         return st;
-    if (!o->scene)
+    if (!o->c.scene)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: no scene given (see --help)");
-    if (!o->out_png && !o->out_hdr)
+    if (!o->c.out_png && !o->c.out_hdr)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: nothing to write: give -o FILE.png or --hdr FILE.pfm");
     return PS_OK;
 }
@@ -235,7 +195,7 @@ static ps_status feed_batch(feed *f, int k, uint64_t first, uint64_t count, ps_e
 static void *feed_run(void *arg)
 {
     feed *f = arg;
-    double t0 = now_seconds();
+    double t0 = ps_now_seconds();
     uint64_t next[PS_MAP_COUNT] = {0, 0};
     uint64_t biggest = f->cap[0] > f->cap[1] ? f->cap[0] : f->cap[1];
     ps_status st = PS_OK;
@@ -263,7 +223,7 @@ static void *feed_run(void *arg)
     pthread_mutex_lock(&f->lock);
     f->status = st;
     f->done = true;
-    f->trace_seconds = now_seconds() - t0;
+    f->trace_seconds = ps_now_seconds() - t0;
     pthread_mutex_unlock(&f->lock);
     return NULL;
 }
@@ -291,7 +251,7 @@ typedef struct snap_run {
 static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
 {
     const snap_options *o = s->o;
-    double t0 = now_seconds();
+    double t0 = ps_now_seconds();
     size_t nmat;
     const ps_material *materials = ps_scene_materials(s->scene, &nmat);
     double wanted = 0.0, lost = 0.0;
@@ -314,7 +274,7 @@ static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
         p.kernel_mean = s->kernel.mean;
         p.kernel_extent = s->kernel.extent;
         /* Powers are normalised for the cap N; n have been emitted so far. */
-        p.scale = o->exposure * (double)f->cap[k] / (double)m->counters.emitted;
+        p.scale = o->c.exposure * (double)f->cap[k] / (double)m->counters.emitted;
         p.point_size = o->point_size;
         p.precision = (ps_precision)o->precision;
         p.levels = o->color_depth == 0 ? 255 : 0;
@@ -329,7 +289,7 @@ static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
         s->splats += b->splats;
     }
     s->lost_fraction = wanted > 0.0 ? lost / wanted : 0.0;
-    s->splat_seconds += now_seconds() - t0;
+    s->splat_seconds += ps_now_seconds() - t0;
     return PS_OK;
 }
 
@@ -337,12 +297,12 @@ static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
 static void draw_frame(snap_run *s)
 {
     const snap_options *o = s->o;
-    double t0 = now_seconds();
-    ps_gl_begin_frame(s->gl, &s->cam, o->exposure, (o->layers & LAYER_DIRECT) != 0);
+    double t0 = ps_now_seconds();
+    ps_gl_begin_frame(s->gl, &s->cam, o->c.exposure, (o->layers & LAYER_DIRECT) != 0);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_gl_draw_splats(s->gl, &s->batch[k], (ps_splat_mode)o->splat, s->radius[k], o->point_size);
     s->frames++;
-    s->splat_seconds += now_seconds() - t0;
+    s->splat_seconds += ps_now_seconds() - t0;
 }
 
 static ps_status write_outputs(snap_run *s, ps_error *err)
@@ -354,34 +314,24 @@ static ps_status write_outputs(snap_run *s, ps_error *err)
         return st;
     /* The buffer holds radiance times exposure: the PNG takes it as it is,
      * the PFM the radiance. */
-    if (o->out_png)
-        st = ps_png_write(&img, o->out_png, 1.0f, err);
-    if (st == PS_OK && o->out_hdr) {
-        float inv = o->exposure > 0.0 ? (float)(1.0 / o->exposure) : 0.0f;
+    if (o->c.out_png)
+        st = ps_png_write(&img, o->c.out_png, 1.0f, err);
+    if (st == PS_OK && o->c.out_hdr) {
+        float inv = o->c.exposure > 0.0 ? (float)(1.0 / o->c.exposure) : 0.0f;
         size_t n = 3 * (size_t)img.width * (size_t)img.height;
         for (size_t i = 0; i < n; i++)
             img.rgb[i] *= inv;
-        st = ps_pfm_write(&img, o->out_hdr, err);
+        st = ps_pfm_write(&img, o->c.out_hdr, err);
     }
     ps_image_destroy(&img);
     return st;
-}
-
-static ps_status write_dump(const char *path, const ps_photon_map maps[PS_MAP_COUNT], ps_error *err)
-{
-    ps_outfile *out = ps_outfile_open(path, err);
-    if (!out)
-        return err->status;
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_write_text(ps_outfile_stream(out), &maps[k]);
-    return ps_outfile_commit(out, err);
 }
 
 /* The photons, the frames, the files. */
 static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext ctx, void *buffer, ps_error *err)
 {
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
-    int width = o->width ? o->width : def->width, height = o->height ? o->height : def->height;
+    int width = o->c.width ? o->c.width : def->width, height = o->c.height ? o->c.height : def->height;
     GLenum type = o->color_depth == 0 ? GL_UNSIGNED_BYTE : GL_FLOAT;
     if (!OSMesaMakeCurrent(ctx, buffer, type, width, height))
         return ps_error_set(err, PS_ERR_LIMIT, "photosplat-snap: OSMesa cannot draw a %dx%d %s buffer", width, height,
@@ -391,8 +341,8 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     s.o = o;
     s.scene = scene;
     s.cam = ps_camera_frame_make(ps_scene_camera(scene), width, height);
-    s.radius[PS_MAP_CAUSTIC] = o->radius[PS_MAP_CAUSTIC] > 0 ? o->radius[PS_MAP_CAUSTIC] : def->caustic_radius;
-    s.radius[PS_MAP_GLOBAL] = o->radius[PS_MAP_GLOBAL] > 0 ? o->radius[PS_MAP_GLOBAL] : def->global_radius;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        s.radius[k] = ps_shared_radius(&o->c, def, (ps_map_kind)k);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_splat_batch_init(&s.batch[k]);
 
@@ -407,8 +357,8 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     memset(&mesh, 0, sizeof mesh);
     ps_status st = ps_world_create(scene, NULL, &world, err);
     ps_tracer_options topt = ps_tracer_default_options();
-    topt.seed = (uint64_t)o->seed;
-    topt.threads = (int)o->threads;
+    topt.seed = (uint64_t)o->c.seed;
+    topt.threads = (int)o->c.threads;
     if (st == PS_OK)
         st = ps_tracer_create(world, &topt, &f.tracer, err);
     ps_mesh_options mopt = ps_mesh_default_options(scene);
@@ -421,12 +371,11 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         st = ps_gl_renderer_create(scene, &mesh, &s.kernel, &gopt, &s.gl, err);
 
     /* Which maps to trace: a layer that is off, or 0 photons, is skipped. */
-    int64_t want[PS_MAP_COUNT] = {o->photons[0] >= 0 ? o->photons[0] : def->caustic_photons,
-                                  o->photons[1] >= 0 ? o->photons[1] : def->global_photons};
+    uint64_t want[PS_MAP_COUNT] = {ps_shared_photons(&o->c, def, PS_MAP_CAUSTIC), ps_shared_photons(&o->c, def, PS_MAP_GLOBAL)};
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
         unsigned layer = k == PS_MAP_CAUSTIC ? LAYER_CAUSTIC : LAYER_GLOBAL;
         const char *name = ps_map_name((ps_map_kind)k);
-        f.cap[k] = (uint64_t)want[k];
+        f.cap[k] = want[k];
         f.active[k] = false;
         if (!ps_tracer_map_enabled(f.tracer, (ps_map_kind)k))
             continue;
@@ -442,7 +391,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     if (st == PS_OK && !(o->layers & LAYER_DIRECT))
         st = ps_tracer_note_skip(f.tracer, "direct", "layer not shown (--layers)");
 
-    double t_start = now_seconds(), first_frame = -1.0;
+    double t_start = ps_now_seconds(), first_frame = -1.0;
     bool counter_stopped = false;
     uint64_t counter_at = 0;
     if (st == PS_OK && o->time <= 0.0) {
@@ -455,7 +404,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
             st = build_splats(&s, &f, err);
         if (st == PS_OK)
             draw_frame(&s);
-        first_frame = now_seconds() - t_start;
+        first_frame = ps_now_seconds() - t_start;
     } else if (st == PS_OK) {
         /* Progressive: trace in the background, refresh every tau. */
         pthread_t tid;
@@ -464,7 +413,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
             feed_run(&f);
         double next = t_start + o->tau, end = t_start + o->time;
         for (;;) {
-            double t = now_seconds();
+            double t = ps_now_seconds();
             double until = next < end ? next : end;
             if (t < until) {
                 struct timespec ts = {(time_t)(until - t), (long)((until - t - (double)(time_t)(until - t)) * 1e9)};
@@ -485,9 +434,9 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
             if (st == PS_OK)
                 draw_frame(&s);
             if (first_frame < 0.0)
-                first_frame = now_seconds() - t_start;
+                first_frame = ps_now_seconds() - t_start;
             next += o->tau;
-            if (st != PS_OK || done || now_seconds() >= end)
+            if (st != PS_OK || done || ps_now_seconds() >= end)
                 break;
         }
         pthread_mutex_lock(&f.lock);
@@ -505,10 +454,10 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         if (st == PS_OK)
             draw_frame(&s);
     }
-    if (st == PS_OK && (o->out_png || o->out_hdr))
+    if (st == PS_OK && (o->c.out_png || o->c.out_hdr))
         st = write_outputs(&s, err);
-    if (st == PS_OK && o->dump)
-        st = write_dump(o->dump, f.maps, err);
+    if (st == PS_OK && o->c.dump)
+        st = ps_write_photon_dump(o->c.dump, f.maps, err);
 
     ps_run_stats rs;
     memset(&rs, 0, sizeof rs);
@@ -524,10 +473,10 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         rs.skips = ps_tracer_skips(f.tracer, &rs.skip_count);
         ps_gl_stats gs = ps_gl_get_stats(s.gl);
         ps_stats_add(&rs, "threads", ps_tracer_threads(f.tracer));
-        ps_stats_add(&rs, "seed", (double)o->seed);
+        ps_stats_add(&rs, "seed", (double)o->c.seed);
         ps_stats_add(&rs, "width", width);
         ps_stats_add(&rs, "height", height);
-        ps_stats_add(&rs, "seconds", now_seconds() - t_start);
+        ps_stats_add(&rs, "seconds", ps_now_seconds() - t_start);
         ps_stats_add(&rs, "first_frame_seconds", first_frame);
         ps_stats_add(&rs, "splats", (double)s.splats);
         ps_stats_add(&rs, "kernel_mean", s.kernel.mean);
@@ -539,8 +488,8 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         ps_stats_add(&rs, "counter_stopped", counter_stopped ? 1.0 : 0.0);
         ps_stats_add(&rs, "counter_stopped_at_photons", (double)counter_at);
         ps_stats_add(&rs, "counter_threshold", o->counter_threshold);
-        if (o->stats)
-            st = ps_stats_write(o->stats, &rs, err);
+        if (o->c.stats)
+            st = ps_stats_write(o->c.stats, &rs, err);
     }
     if (st == PS_OK) {
         printf("caustic: %llu emitted, %llu stored; global: %llu emitted, %llu stored; %llu frames; %s splats, %s\n",
@@ -553,10 +502,10 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
                    (unsigned long long)counter_at, 100.0 * s.lost_fraction, 100.0 * o->counter_threshold);
         for (size_t k = 0; k < rs.skip_count; k++)
             printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
-        if (o->out_png)
-            printf("wrote %s\n", o->out_png);
-        if (o->out_hdr)
-            printf("wrote %s\n", o->out_hdr);
+        if (o->c.out_png)
+            printf("wrote %s\n", o->c.out_png);
+        if (o->c.out_hdr)
+            printf("wrote %s\n", o->c.out_hdr);
     }
     ps_gl_renderer_destroy(s.gl);
     ps_kernel_texture_free(&s.kernel);
@@ -584,10 +533,10 @@ int main(int argc, char **argv)
         return PS_EXIT_OK;
     }
     ps_scene *scene;
-    if (ps_scene_load(o.scene, NULL, &scene, &err) != PS_OK)
+    if (ps_scene_load(o.c.scene, NULL, &scene, &err) != PS_OK)
         return ps_cli_fail(&err);
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
-    int width = o.width ? o.width : def->width, height = o.height ? o.height : def->height;
+    int width = o.c.width ? o.c.width : def->width, height = o.c.height ? o.c.height : def->height;
     /* RGBA, 24-bit depth, 8-bit stencil, no accumulation buffer (platform
      * notes: it wraps above 1.0 and is no place for photon sums). */
     OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);

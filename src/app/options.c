@@ -1,0 +1,84 @@
+/* options.c: the shared options, the photon dump, the clock. */
+#include "app/options.h"
+
+#include <string.h>
+#include <time.h>
+
+#include "core/fileio.h"
+
+void ps_shared_options_init(ps_shared_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->photons[PS_MAP_CAUSTIC] = o->photons[PS_MAP_GLOBAL] = -1;
+    o->exposure = 1.0;
+}
+
+bool ps_shared_option(ps_cli *cli, const char *prog, ps_shared_options *o, ps_status *st, ps_error *err)
+{
+    /* Radii are lengths in scene units, which may be anything from 1e-300 up. */
+    const double min_len = 1e-300, max_len = 1e300;
+    if (ps_cli_positional(cli)) {
+        if (o->scene)
+            *st = ps_error_set(err, PS_ERR_PARSE, "%s: more than one scene given ('%s')", prog, ps_cli_arg(cli));
+        else
+            o->scene = ps_cli_arg(cli), *st = PS_OK;
+    } else if (ps_cli_is(cli, "-o")) {
+        *st = ps_cli_string(cli, &o->out_png, err);
+    } else if (ps_cli_is(cli, "--hdr")) {
+        *st = ps_cli_string(cli, &o->out_hdr, err);
+    } else if (ps_cli_is(cli, "--stats")) {
+        *st = ps_cli_string(cli, &o->stats, err);
+    } else if (ps_cli_is(cli, "--dump-photons")) {
+        *st = ps_cli_string(cli, &o->dump, err);
+    } else if (ps_cli_is(cli, "--size")) {
+        *st = ps_cli_size(cli, PS_SCENE_MAX_IMAGE_SIDE, &o->width, &o->height, err);
+    } else if (ps_cli_is(cli, "--exposure")) {
+        *st = ps_cli_double(cli, 0.0, 1e30, &o->exposure, err);
+    } else if (ps_cli_is(cli, "--caustic-photons")) {
+        *st = ps_cli_int(cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_CAUSTIC], err);
+    } else if (ps_cli_is(cli, "--global-photons")) {
+        *st = ps_cli_int(cli, 0, PS_SCENE_MAX_PHOTONS, &o->photons[PS_MAP_GLOBAL], err);
+    } else if (ps_cli_is(cli, "--caustic-radius")) {
+        *st = ps_cli_double(cli, min_len, max_len, &o->radius[PS_MAP_CAUSTIC], err);
+    } else if (ps_cli_is(cli, "--global-radius")) {
+        *st = ps_cli_double(cli, min_len, max_len, &o->radius[PS_MAP_GLOBAL], err);
+    } else if (ps_cli_is(cli, "--seed")) {
+        *st = ps_cli_int(cli, 0, INT64_MAX, &o->seed, err);
+    } else if (ps_cli_is(cli, "--threads")) {
+        *st = ps_cli_int(cli, 1, PS_TRACER_MAX_THREADS, &o->threads, err);
+    } else {
+        return false;
+    }
+    return true;
+}
+
+uint64_t ps_shared_photons(const ps_shared_options *o, const ps_scene_defaults *d, ps_map_kind k)
+{
+    if (o->photons[k] >= 0)
+        return (uint64_t)o->photons[k];
+    return (uint64_t)(k == PS_MAP_CAUSTIC ? d->caustic_photons : d->global_photons);
+}
+
+double ps_shared_radius(const ps_shared_options *o, const ps_scene_defaults *d, ps_map_kind k)
+{
+    if (o->radius[k] > 0.0)
+        return o->radius[k];
+    return k == PS_MAP_CAUSTIC ? d->caustic_radius : d->global_radius;
+}
+
+ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP_COUNT], ps_error *err)
+{
+    ps_outfile *out = ps_outfile_open(path, err);
+    if (!out)
+        return err->status;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_write_text(ps_outfile_stream(out), &maps[k]);
+    return ps_outfile_commit(out, err);
+}
+
+double ps_now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}

@@ -1,0 +1,40 @@
+/* options.h: what photosplat-ref and photosplat-snap share: the contract's
+ * common options ("Options shared by snap and ref"), the photon dump, a clock. */
+#ifndef PS_APP_OPTIONS_H
+#define PS_APP_OPTIONS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "app/cli.h"
+#include "core/status.h"
+#include "photon/tracer.h"
+
+typedef struct ps_shared_options {
+    const char *scene, *out_png, *out_hdr, *stats, *dump;
+    int64_t photons[PS_MAP_COUNT]; /* -1: the scene's `photons` */
+    double radius[PS_MAP_COUNT];   /* 0: the scene's `radius` */
+    int width, height;             /* 0: the scene's `image` */
+    double exposure;               /* 1 */
+    int64_t seed, threads;         /* 0, 0 (all cores) */
+} ps_shared_options;
+
+void ps_shared_options_init(ps_shared_options *o);
+
+/* When the current argument is one of the shared options or the scene,
+ * consumes it (and its value) and returns true, with *st the outcome;
+ * false leaves it to the program. `prog` names the program in messages. */
+bool ps_shared_option(ps_cli *cli, const char *prog, ps_shared_options *o, ps_status *st, ps_error *err);
+
+/* The photons each map emits and the radius each uses: the options', else
+ * the scene's defaults. */
+uint64_t ps_shared_photons(const ps_shared_options *o, const ps_scene_defaults *d, ps_map_kind k);
+double ps_shared_radius(const ps_shared_options *o, const ps_scene_defaults *d, ps_map_kind k);
+
+/* --dump-photons: every photon of both maps, written whole or not at all. */
+ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP_COUNT], ps_error *err);
+
+/* Seconds on a monotonic clock. */
+double ps_now_seconds(void);
+
+#endif
