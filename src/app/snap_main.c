@@ -2,7 +2,6 @@
  * the photon tracer feeding splats to src/gl, one snapshot written as PNG
  * and/or PFM. The same frame the window shows, for tests and benchmarks. */
 #include <GL/osmesa.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,14 +13,11 @@
 #include "gl/gl_render.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
+#include "preview/feed.h"
 #include "preview/mesh.h"
 #include "preview/splat.h"
 #include "scene/scene.h"
 
-/* Photons traced per map between hand-overs to the GL thread in progressive
- * mode: large enough to keep the tracer's threads busy, small enough that a
- * refresh every tau sees recent ones. */
-#define SNAP_BATCH 16384
 /* The error counter's default: stop shooting once this fraction of a
  * refresh's splat energy rounds away in the 8-bit buffer. */
 #define SNAP_COUNTER_THRESHOLD 0.1
@@ -162,72 +158,6 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
     return PS_OK;
 }
 
-/* ---- photons: traced in the background, handed over under a lock ---------- */
-
-typedef struct feed {
-    ps_tracer *tracer;
-    uint64_t cap[PS_MAP_COUNT]; /* N: photons each map is normalised for */
-    bool active[PS_MAP_COUNT];
-    pthread_mutex_t lock;
-    ps_photon_map maps[PS_MAP_COUNT]; /* under lock: what has arrived */
-    bool stop, done;                  /* under lock */
-    ps_status status;
-    ps_error err;
-    double trace_seconds;
-} feed;
-
-/* Appends photons [first, first + count) of map k, traced outside the lock. */
-static ps_status feed_batch(feed *f, int k, uint64_t first, uint64_t count, ps_error *err)
-{
-    ps_photon_map local;
-    ps_photon_map_init(&local, (ps_map_kind)k);
-    ps_status st = ps_tracer_trace(f->tracer, (ps_map_kind)k, first, count, f->cap[k], &local, err);
-    pthread_mutex_lock(&f->lock);
-    if (st == PS_OK && !ps_photon_map_append(&f->maps[k], &local))
-        st = ps_error_set(err, PS_ERR_NOMEM, "photosplat-snap: out of memory for photons");
-    pthread_mutex_unlock(&f->lock);
-    ps_photon_map_free(&local);
-    return st;
-}
-
-/* Traces every active map up to its cap, in rounds that keep the maps'
- * emitted counts in proportion, until done or told to stop. */
-static void *feed_run(void *arg)
-{
-    feed *f = arg;
-    double t0 = ps_now_seconds();
-    uint64_t next[PS_MAP_COUNT] = {0, 0};
-    uint64_t biggest = f->cap[0] > f->cap[1] ? f->cap[0] : f->cap[1];
-    ps_status st = PS_OK;
-    for (uint64_t round = 0; st == PS_OK; round++) {
-        bool more = false;
-        for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
-            if (!f->active[k] || next[k] >= f->cap[k])
-                continue;
-            /* This map's share of the round, so that all maps finish together. */
-            uint64_t until = biggest ? (uint64_t)((double)f->cap[k] * (double)((round + 1) * SNAP_BATCH) / (double)biggest) : 0;
-            if (until > f->cap[k])
-                until = f->cap[k];
-            if (until <= next[k])
-                until = next[k] + 1;
-            st = feed_batch(f, k, next[k], until - next[k], &f->err);
-            next[k] = until;
-            more = more || next[k] < f->cap[k];
-        }
-        pthread_mutex_lock(&f->lock);
-        bool stop = f->stop;
-        pthread_mutex_unlock(&f->lock);
-        if (!more || stop)
-            break;
-    }
-    pthread_mutex_lock(&f->lock);
-    f->status = st;
-    f->done = true;
-    f->trace_seconds = ps_now_seconds() - t0;
-    pthread_mutex_unlock(&f->lock);
-    return NULL;
-}
-
 /* ---- frames ----------------------------------------------------------------- */
 
 typedef struct snap_run {
@@ -248,7 +178,7 @@ typedef struct snap_run {
 /* Builds the splats of every shown map from the photons that have arrived
  * (call under the feed's lock: the arrays must not move while read). CPU
  * only, so the lock is held briefly; drawing comes after, unlocked. */
-static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
+static ps_status build_splats(snap_run *s, const ps_feed *f, ps_error *err)
 {
     const snap_options *o = s->o;
     double t0 = ps_now_seconds();
@@ -257,7 +187,7 @@ static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
     double wanted = 0.0, lost = 0.0;
     s->splats = 0;
     for (int k = 0; k < PS_MAP_COUNT; k++) {
-        const ps_photon_map *m = &f->maps[k];
+        const ps_photon_map *m = &ps_feed_maps(f)[k];
         ps_splat_batch *b = &s->batch[k];
         unsigned layer = k == PS_MAP_CAUSTIC ? LAYER_CAUSTIC : LAYER_GLOBAL;
         ps_splat_batch_clear(b);
@@ -274,7 +204,7 @@ static ps_status build_splats(snap_run *s, const feed *f, ps_error *err)
         p.kernel_mean = s->kernel.mean;
         p.kernel_extent = s->kernel.extent;
         /* Powers are normalised for the cap N; n have been emitted so far. */
-        p.scale = o->c.exposure * (double)f->cap[k] / (double)m->counters.emitted;
+        p.scale = o->c.exposure * (double)ps_feed_cap(f, (ps_map_kind)k) / (double)m->counters.emitted;
         p.point_size = o->point_size;
         p.precision = (ps_precision)o->precision;
         p.levels = o->color_depth == 0 ? 255 : 0;
@@ -346,13 +276,9 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_splat_batch_init(&s.batch[k]);
 
-    feed f;
-    memset(&f, 0, sizeof f);
-    pthread_mutex_init(&f.lock, NULL);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_init(&f.maps[k], (ps_map_kind)k);
-
     ps_world *world = NULL;
+    ps_tracer *tracer = NULL;
+    ps_feed *feed = NULL;
     ps_preview_mesh mesh;
     memset(&mesh, 0, sizeof mesh);
     ps_status st = ps_world_create(scene, NULL, &world, err);
@@ -360,7 +286,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     topt.seed = (uint64_t)o->c.seed;
     topt.threads = (int)o->c.threads;
     if (st == PS_OK)
-        st = ps_tracer_create(world, &topt, &f.tracer, err);
+        st = ps_tracer_create(world, &topt, &tracer, err);
     ps_mesh_options mopt = ps_mesh_default_options(scene);
     if (st == PS_OK)
         st = ps_preview_mesh_build(scene, &mopt, &mesh, err);
@@ -372,107 +298,98 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
 
     /* Which maps to trace: a layer that is off, or 0 photons, is skipped. */
     uint64_t want[PS_MAP_COUNT] = {ps_shared_photons(&o->c, def, PS_MAP_CAUSTIC), ps_shared_photons(&o->c, def, PS_MAP_GLOBAL)};
+    bool active[PS_MAP_COUNT] = {false, false};
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
         unsigned layer = k == PS_MAP_CAUSTIC ? LAYER_CAUSTIC : LAYER_GLOBAL;
         const char *name = ps_map_name((ps_map_kind)k);
-        f.cap[k] = want[k];
-        f.active[k] = false;
-        if (!ps_tracer_map_enabled(f.tracer, (ps_map_kind)k))
+        if (!ps_tracer_map_enabled(tracer, (ps_map_kind)k))
             continue;
         if (!(o->layers & layer))
-            st = ps_tracer_note_skip(f.tracer, name, "layer not shown (--layers)");
+            st = ps_tracer_note_skip(tracer, name, "layer not shown (--layers)");
         else if (want[k] == 0)
-            st = ps_tracer_note_skip(f.tracer, name, "0 photons requested");
+            st = ps_tracer_note_skip(tracer, name, "0 photons requested");
         else
-            f.active[k] = true;
+            active[k] = true;
         if (st != PS_OK)
             ps_error_set(err, st, "photosplat-snap: out of memory");
     }
     if (st == PS_OK && !(o->layers & LAYER_DIRECT))
-        st = ps_tracer_note_skip(f.tracer, "direct", "layer not shown (--layers)");
+        st = ps_tracer_note_skip(tracer, "direct", "layer not shown (--layers)");
+    if (st == PS_OK)
+        st = ps_feed_create(tracer, want, active, &feed, err);
 
     double t_start = ps_now_seconds(), first_frame = -1.0;
     bool counter_stopped = false;
     uint64_t counter_at = 0;
     if (st == PS_OK && o->time <= 0.0) {
         /* A fixed photon count: trace everything, then draw once. */
-        feed_run(&f);
-        st = f.status;
-        if (st != PS_OK)
-            *err = f.err;
+        st = ps_feed_run(feed, err);
         if (st == PS_OK)
-            st = build_splats(&s, &f, err);
+            st = build_splats(&s, feed, err);
         if (st == PS_OK)
             draw_frame(&s);
         first_frame = ps_now_seconds() - t_start;
     } else if (st == PS_OK) {
         /* Progressive: trace in the background, refresh every tau. */
-        pthread_t tid;
-        bool threaded = pthread_create(&tid, NULL, feed_run, &f) == 0;
-        if (!threaded)
-            feed_run(&f);
+        st = ps_feed_start(feed, err);
         double next = t_start + o->tau, end = t_start + o->time;
-        for (;;) {
+        while (st == PS_OK) {
             double t = ps_now_seconds();
             double until = next < end ? next : end;
             if (t < until) {
                 struct timespec ts = {(time_t)(until - t), (long)((until - t - (double)(time_t)(until - t)) * 1e9)};
                 nanosleep(&ts, NULL);
             }
-            pthread_mutex_lock(&f.lock);
-            bool done = f.done;
-            st = build_splats(&s, &f, err);
-            /* Thesis 5.1: once a refresh loses this much to round-off, more
-             * photons only add noise; stop shooting. */
-            if (st == PS_OK && o->precision == PS_PRECISION_COUNTER && o->color_depth == 0 && !counter_stopped &&
-                s.lost_fraction > o->counter_threshold) {
-                counter_stopped = true;
-                counter_at = f.maps[0].counters.emitted + f.maps[1].counters.emitted;
-                f.stop = true;
-            }
-            pthread_mutex_unlock(&f.lock);
-            if (st == PS_OK)
-                draw_frame(&s);
+            ps_feed_lock(feed);
+            bool ended = ps_feed_ended(feed);
+            st = build_splats(&s, feed, err);
+            uint64_t emitted = ps_feed_maps(feed)[0].counters.emitted + ps_feed_maps(feed)[1].counters.emitted;
+            ps_feed_unlock(feed);
+            if (st != PS_OK)
+                break;
+            draw_frame(&s);
             if (first_frame < 0.0)
                 first_frame = ps_now_seconds() - t_start;
+            /* Thesis 5.1: once a refresh loses this much to round-off, more
+             * photons only add noise; stop shooting. */
+            if (o->precision == PS_PRECISION_COUNTER && o->color_depth == 0 && s.lost_fraction > o->counter_threshold) {
+                counter_stopped = true;
+                counter_at = emitted;
+                break;
+            }
             next += o->tau;
-            if (st != PS_OK || done || ps_now_seconds() >= end)
+            if (ended || ps_now_seconds() >= end)
                 break;
         }
-        pthread_mutex_lock(&f.lock);
-        f.stop = true;
-        pthread_mutex_unlock(&f.lock);
-        if (threaded)
-            pthread_join(tid, NULL);
-        if (st == PS_OK && f.status != PS_OK) {
-            st = f.status;
-            *err = f.err;
-        }
+        ps_feed_stop(feed);
+        if (st == PS_OK)
+            st = ps_feed_status(feed, err);
         /* The snapshot: everything that arrived, drawn once more. */
         if (st == PS_OK)
-            st = build_splats(&s, &f, err);
+            st = build_splats(&s, feed, err);
         if (st == PS_OK)
             draw_frame(&s);
     }
     if (st == PS_OK && (o->c.out_png || o->c.out_hdr))
         st = write_outputs(&s, err);
     if (st == PS_OK && o->c.dump)
-        st = ps_write_photon_dump(o->c.dump, f.maps, err);
+        st = ps_write_photon_dump(o->c.dump, ps_feed_maps(feed), err);
 
     ps_run_stats rs;
     memset(&rs, 0, sizeof rs);
     if (st == PS_OK) {
         for (int k = 0; k < PS_MAP_COUNT; k++) {
-            rs.emitted[k] = f.maps[k].counters.emitted;
-            rs.stored[k] = f.maps[k].counters.stored;
-            rs.rays += f.maps[k].counters.rays;
+            const ps_photon_map *m = &ps_feed_maps(feed)[k];
+            rs.emitted[k] = m->counters.emitted;
+            rs.stored[k] = m->counters.stored;
+            rs.rays += m->counters.rays;
         }
-        rs.trace_seconds = f.trace_seconds;
+        rs.trace_seconds = ps_feed_seconds(feed);
         rs.splat_seconds = s.splat_seconds;
         rs.frames = s.frames;
-        rs.skips = ps_tracer_skips(f.tracer, &rs.skip_count);
+        rs.skips = ps_tracer_skips(tracer, &rs.skip_count);
         ps_gl_stats gs = ps_gl_get_stats(s.gl);
-        ps_stats_add(&rs, "threads", ps_tracer_threads(f.tracer));
+        ps_stats_add(&rs, "threads", ps_tracer_threads(tracer));
         ps_stats_add(&rs, "seed", (double)o->c.seed);
         ps_stats_add(&rs, "width", width);
         ps_stats_add(&rs, "height", height);
@@ -512,11 +429,9 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_splat_batch_free(&s.batch[k]);
     ps_preview_mesh_free(&mesh);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_free(&f.maps[k]);
-    ps_tracer_destroy(f.tracer);
+    ps_feed_destroy(feed);
+    ps_tracer_destroy(tracer);
     ps_world_destroy(world);
-    pthread_mutex_destroy(&f.lock);
     return st;
 }
 

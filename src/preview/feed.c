@@ -1,0 +1,174 @@
+/* feed.c: the background photon tracer of the progressive preview. */
+#include "preview/feed.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+struct ps_feed {
+    ps_tracer *tracer;
+    uint64_t cap[PS_MAP_COUNT];
+    bool active[PS_MAP_COUNT];
+    pthread_mutex_t lock;
+    pthread_cond_t wake;              /* signalled when pause or stop change */
+    ps_photon_map maps[PS_MAP_COUNT]; /* under lock: what has arrived */
+    bool stop, paused, ended;         /* under lock */
+    bool started;
+    pthread_t thread;
+    ps_status status;
+    ps_error err;
+    double seconds;
+};
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const bool active[PS_MAP_COUNT],
+                         ps_feed **out, ps_error *err)
+{
+    *out = NULL;
+    ps_feed *f = calloc(1, sizeof *f);
+    if (!f)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
+    f->tracer = t;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        f->cap[k] = caps[k];
+        f->active[k] = active[k] && caps[k] > 0;
+        ps_photon_map_init(&f->maps[k], (ps_map_kind)k);
+    }
+    pthread_mutex_init(&f->lock, NULL);
+    pthread_cond_init(&f->wake, NULL);
+    *out = f;
+    return PS_OK;
+}
+
+/* Traces photons [first, first + count) of map k outside the lock, then
+ * appends them under it. */
+static ps_status batch(ps_feed *f, int k, uint64_t first, uint64_t count, ps_error *err)
+{
+    ps_photon_map local;
+    ps_photon_map_init(&local, (ps_map_kind)k);
+    ps_status st = ps_tracer_trace(f->tracer, (ps_map_kind)k, first, count, f->cap[k], &local, err);
+    pthread_mutex_lock(&f->lock);
+    if (st == PS_OK && !ps_photon_map_append(&f->maps[k], &local))
+        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for %llu more photons",
+                          (unsigned long long)local.count);
+    pthread_mutex_unlock(&f->lock);
+    ps_photon_map_free(&local);
+    return st;
+}
+
+/* Rounds that keep the maps' emitted counts in proportion to their caps, so
+ * that all of them finish together. */
+static void *feed_main(void *arg)
+{
+    ps_feed *f = arg;
+    double t0 = now();
+    uint64_t next[PS_MAP_COUNT] = {0, 0};
+    uint64_t biggest = 0;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        if (f->active[k] && f->cap[k] > biggest)
+            biggest = f->cap[k];
+    ps_status st = PS_OK;
+    ps_error err;
+    ps_error_clear(&err);
+    for (uint64_t round = 0; st == PS_OK; round++) {
+        pthread_mutex_lock(&f->lock);
+        while (f->paused && !f->stop)
+            pthread_cond_wait(&f->wake, &f->lock);
+        bool stop = f->stop;
+        pthread_mutex_unlock(&f->lock);
+        if (stop)
+            break;
+        bool more = false;
+        for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
+            if (!f->active[k] || next[k] >= f->cap[k])
+                continue;
+            double share = (double)(round + 1) * PS_FEED_BATCH / (double)biggest;
+            uint64_t until = share >= 1.0 ? f->cap[k] : (uint64_t)((double)f->cap[k] * share);
+            if (until <= next[k])
+                until = next[k] + 1;
+            st = batch(f, k, next[k], until - next[k], &err);
+            next[k] = until;
+            more = more || next[k] < f->cap[k];
+        }
+        if (!more)
+            break;
+    }
+    pthread_mutex_lock(&f->lock);
+    f->status = st;
+    f->err = err;
+    f->ended = true;
+    f->seconds = now() - t0;
+    pthread_mutex_unlock(&f->lock);
+    return NULL;
+}
+
+ps_status ps_feed_run(ps_feed *f, ps_error *err)
+{
+    feed_main(f);
+    if (f->status != PS_OK && err)
+        *err = f->err;
+    return f->status;
+}
+
+ps_status ps_feed_start(ps_feed *f, ps_error *err)
+{
+    if (pthread_create(&f->thread, NULL, feed_main, f) != 0)
+        return ps_error_set(err, PS_ERR_NOMEM, "could not start the photon tracing thread");
+    f->started = true;
+    return PS_OK;
+}
+
+void ps_feed_stop(ps_feed *f)
+{
+    pthread_mutex_lock(&f->lock);
+    f->stop = true;
+    pthread_cond_broadcast(&f->wake);
+    pthread_mutex_unlock(&f->lock);
+    if (f->started) {
+        pthread_join(f->thread, NULL);
+        f->started = false;
+    }
+}
+
+void ps_feed_pause(ps_feed *f, bool paused)
+{
+    pthread_mutex_lock(&f->lock);
+    f->paused = paused;
+    pthread_cond_broadcast(&f->wake);
+    pthread_mutex_unlock(&f->lock);
+}
+
+void ps_feed_lock(ps_feed *f) { pthread_mutex_lock(&f->lock); }
+void ps_feed_unlock(ps_feed *f) { pthread_mutex_unlock(&f->lock); }
+const ps_photon_map *ps_feed_maps(const ps_feed *f) { return f->maps; }
+bool ps_feed_ended(const ps_feed *f) { return f->ended; }
+
+ps_status ps_feed_status(const ps_feed *f, ps_error *err)
+{
+    if (f->status != PS_OK && err)
+        *err = f->err;
+    return f->status;
+}
+
+double ps_feed_seconds(const ps_feed *f) { return f->seconds; }
+uint64_t ps_feed_cap(const ps_feed *f, ps_map_kind k) { return f->cap[k]; }
+bool ps_feed_active(const ps_feed *f, ps_map_kind k) { return f->active[k]; }
+
+void ps_feed_destroy(ps_feed *f)
+{
+    if (!f)
+        return;
+    ps_feed_stop(f);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_free(&f->maps[k]);
+    pthread_cond_destroy(&f->wake);
+    pthread_mutex_destroy(&f->lock);
+    free(f);
+}

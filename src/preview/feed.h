@@ -1,0 +1,56 @@
+/* feed.h: photons for the progressive preview (thesis 4.1.4): a thread that
+ * traces both maps in rounds and hands each batch over under a lock, while
+ * the drawing thread takes what has arrived every tau.
+ *
+ * Photon i is the same whatever the timing (tracer.h), so the photons a
+ * frame shows are always a prefix of each map's index range: the picture
+ * after n photons is the same picture, however fast they came. Powers are
+ * normalised for each map's cap N; a frame that has n of them scales by N/n. */
+#ifndef PS_PREVIEW_FEED_H
+#define PS_PREVIEW_FEED_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/status.h"
+#include "photon/tracer.h"
+
+/* Photons traced per round for the larger map (the other in proportion):
+ * enough to keep the tracer's threads busy, few enough that a refresh every
+ * tau sees recent ones. */
+#define PS_FEED_BATCH 16384
+
+typedef struct ps_feed ps_feed;
+
+/* A feed of tracer t (which must outlive it) for caps[k] photons of each map
+ * whose active[k] is set. Nothing is traced until run or start. */
+ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const bool active[PS_MAP_COUNT],
+                         ps_feed **out, ps_error *err);
+/* Stops (and joins) a started feed first. Accepts NULL. */
+void ps_feed_destroy(ps_feed *f);
+
+/* Traces everything on the calling thread. */
+ps_status ps_feed_run(ps_feed *f, ps_error *err);
+/* Traces in a background thread until done, stopped, or an error. */
+ps_status ps_feed_start(ps_feed *f, ps_error *err);
+/* Asks the thread to stop after its current batch and waits for it. */
+void ps_feed_stop(ps_feed *f);
+/* Holds the thread between batches (true) or lets it go on. */
+void ps_feed_pause(ps_feed *f, bool paused);
+
+/* Between lock and unlock the maps do not change or move. */
+void ps_feed_lock(ps_feed *f);
+void ps_feed_unlock(ps_feed *f);
+/* Under the lock: both maps as they stand, and whether the feed has ended
+ * (every cap reached, stopped, or failed). */
+const ps_photon_map *ps_feed_maps(const ps_feed *f);
+bool ps_feed_ended(const ps_feed *f);
+
+/* After the feed has ended: how it ended (an error from the tracer, or
+ * PS_OK), and the seconds it spent tracing. */
+ps_status ps_feed_status(const ps_feed *f, ps_error *err);
+double ps_feed_seconds(const ps_feed *f);
+uint64_t ps_feed_cap(const ps_feed *f, ps_map_kind k);
+bool ps_feed_active(const ps_feed *f, ps_map_kind k);
+
+#endif
