@@ -62,7 +62,11 @@ static bool begin_range(builder *b, uint32_t object, uint32_t material)
     return true;
 }
 
-static void end_range(builder *b) { b->m->ranges[b->m->range_count - 1].count = b->m->vertex_count - b->m->ranges[b->m->range_count - 1].first; }
+static void end_range(builder *b)
+{
+    ps_mesh_range *r = &b->m->ranges[b->m->range_count - 1];
+    r->count = b->m->vertex_count - r->first;
+}
 
 /* Barycentric point (a, b) of triangle (p0, p1, p2) with its interpolated unit normal. */
 static void corner(const ps_vec3 p[3], const ps_vec3 n[3], double a, double c, ps_vec3 *pos, ps_vec3 *nrm)

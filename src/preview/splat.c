@@ -19,7 +19,7 @@ const char *ps_precision_name(ps_precision p) { return (unsigned)p < PS_PRECISIO
 ps_status ps_kernel_texture_make(ps_kernel k, int size, ps_kernel_texture *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
-    if (size < 2 || size > 4096)
+    if (size < 3 || size > 4096) /* extent = size / (size - 2) needs 3 */
         return ps_error_set(err, PS_ERR_RANGE, "kernel texture: size %d out of range", size);
     out->alpha = malloc((size_t)size * (size_t)size);
     if (!out->alpha)
@@ -80,6 +80,12 @@ static bool group_splats(ps_splat_batch *b, size_t first, size_t per)
 {
     size_t n = b->splats - first;
     size_t count[PS_SPLAT_GROUPS + 1] = {0};
+    b->grouped = true;
+    if (n == 0) { /* nothing drawn: every group empty */
+        for (int g = 0; g <= PS_SPLAT_GROUPS; g++)
+            b->group_first[g] = first * per;
+        return true;
+    }
     for (size_t i = 0; i < n; i++)
         count[b->group[first + i] + 1]++;
     for (int g = 0; g < PS_SPLAT_GROUPS; g++)
@@ -191,6 +197,11 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
         double cos_v = ps_v3_dot(wo, n);
         if (cos_v <= 0.0)
             continue; /* the other face of a two-sided surface */
+        /* Behind the eye or in its plane: GL clips it anyway, and its point
+         * footprint would be negative or zero (a NaN or negative carry). */
+        double depth = -ps_v3_dot(to_eye, cam->forward);
+        if (!(depth > 0.0))
+            continue;
         /* A diffuse BRDF needs no direction (and decoding one is half the
          * cost of a point splat). */
         const ps_material *mat = &p->materials[materials[i]];
@@ -203,7 +214,6 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
              * subtends side^2 pixel^2 cos^3(a) at angle a off the axis; at
              * distance dist = depth / cos(a) that is side^2 pixel^2 depth^2
              * cos(a) across the ray, and 1 / cos_v more along the surface. */
-            double depth = ps_v3_dot(ps_v3_neg(to_eye), cam->forward);
             double side = p->point_size * pixel * depth;
             double area = side * side * (depth / dist) / fmax(cos_v, PS_SPLAT_MIN_COS);
             c = ps_rgb_scale(c, 1.0 / area);
@@ -231,7 +241,7 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
             /* The equilateral triangle around the disc of radius r: corners
              * at 2r, at 90, 210 and 330 degrees; the texture's unit square
              * spans [-extent r, extent r]^2, so texcoords run 0.5 + cos / extent. */
-            double tex = 1.0 / p->kernel_extent;
+            double tex = p->kernel_extent > 0.0 ? 1.0 / p->kernel_extent : 1.0;
             static const double cs[3][2] = {{0.0, 1.0}, {-0.86602540378443865, -0.5}, {0.86602540378443865, -0.5}};
             ps_vec3 x, y;
             ps_splat_basis(n, &x, &y);
