@@ -41,12 +41,19 @@ LIB_C := $(filter-out src/app/%_main.c src/gl/%,$(wildcard src/*/*.c))
 LIB_CXX := $(wildcard src/*/*.cpp)
 GL_C := $(wildcard src/gl/*.c)
 MAINS := $(wildcard src/app/*_main.c)
-PROGS := $(patsubst src/app/%_main.c,photosplat-%,$(MAINS))
-GL_PROGS := photosplat-snap
+# window_main.c is the preview window, bin/photosplat; every other NAME_main.c
+# is bin/photosplat-NAME.
+PROGS := $(patsubst src/app/%_main.c,photosplat-%,$(filter-out src/app/window_main.c,$(MAINS))) photosplat
+GL_PROGS := photosplat-snap photosplat
 TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c))
+# Small programs the command-line tests use (tests/tool_*.c), not tests themselves.
+TOOLS := $(patsubst tests/%.c,%,$(wildcard tests/tool_*.c))
 GL_TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_gl*.c))
 OSMESA_CFLAGS := $(shell pkg-config --cflags osmesa 2>/dev/null) -DGL_GLEXT_PROTOTYPES
 OSMESA_LIBS := $(shell pkg-config --libs osmesa 2>/dev/null)
+# The window: GLFW with libGL, never OSMesa in the same program (platform notes).
+WINDOW_CFLAGS := $(shell pkg-config --cflags glfw3 gl 2>/dev/null) -DGL_GLEXT_PROTOTYPES
+WINDOW_LIBS := $(shell pkg-config --libs glfw3 gl 2>/dev/null)
 
 # variant-rules(VARIANT): objects, library, programs and tests of one variant.
 define variant-rules
@@ -73,6 +80,12 @@ build/$(1)/obj/gl/%.o: src/gl/%.c
 build/$(1)/bin/photosplat-snap: build/$(1)/obj/app/snap_main.o $$(GLLIB_$(1)) $$(LIB_$(1))
 	@mkdir -p $$(@D)
 	$$(CC) $$(LDOPT_$(1)) $$^ -o $$@ $$(OSMESA_LIBS) $$(LIBS)
+build/$(1)/bin/photosplat: build/$(1)/obj/app/window_main.o $$(GLLIB_$(1)) $$(LIB_$(1))
+	@mkdir -p $$(@D)
+	$$(CC) $$(LDOPT_$(1)) $$^ -o $$@ $$(WINDOW_LIBS) $$(LIBS)
+build/$(1)/obj/app/window_main.o: src/app/window_main.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc $$(PKG_CFLAGS) $$(WINDOW_CFLAGS) -MMD -MP -c $$< -o $$@
 build/$(1)/obj/app/snap_main.o: src/app/snap_main.c
 	@mkdir -p $$(@D)
 	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc $$(PKG_CFLAGS) $$(OSMESA_CFLAGS) -MMD -MP -c $$< -o $$@
@@ -101,8 +114,8 @@ bin/%: build/release/bin/%
 .PHONY: all deps test check run run-built bench clean build-tests
 all: $(addprefix bin/,$(PROGS))
 
-build-tests: all $(addprefix build/release/tests/,$(TESTS)) \
-             $(addprefix build/asan/tests/,$(TESTS)) $(addprefix build/asan/bin/,$(PROGS))
+build-tests: all $(addprefix build/release/tests/,$(TESTS) $(TOOLS)) \
+             $(addprefix build/asan/tests/,$(TESTS) $(TOOLS)) $(addprefix build/asan/bin/,$(PROGS))
 
 deps:
 	@scripts/install-deps.sh
@@ -154,12 +167,20 @@ SCENE ?= data/scenes/cornell-caustic.scn
 # exposure maps them into the PNG's range.
 EXPOSURE ?= 0.3
 RUN_PNG ?= out/default.png
-# Until the preview window exists (issue 6), `make run` renders the scene with
-# the reference renderer, headless, and says where the PNG went.
+# The window when there is a display; else the same preview headless
+# (photosplat-snap, 2 s of refinement) to a PNG, and where it went.
 run-built:
-	@mkdir -p $(dir $(RUN_PNG))
-	bin/photosplat-ref $(SCENE) -o $(RUN_PNG) --exposure $(EXPOSURE)
-	@echo "make run: the default scene, rendered headless by the reference renderer, is in $(RUN_PNG)"
+	@if [ -n "$${DISPLAY:-}" ] && bin/photosplat $(SCENE) --exposure $(EXPOSURE); then :; else \
+	    mkdir -p $(dir $(RUN_PNG)) && \
+	    bin/photosplat-snap $(SCENE) -o $(RUN_PNG) --exposure $(EXPOSURE) --time 2 \
+	        --caustic-photons 2000000 --global-photons 400000 && \
+	    echo "make run: no display: the default scene, previewed headless for 2 s, is in $(RUN_PNG)"; fi
+
+# Screenshots of the window for the README, under Xvfb.
+.PHONY: screenshots
+screenshots: deps
+	@$(MAKE) --no-print-directory -j$(JOBS) all
+	@scripts/screenshots.sh
 
 clean:
 	rm -rf build bin

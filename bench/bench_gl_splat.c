@@ -207,7 +207,7 @@ static int first_picture_run(bench_gl *g, double t[STAGE_COUNT], double warm[3],
     if (ps_kernel_texture_make(PS_KERNEL_CONE, PS_KERNEL_TEXTURE_SIZE, &g->kernel, err) != PS_OK)
         goto done;
     STAGE();
-    ps_gl_options gopt = {true, false};
+    ps_gl_options gopt = {true, false, 0};
     if (ps_gl_renderer_create(g->scene, &g->mesh, &g->kernel, &gopt, &g->gl, err) != PS_OK)
         goto done;
     glFinish();

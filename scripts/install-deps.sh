@@ -20,6 +20,11 @@ need_pc tinyobjloader libtinyobjloader-dev
 need_pc cmocka libcmocka-dev
 # photosplat-snap draws with OSMesa (libosmesa6-dev brings the GL headers too).
 need_pc osmesa libosmesa6-dev
+# The window: GLFW and libGL; its tests run it under a virtual X server.
+need_pc glfw3 libglfw3-dev
+need_pc gl libgl-dev
+need_cmd xvfb-run xvfb
+need_cmd xauth xauth
 # The sanitizer runtimes come with gcc on Debian but may be trimmed from images.
 [ -e "$(gcc -print-file-name=libasan.so 2>/dev/null)" ] && gcc -print-file-name=libasan.so | grep -q / || missing+=(libasan8)
 [ -e "$(gcc -print-file-name=libubsan.so 2>/dev/null)" ] && gcc -print-file-name=libubsan.so | grep -q / || missing+=(libubsan1)

@@ -54,7 +54,7 @@ static void preview_make(preview *out, const char *text, int w, int h, ps_kernel
     assert_non_null(p.ctx);
     p.buffer = malloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
     assert_true(OSMesaMakeCurrent(p.ctx, p.buffer, GL_FLOAT, w, h));
-    ps_gl_options go = {true, true};
+    ps_gl_options go = {true, true, 0};
     *pp = p;
     assert_int_equal(ps_gl_renderer_create(pp->scene, &pp->mesh, &pp->kernel, &go, &pp->gl, &err), PS_OK);
     pp->cam = ps_camera_frame_make(ps_scene_camera(pp->scene), w, h);

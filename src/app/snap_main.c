@@ -292,7 +292,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         st = ps_preview_mesh_build(scene, &mopt, &mesh, err);
     if (st == PS_OK)
         st = ps_kernel_texture_make((ps_kernel)o->kernel, PS_KERNEL_TEXTURE_SIZE, &s.kernel, err);
-    ps_gl_options gopt = {o->shadows != 0, o->color_depth != 0};
+    ps_gl_options gopt = {o->shadows != 0, o->color_depth != 0, 0};
     if (st == PS_OK)
         st = ps_gl_renderer_create(scene, &mesh, &s.kernel, &gopt, &s.gl, err);
 

@@ -39,6 +39,11 @@ typedef struct vlight {
 struct ps_gl_renderer {
     const ps_scene *scene;
     const ps_preview_mesh *mesh;
+    /* The scene's own triangles, not subdivided: what depth-only passes (the
+     * prepass, shadow maps) draw. Subdividing changes no depth, only the
+     * number of vertices lit, so these are many times cheaper. */
+    ps_preview_mesh coarse;
+    int shadow_size;
     const ps_material *materials;
     ps_gl_options opt;
     vlight *lights;
@@ -252,7 +257,7 @@ static ps_status build_lights(ps_gl_renderer *r, ps_error *err)
  * each object writes its stencil value (ps_splat_stencil). */
 static void draw_mesh_stencil(const ps_gl_renderer *r, bool with_materials, bool stencil)
 {
-    const ps_preview_mesh *m = r->mesh;
+    const ps_preview_mesh *m = with_materials ? r->mesh : &r->coarse;
     glEnableClientState(GL_VERTEX_ARRAY);
     glVertexPointer(3, GL_FLOAT, 0, m->positions);
     if (with_materials) {
@@ -329,7 +334,7 @@ static void make_shadow_maps(ps_gl_renderer *r)
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
-    glViewport(0, 0, PS_GL_SHADOW_SIZE, PS_GL_SHADOW_SIZE);
+    glViewport(0, 0, r->shadow_size, r->shadow_size);
     glDrawBuffer(GL_NONE);
     glReadBuffer(GL_NONE);
     glEnable(GL_DEPTH_TEST);
@@ -345,7 +350,7 @@ static void make_shadow_maps(ps_gl_renderer *r)
             if (!v->shadow[f]) {
                 glGenTextures(1, &v->shadow[f]);
                 glBindTexture(GL_TEXTURE_2D, v->shadow[f]);
-                glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, PS_GL_SHADOW_SIZE, PS_GL_SHADOW_SIZE, 0,
+                glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, r->shadow_size, r->shadow_size, 0,
                              GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, NULL);
                 glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
                 glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -372,9 +377,8 @@ static void make_shadow_maps(ps_gl_renderer *r)
         }
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
+    /* Draw and read buffers are per framebuffer: rebinding restores them. */
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
-    glDrawBuffer(old_fbo ? GL_COLOR_ATTACHMENT0 : GL_BACK);
-    glReadBuffer(old_fbo ? GL_COLOR_ATTACHMENT0 : GL_BACK);
     glBindTexture(GL_TEXTURE_2D, 0);
     r->shadows_valid = true;
 }
@@ -676,7 +680,12 @@ ps_status ps_gl_renderer_create(const ps_scene *s, const ps_preview_mesh *mesh, 
     r->scene_diag = ps_v3_len(ps_aabb_diag(r->bounds));
     if (!(r->scene_diag > 0.0) || !isfinite(r->scene_diag))
         r->scene_diag = 1.0;
-    ps_status st = build_lights(r, err);
+    r->shadow_size = o->shadow_size > 0 ? o->shadow_size : PS_GL_SHADOW_SIZE;
+    ps_mesh_options coarse = ps_mesh_default_options(s);
+    coarse.max_edge = HUGE_VAL;
+    ps_status st = ps_preview_mesh_build(s, &coarse, &r->coarse, err);
+    if (st == PS_OK)
+        st = build_lights(r, err);
     if (st != PS_OK) {
         ps_gl_renderer_destroy(r);
         return st;
@@ -706,5 +715,166 @@ void ps_gl_renderer_destroy(ps_gl_renderer *r)
     if (r->kernel_tex)
         glDeleteTextures(1, &r->kernel_tex);
     free(r->lights);
+    ps_preview_mesh_free(&r->coarse);
     free(r);
+}
+
+/* ---- layers kept between frames (the window's incremental refresh) -------- */
+
+enum { LAYER_DIRECT_TEX, LAYER_CAUSTIC_TEX, LAYER_GLOBAL_TEX, LAYER_FINAL_TEX, LAYER_TEX_COUNT };
+
+struct ps_gl_layers {
+    int width, height;
+    bool float_buffers;
+    GLuint tex[LAYER_TEX_COUNT], fbo[LAYER_TEX_COUNT], depth_stencil;
+};
+
+ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_layers **out, ps_error *err)
+{
+    *out = NULL;
+    ps_gl_layers *l = calloc(1, sizeof *l);
+    if (!l)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the GL layers");
+    l->width = width;
+    l->height = height;
+    l->float_buffers = float_buffers;
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    /* One depth-stencil buffer for all: the prepass drawn once serves every
+     * layer's depth test and stencil clipping. */
+    glGenRenderbuffers(1, &l->depth_stencil);
+    glBindRenderbuffer(GL_RENDERBUFFER, l->depth_stencil);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, width, height);
+    glGenTextures(LAYER_TEX_COUNT, l->tex);
+    glGenFramebuffers(LAYER_TEX_COUNT, l->fbo);
+    bool complete = true;
+    for (int i = 0; i < LAYER_TEX_COUNT; i++) {
+        glBindTexture(GL_TEXTURE_2D, l->tex[i]);
+        /* The final picture is always float: it is read back and encoded
+         * (exposure, sRGB) on the CPU exactly as photosplat-snap does. */
+        bool is_float = float_buffers || i == LAYER_FINAL_TEX;
+        glTexImage2D(GL_TEXTURE_2D, 0, is_float ? GL_RGBA32F : GL_RGBA8, width, height, 0, GL_RGBA,
+                     is_float ? GL_FLOAT : GL_UNSIGNED_BYTE, NULL);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[i]);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, l->tex[i], 0);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, l->depth_stencil);
+        complete = complete && glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    if (!complete) {
+        ps_gl_layers_destroy(l);
+        return ps_error_set(err, PS_ERR_IO, "the GL implementation cannot render to %s textures of %dx%d",
+                            float_buffers ? "RGBA32F" : "RGBA8", width, height);
+    }
+    *out = l;
+    return PS_OK;
+}
+
+void ps_gl_layers_destroy(ps_gl_layers *l)
+{
+    if (!l)
+        return;
+    glDeleteFramebuffers(LAYER_TEX_COUNT, l->fbo);
+    glDeleteTextures(LAYER_TEX_COUNT, l->tex);
+    glDeleteRenderbuffers(1, &l->depth_stencil);
+    free(l);
+}
+
+void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_DIRECT_TEX]);
+    ps_gl_begin_frame(r, cam, exposure, direct);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_gl_layers_clear_map(l, k);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
+void ps_gl_layers_clear_map(ps_gl_layers *l, int map)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_CAUSTIC_TEX + map]);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT); /* colour only: the shared depth is the view's */
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
+void ps_gl_layers_add(ps_gl_layers *l, ps_gl_renderer *r, int map, const ps_splat_batch *b, ps_splat_mode mode,
+                      double radius, double point_size)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_CAUSTIC_TEX + map]);
+    glViewport(0, 0, l->width, l->height);
+    ps_gl_draw_splats(r, b, mode, radius, point_size);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
+/* A screen-filling quad of texture t times gain, added to what is there. */
+static void add_texture(GLuint t, double gain)
+{
+    glBindTexture(GL_TEXTURE_2D, t);
+    glColor4f((GLfloat)gain, (GLfloat)gain, (GLfloat)gain, 1.0f);
+    glBegin(GL_QUADS);
+    glTexCoord2f(0, 0), glVertex2f(-1, -1);
+    glTexCoord2f(1, 0), glVertex2f(1, -1);
+    glTexCoord2f(1, 1), glVertex2f(1, 1);
+    glTexCoord2f(0, 1), glVertex2f(-1, 1);
+    glEnd();
+}
+
+ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
+                                 ps_image *out, ps_error *err)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_FINAL_TEX]);
+    glViewport(0, 0, l->width, l->height);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    /* Gains above 1 (N/n early on) must not clamp on the way. */
+    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
+    glMatrixMode(GL_PROJECTION);
+    glLoadIdentity();
+    glMatrixMode(GL_MODELVIEW);
+    glLoadIdentity();
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_LIGHTING);
+    glEnable(GL_TEXTURE_2D);
+    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    add_texture(l->tex[LAYER_DIRECT_TEX], direct_gain);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        if (map_gain[k] > 0.0)
+            add_texture(l->tex[LAYER_CAUSTIC_TEX + k], map_gain[k]);
+    glDisable(GL_BLEND);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glDisable(GL_TEXTURE_2D);
+    ps_status st = ps_image_create(l->width, l->height, out, err);
+    float *rows = st == PS_OK ? malloc(sizeof(float) * 3 * (size_t)l->width * (size_t)l->height) : NULL;
+    if (st == PS_OK && !rows) {
+        ps_image_destroy(out);
+        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory reading the picture back");
+    }
+    if (st == PS_OK) {
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadPixels(0, 0, l->width, l->height, GL_RGB, GL_FLOAT, rows);
+        for (int y = 0; y < l->height; y++)
+            memcpy(ps_image_at(out, 0, y), rows + 3 * (size_t)(l->height - 1 - y) * (size_t)l->width,
+                   sizeof(float) * 3 * (size_t)l->width);
+    }
+    free(rows);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    return st;
 }

@@ -32,6 +32,7 @@
 
 #include "core/status.h"
 #include "image/image.h"
+#include "photon/photon.h"
 #include "preview/mesh.h"
 #include "preview/splat.h"
 #include "scene/camera.h"
@@ -43,11 +44,13 @@
 typedef struct ps_gl_renderer ps_gl_renderer;
 
 typedef struct ps_gl_options {
-    bool shadows;   /* default true */
+    bool shadows;      /* default true */
     bool float_buffer; /* the colour buffer keeps floats: no clamping anywhere */
+    int shadow_size;   /* shadow maps' side in texels; 0: PS_GL_SHADOW_SIZE */
 } ps_gl_options;
 
-/* The scene's mesh (mesh must outlive the renderer) and its lights; the kernel
+/* The scene's fine mesh for lighting (it must outlive the renderer; the
+ * renderer makes its own coarse one for depth-only passes) and its lights; the kernel
  * texture is uploaded for the splats. Needs a current context. */
 ps_status ps_gl_renderer_create(const ps_scene *s, const ps_preview_mesh *mesh, const ps_kernel_texture *kernel,
                                 const ps_gl_options *o, ps_gl_renderer **out, ps_error *err);
@@ -73,6 +76,32 @@ void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode
 /* Reads the colour buffer into out (created here; row 0 the top), as stored:
  * radiance times exposure. */
 ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err);
+
+/* ---- layers kept between frames -------------------------------------------
+ * The window refreshes incrementally (issue: a refresh draws only the photons
+ * that arrived since the last one): the direct layer and each map's splats
+ * live in their own textures behind framebuffer objects, sharing one
+ * depth-stencil buffer that holds the view's prepass. With float buffers the
+ * splats accumulate at their stored power and the composite scales each map
+ * by N/n, so old splats never need redrawing; with 8-bit buffers that would
+ * lose every faint photon (thesis 5.1), so the caller clears a map's layer
+ * and redraws all of it, already scaled, each refresh. The composite is read
+ * back as radiance times exposure, for the same CPU encoding as snapshots. */
+typedef struct ps_gl_layers ps_gl_layers;
+
+ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_layers **out, ps_error *err);
+void ps_gl_layers_destroy(ps_gl_layers *l);
+/* A new view: the direct layer (times exposure) or black, the prepass, and
+ * empty map layers. */
+void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct);
+void ps_gl_layers_clear_map(ps_gl_layers *l, int map);
+/* Adds splats to a map's layer, tested against the view's depth and stencil. */
+void ps_gl_layers_add(ps_gl_layers *l, ps_gl_renderer *r, int map, const ps_splat_batch *b, ps_splat_mode mode,
+                      double radius, double point_size);
+/* direct * direct_gain + sum of map * map_gain[map], read back into out
+ * (created here; row 0 the top). */
+ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
+                                 ps_image *out, ps_error *err);
 
 /* What ran: shadow maps made so far and lighting passes in the last frame. */
 typedef struct ps_gl_stats {

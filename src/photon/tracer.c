@@ -294,7 +294,7 @@ static ps_status plan_maps(ps_tracer *t, ps_error *err)
     return PS_OK;
 }
 
-static int online_cores(void)
+int ps_online_cores(void)
 {
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     return n < 1 ? 1 : n > PS_TRACER_MAX_THREADS ? PS_TRACER_MAX_THREADS : (int)n;
@@ -313,7 +313,7 @@ ps_status ps_tracer_create(const ps_world *w, const ps_tracer_options *opt, ps_t
     t->materials = ps_scene_materials(s, &nm);
     t->opt = opt ? *opt : ps_tracer_default_options();
     t->threads = t->opt.threads > 0 ? (t->opt.threads < PS_TRACER_MAX_THREADS ? t->opt.threads : PS_TRACER_MAX_THREADS)
-                                    : online_cores();
+                                    : ps_online_cores();
     ps_status st = ps_light_sampler_create(s, &t->lights, err);
     if (st == PS_OK)
         st = plan_maps(t, err);

@@ -45,6 +45,10 @@ typedef struct ps_tracer_options {
                           * irradiance for final gathering needs all of the light. */
 } ps_tracer_options;
 
+/* Online cores, at least 1 and at most PS_TRACER_MAX_THREADS: the default
+ * thread count. */
+int ps_online_cores(void);
+
 /* seed 0, all cores, cones and the first-hit test on. */
 ps_tracer_options ps_tracer_default_options(void);
 

@@ -6,6 +6,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "core/array.h"
+
 struct ps_feed {
     ps_tracer *tracer;
     uint64_t cap[PS_MAP_COUNT];
@@ -13,6 +15,8 @@ struct ps_feed {
     pthread_mutex_t lock;
     pthread_cond_t wake;              /* signalled when pause or stop change */
     ps_photon_map maps[PS_MAP_COUNT]; /* under lock: what has arrived */
+    ps_feed_mark *marks[PS_MAP_COUNT];  /* under lock: batch ends */
+    size_t mark_count[PS_MAP_COUNT], mark_cap[PS_MAP_COUNT];
     bool stop, paused, ended;         /* under lock */
     bool started;
     pthread_t thread;
@@ -55,9 +59,14 @@ static ps_status batch(ps_feed *f, int k, uint64_t first, uint64_t count, ps_err
     ps_photon_map_init(&local, (ps_map_kind)k);
     ps_status st = ps_tracer_trace(f->tracer, (ps_map_kind)k, first, count, f->cap[k], &local, err);
     pthread_mutex_lock(&f->lock);
-    if (st == PS_OK && !ps_photon_map_append(&f->maps[k], &local))
+    if (st == PS_OK && (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1) ||
+                        !ps_photon_map_append(&f->maps[k], &local)))
         st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for %llu more photons",
                           (unsigned long long)local.count);
+    if (st == PS_OK) {
+        ps_feed_mark m = {f->maps[k].count, f->maps[k].counters.emitted};
+        f->marks[k][f->mark_count[k]++] = m;
+    }
     pthread_mutex_unlock(&f->lock);
     ps_photon_map_free(&local);
     return st;
@@ -150,6 +159,12 @@ void ps_feed_unlock(ps_feed *f) { pthread_mutex_unlock(&f->lock); }
 const ps_photon_map *ps_feed_maps(const ps_feed *f) { return f->maps; }
 bool ps_feed_ended(const ps_feed *f) { return f->ended; }
 
+const ps_feed_mark *ps_feed_marks(const ps_feed *f, ps_map_kind k, size_t *count)
+{
+    *count = f->mark_count[k];
+    return f->marks[k];
+}
+
 ps_status ps_feed_status(const ps_feed *f, ps_error *err)
 {
     if (f->status != PS_OK && err)
@@ -166,8 +181,10 @@ void ps_feed_destroy(ps_feed *f)
     if (!f)
         return;
     ps_feed_stop(f);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_photon_map_free(&f->maps[k]);
+        free(f->marks[k]);
+    }
     pthread_cond_destroy(&f->wake);
     pthread_mutex_destroy(&f->lock);
     free(f);

@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "core/status.h"
+#include <stddef.h>
 #include "photon/tracer.h"
 
 /* Photons traced per round for the larger map (the other in proportion):
@@ -45,6 +46,15 @@ void ps_feed_unlock(ps_feed *f);
  * (every cap reached, stopped, or failed). */
 const ps_photon_map *ps_feed_maps(const ps_feed *f);
 bool ps_feed_ended(const ps_feed *f);
+
+/* Under the lock: where each handed-over batch of map k ended, as (stored
+ * photons, emitted photons) pairs in order. A frame that draws a prefix of
+ * the map ending at one of them knows the n to scale by: emitted. */
+typedef struct ps_feed_mark {
+    size_t stored;
+    uint64_t emitted;
+} ps_feed_mark;
+const ps_feed_mark *ps_feed_marks(const ps_feed *f, ps_map_kind k, size_t *count);
 
 /* After the feed has ended: how it ended (an error from the tracer, or
  * PS_OK), and the seconds it spent tracing. */

@@ -1,6 +1,11 @@
-/* scene.c: scene storage, accessors and derived quantities. */
+/* scene.c: scene storage, accessors, derived quantities, edits and copies. */
 #include "scene/scene_internal.h"
 
+#include <inttypes.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -107,16 +112,273 @@ void ps_scene_update_object(ps_scene *s, uint32_t index)
     }
 }
 
-void ps_scene_finish(ps_scene *s)
+/* The scene's box from the objects' (current) bounds and the lights. */
+static ps_aabb scene_bounds(const ps_scene *s)
 {
     ps_aabb all = ps_aabb_empty();
-    for (size_t o = 0; o < s->objects.count; o++) {
-        ps_scene_update_object(s, (uint32_t)o);
+    for (size_t o = 0; o < s->objects.count; o++)
         all = ps_aabb_union(all, s->objects.items[o].bounds);
-    }
     for (size_t i = 0; i < s->lights.count; i++)
         all = ps_aabb_union(all, light_bounds(&s->lights.items[i]));
-    s->bounds = all;
+    return all;
+}
+
+void ps_scene_finish(ps_scene *s)
+{
+    for (size_t o = 0; o < s->objects.count; o++)
+        ps_scene_update_object(s, (uint32_t)o);
+    s->bounds = scene_bounds(s);
+}
+
+/* ---- editing ----------------------------------------------------------------------
+ *
+ * Every edit checks all it will write before writing anything, so that a
+ * refused edit leaves the scene as it was, byte for byte; nothing is undone
+ * (x + d - d need not be x). */
+
+/* "file:line: light 3" + the rest (which brings its own ": " or " is ..."). */
+static ps_status refuse(ps_error *err, const ps_scene *s, const char *what, size_t index, int line,
+                        const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 6, 7)))
+#endif
+    ;
+
+static ps_status refuse(ps_error *err, const ps_scene *s, const char *what, size_t index, int line,
+                        const char *fmt, ...)
+{
+    char rest[PS_ERROR_MSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(rest, sizeof rest, fmt, ap);
+    va_end(ap);
+    return ps_error_set(err, PS_ERR_RANGE, "%s:%d: %s %zu%s", s->path, line, what, index, rest);
+}
+
+static bool index_exists(const ps_scene *s, const char *what, size_t index, size_t count, ps_error *err)
+{
+    if (index < count)
+        return true;
+    ps_error_set(err, PS_ERR_RANGE, "%s: %s %zu does not exist (the scene has %zu %s%s)", s->path, what, index, count,
+                 what, count == 1 ? "" : "s");
+    return false;
+}
+
+static bool aabb_isfinite(ps_aabb b) { return ps_v3_isfinite(b.lo) && ps_v3_isfinite(b.hi); }
+
+/* Area of triangle t with its corners moved by d, computed as
+ * ps_scene_triangle_area computes it once they are stored there. */
+static double moved_area(const ps_scene *s, uint32_t t, ps_vec3 d)
+{
+    const ps_triangle *tr = &s->triangles.items[t];
+    ps_vec3 p0 = ps_v3_add(s->positions.items[tr->v[0]], d);
+    ps_vec3 p1 = ps_v3_add(s->positions.items[tr->v[1]], d);
+    ps_vec3 p2 = ps_v3_add(s->positions.items[tr->v[2]], d);
+    return 0.5 * ps_v3_len(ps_v3_cross(ps_v3_sub(p1, p0), ps_v3_sub(p2, p0)));
+}
+
+/* An emissive mesh's area with its faces moved by d, summed in the loader's
+ * order; 0 when a face would collapse (the loader keeps only faces of positive
+ * area as emitters, and samples them by area). */
+static double moved_mesh_light_area(const ps_scene *s, const ps_light *l, ps_vec3 d)
+{
+    double area = 0.0;
+    for (uint32_t e = l->first_emitter; e < l->first_emitter + l->emitter_count; e++) {
+        double a = moved_area(s, s->emitters.items[e], d);
+        if (!(a > 0.0))
+            return 0.0;
+        area += a;
+    }
+    return area;
+}
+
+ps_status ps_scene_set_light_position(ps_scene *s, size_t light, ps_vec3 position, ps_error *err)
+{
+    if (!index_exists(s, "light", light, s->lights.count, err))
+        return PS_ERR_RANGE;
+    ps_light *l = &s->lights.items[light];
+    if (l->type == PS_LIGHT_MESH)
+        return refuse(err, s, "light", light, l->line, " is an emissive mesh: move its object (object %" PRIu32 ")",
+                      l->object);
+    if (!ps_v3_isfinite(position))
+        return refuse(err, s, "light", light, l->line, ": position (%g %g %g) is not finite", position.x, position.y,
+                      position.z);
+    ps_light moved = *l;
+    moved.position = position;
+    if (!aabb_isfinite(light_bounds(&moved)))
+        return refuse(err, s, "light", light, l->line, ": position (%g %g %g) takes the light out of range",
+                      position.x, position.y, position.z);
+    l->position = position;
+    s->bounds = scene_bounds(s);
+    ps_error_clear(err);
+    return PS_OK;
+}
+
+ps_status ps_scene_set_light_power(ps_scene *s, size_t light, ps_rgb power, ps_error *err)
+{
+    if (!index_exists(s, "light", light, s->lights.count, err))
+        return PS_ERR_RANGE;
+    ps_light *l = &s->lights.items[light];
+    if (!ps_rgb_isfinite(power))
+        return refuse(err, s, "light", light, l->line, ": power (%g %g %g) is not finite", power.r, power.g, power.b);
+    if (power.r < 0 || power.g < 0 || power.b < 0)
+        return refuse(err, s, "light", light, l->line, ": power (%g %g %g) must not be negative", power.r, power.g,
+                      power.b);
+    ps_rgb radiance = l->radiance;
+    if (l->area > 0.0) {
+        /* As the loader: a Lambertian emitter's flux is pi * L * area. */
+        radiance = ps_rgb_scale(power, 1.0 / (PS_PI * l->area));
+        if (!ps_rgb_isfinite(radiance))
+            return refuse(err, s, "light", light, l->line,
+                          ": power (%g %g %g) is too large for its area %g (the radiance would not be finite)",
+                          power.r, power.g, power.b, l->area);
+    }
+    if (l->type == PS_LIGHT_MESH) {
+        /* The faces are drawn and seen with their material's emission; that
+         * MTL material was made for this mesh statement and emits only here. */
+        uint32_t m = s->triangles.items[s->emitters.items[l->first_emitter]].material;
+        s->materials.items[m].emission = radiance;
+    }
+    l->power = power;
+    l->radiance = radiance;
+    ps_error_clear(err);
+    return PS_OK;
+}
+
+ps_status ps_scene_set_spot_angle(ps_scene *s, size_t light, double degrees, ps_error *err)
+{
+    if (!index_exists(s, "light", light, s->lights.count, err))
+        return PS_ERR_RANGE;
+    ps_light *l = &s->lights.items[light];
+    if (l->type != PS_LIGHT_SPOT)
+        return refuse(err, s, "light", light, l->line, " is a %s light, not a spot: only spots have an angle",
+                      ps_light_type_name(l->type));
+    if (!(degrees > 0.0 && degrees <= 90.0))
+        return refuse(err, s, "light", light, l->line, ": angle %g is not in (0, 90]", degrees);
+    l->angle_deg = degrees;
+    l->cos_angle = cos(degrees * (PS_PI / 180.0));
+    ps_error_clear(err);
+    return PS_OK;
+}
+
+ps_status ps_scene_translate_object(ps_scene *s, size_t object, ps_vec3 delta, ps_error *err)
+{
+    if (!index_exists(s, "object", object, s->objects.count, err))
+        return PS_ERR_RANGE;
+    ps_object *o = &s->objects.items[object];
+    if (!ps_v3_isfinite(delta))
+        return refuse(err, s, "object", object, o->line, ": delta (%g %g %g) is not finite", delta.x, delta.y,
+                      delta.z);
+
+    /* Check the object at its new place: every coordinate finite, quads not
+     * collapsed by rounding. Its vertices are one run [vlo, vhi] of positions
+     * (scene.h), unreferenced OBJ vertices inside it included. */
+    size_t vlo = SIZE_MAX, vhi = 0;
+    ps_vec3 center = ps_v3_add(o->center, delta);
+    ps_aabb moved = ps_aabb_empty();
+    if (o->type == PS_OBJ_SPHERE) {
+        ps_vec3 r = ps_v3(o->radius, o->radius, o->radius);
+        moved.lo = ps_v3_sub(center, r);
+        moved.hi = ps_v3_add(center, r);
+    } else {
+        for (uint32_t t = o->first_triangle; t < o->first_triangle + o->triangle_count; t++) {
+            const ps_triangle *tr = &s->triangles.items[t];
+            for (int c = 0; c < 3; c++) {
+                vlo = tr->v[c] < vlo ? tr->v[c] : vlo;
+                vhi = tr->v[c] > vhi ? tr->v[c] : vhi;
+                moved = ps_aabb_point(moved, ps_v3_add(s->positions.items[tr->v[c]], delta));
+            }
+        }
+        for (size_t v = vlo; v <= vhi && vlo != SIZE_MAX; v++)
+            if (!ps_v3_isfinite(ps_v3_add(s->positions.items[v], delta)))
+                return refuse(err, s, "object", object, o->line, ": moving by (%g %g %g) takes a vertex out of range",
+                              delta.x, delta.y, delta.z);
+        if (o->type == PS_OBJ_QUAD)
+            for (uint32_t t = o->first_triangle; t < o->first_triangle + o->triangle_count; t++)
+                if (!(moved_area(s, t, delta) > 0.0))
+                    return refuse(err, s, "object", object, o->line,
+                                  ": moving by (%g %g %g) would collapse it (coordinates too large for its size)",
+                                  delta.x, delta.y, delta.z);
+    }
+    if (!ps_v3_isfinite(center) || !aabb_isfinite(moved))
+        return refuse(err, s, "object", object, o->line, ": moving by (%g %g %g) takes it out of range", delta.x,
+                      delta.y, delta.z);
+    /* Its emissive mesh lights: faces still of positive area, their reference
+     * point (the centre of the object's box, as loaded) and power finite. */
+    for (size_t i = 0; i < s->lights.count; i++) {
+        const ps_light *l = &s->lights.items[i];
+        if (l->type != PS_LIGHT_MESH || l->object != object)
+            continue;
+        double area = moved_mesh_light_area(s, l, delta);
+        if (!(area > 0.0))
+            return refuse(err, s, "object", object, o->line,
+                          ": moving by (%g %g %g) would collapse the emitting faces of light %zu (coordinates too "
+                          "large for their size)",
+                          delta.x, delta.y, delta.z, i);
+        if (!ps_v3_isfinite(ps_aabb_center(moved)) || !ps_rgb_isfinite(ps_rgb_scale(l->radiance, PS_PI * area)))
+            return refuse(err, s, "object", object, o->line, ": moving by (%g %g %g) takes light %zu out of range",
+                          delta.x, delta.y, delta.z, i);
+    }
+
+    /* Move it: the same sums as the checks, so the same results. */
+    if (o->type == PS_OBJ_SPHERE)
+        o->center = center;
+    for (size_t v = vlo; v <= vhi && vlo != SIZE_MAX; v++)
+        s->positions.items[v] = ps_v3_add(s->positions.items[v], delta);
+    ps_scene_update_object(s, (uint32_t)object);
+    for (size_t i = 0; i < s->lights.count; i++) {
+        ps_light *l = &s->lights.items[i];
+        if (l->type != PS_LIGHT_MESH || l->object != object)
+            continue;
+        l->area = moved_mesh_light_area(s, l, ps_v3(0, 0, 0));
+        l->power = ps_rgb_scale(l->radiance, PS_PI * l->area);
+        l->position = ps_aabb_center(o->bounds);
+    }
+    s->bounds = scene_bounds(s);
+    ps_error_clear(err);
+    return PS_OK;
+}
+
+/* ---- copies ----------------------------------------------------------------------- */
+
+/* A copy of count items of elem bytes; NULL for none, or when *ok is or turns false. */
+static void *dup_items(const void *src, size_t count, size_t elem, bool *ok)
+{
+    if (!*ok || count == 0)
+        return NULL;
+    void *p = count <= SIZE_MAX / elem ? malloc(count * elem) : NULL;
+    if (!p) {
+        *ok = false;
+        return NULL;
+    }
+    return memcpy(p, src, count * elem);
+}
+
+ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err)
+{
+    *out = NULL;
+    ps_scene *c = malloc(sizeof *c);
+    if (!c)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
+    *c = *s; /* camera, defaults, bounds and the counts; every pointer replaced below */
+    bool ok = true;
+    c->path = dup_items(s->path, s->path ? strlen(s->path) + 1 : 0, 1, &ok);
+#define DUP_VEC(f) (c->f.items = dup_items(s->f.items, s->f.count, sizeof *s->f.items, &ok), c->f.cap = s->f.count)
+    DUP_VEC(materials);
+    DUP_VEC(positions);
+    DUP_VEC(normals);
+    DUP_VEC(triangles);
+    DUP_VEC(objects);
+    DUP_VEC(lights);
+    DUP_VEC(emitters);
+#undef DUP_VEC
+    if (!ok) {
+        ps_scene_destroy(c); /* what was not copied is NULL */
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
+    }
+    *out = c;
+    ps_error_clear(err);
+    return PS_OK;
 }
 
 const char *ps_material_type_name(ps_material_type t)

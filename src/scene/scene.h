@@ -55,7 +55,8 @@ static inline int ps_material_is_specular(const ps_material *m)
 }
 
 /* A triangle of the scene's one triangle soup. Vertices are per object (never
- * shared between objects), so moving an object moves only its own. */
+ * shared between objects) and each object's are one contiguous run of
+ * ps_scene_positions, so moving an object moves only its own. */
 typedef struct ps_triangle {
     uint32_t v[3];   /* indices into ps_scene_positions */
     int32_t n[3];    /* indices into ps_scene_normals, or -1: use the face normal */
@@ -151,6 +152,57 @@ ps_rgb ps_scene_total_power(const ps_scene *s);
 double ps_scene_triangle_area(const ps_scene *s, uint32_t t);
 /* Unit geometric normal of triangle t (from its winding: (v1-v0) x (v2-v0)). */
 ps_vec3 ps_scene_triangle_normal(const ps_scene *s, uint32_t t);
+
+/* ---- editing (the preview window) ----------------------------------------------
+ *
+ * Edits keep every invariant the loader establishes: numbers finite, flux
+ * consistent with geometry (area lights' radiance = power / (pi * area), a
+ * spot's cos_angle = cos(angle_deg)), object bounds and the scene's bounds
+ * (which include the lights) exact for the new geometry. The defaults
+ * (ps_scene_get_defaults) stay as the file gave them, even those derived from
+ * the scene's size: moving a light does not change the photon radii.
+ *
+ * Each edit checks its arguments (index in range, every number finite,
+ * power >= 0, angle in (0, 90], results finite) and, on error, returns
+ * PS_ERR_RANGE with one line naming the scene file, the scene line of the light
+ * or object and its index as given here (from 0):
+ *     "room.scn:12: light 3: angle 95 is not in (0, 90]"
+ *     "room.scn: light 7 does not exist (the scene has 3 lights)"
+ * and leaves the scene unchanged, byte for byte. On success err is cleared.
+ * Edits are not synchronised: edit a scene no other thread reads (give the
+ * window its own with ps_scene_clone). Views returned earlier stay valid. */
+
+/* Moves a light's reference point as the scene file writes it (point and spot
+ * `position`, quad `corner`, sphere and disc `center`) to `position`; the shape
+ * moves with it, its edges, normal, radius, area and radiance unchanged. An
+ * emissive mesh (PS_LIGHT_MESH) moves only with its object
+ * (ps_scene_translate_object): refused. */
+ps_status ps_scene_set_light_position(ps_scene *s, size_t light, ps_vec3 position, ps_error *err);
+
+/* Sets a light's total flux (W per channel, each >= 0). Area lights get
+ * radiance = power / (pi * area). An emissive mesh's faces shade with their
+ * material's emission, so that material's emission becomes the new radiance
+ * too (an emissive MTL material belongs to one mesh statement and so to this
+ * light alone). */
+ps_status ps_scene_set_light_power(ps_scene *s, size_t light, ps_rgb power, ps_error *err);
+
+/* Sets a spot light's half-angle in degrees, in (0, 90], and its cos_angle.
+ * Any other light type is refused. */
+ps_status ps_scene_set_spot_angle(ps_scene *s, size_t light, double degrees, ps_error *err);
+
+/* Moves an object by delta: a mesh's or quad's own vertices (normals
+ * unchanged), a sphere's centre; then its bounds and the scene's. The emissive
+ * mesh lights of the object move with it: their position (the centre of the
+ * object's bounds), area (the sum of their faces' areas, recomputed) and power
+ * (pi * area * radiance, as loaded). Refused when a coordinate would not be
+ * finite, or when rounding at the new place would collapse a quad or an
+ * emitting face to zero area (a delta far larger than the object). */
+ps_status ps_scene_translate_object(ps_scene *s, size_t object, ps_vec3 delta, ps_error *err);
+
+/* A deep copy, equal in every array and value, sharing nothing with s: the
+ * window edits its copy while the photon tracer of the previous frame still
+ * reads the old one. On failure (PS_ERR_NOMEM) *out is NULL. */
+ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err);
 
 const char *ps_material_type_name(ps_material_type t);
 const char *ps_light_type_name(ps_light_type t);
