@@ -62,7 +62,9 @@ echo "caustic peak at x = $x1 px before the light moved right, $x2 px after"
 awk_true "$x2 < $x1 - 3" && ok || bad "the caustic did not move left with the light: $x1 -> $x2"
 latency=$(stat_of edit_to_frame_seconds_max "$cli_tmp/session.json")
 echo "first frame after the move: $latency s (tau 0.1 s)"
-awk_true "$latency > 0 && $latency < 1.0" && ok || bad "the frame after the move came $latency s later (over 10 tau)"
+# Ten tau in the release build; the sanitizer build runs several times slower.
+if [[ $bin == *asan* ]]; then most=3.0; else most=1.0; fi
+awk_true "$latency > 0 && $latency < $most" && ok || bad "the frame after the move came $latency s later (over $most s)"
 [ "$(stat_of edits "$cli_tmp/session.json")" = 1 ] && ok || bad "stats do not count one edit"
 
 # The window and photosplat-snap draw the same picture for the same scene and
