@@ -801,7 +801,12 @@ static ps_status parse_light(parser *p)
     }
     if ((st = check_power(p, l.power)) != PS_OK)
         return st;
-    /* Lambertian area emitters: flux = pi * L * area. */
+    /* Lambertian area emitters: flux = pi * L * area. A size whose area
+     * overflows (a sphere of radius 1e200) would give radiance 0 from an
+     * infinite surface: refuse it. */
+    if (!isfinite(l.area))
+        return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: light %s: its area overflows (%g)", p->name, p->line, type,
+                            l.area);
     if (l.area > 0.0)
         l.radiance = ps_rgb_scale(l.power, 1.0 / (PS_PI * l.area));
     ps_light *dst = PS_VEC_PUSH(p->s->lights);
