@@ -5,6 +5,8 @@
 #include <time.h>
 
 #include "core/fileio.h"
+#include "photon/estimate.h"
+#include "preview/splat.h"
 
 void ps_shared_options_init(ps_shared_options *o)
 {
@@ -81,4 +83,76 @@ double ps_now_seconds(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void ps_preview_options_init(ps_preview_options *o, bool float_depth)
+{
+    memset(o, 0, sizeof *o);
+    o->tau = 0.1;
+    o->counter_threshold = 0.1;
+    o->point_size = 1.0;
+    o->splat = PS_SPLAT_TRIANGLES;
+    o->kernel = PS_KERNEL_CONE;
+    o->color_depth = float_depth ? 1 : 0;
+    o->precision = PS_PRECISION_DIFFUSION;
+    o->shadows = o->stencil_clip = 1;
+    o->layers = PS_LAYER_ALL;
+}
+
+ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_error *err)
+{
+    static const char *const names[3] = {"direct", "caustic", "global"};
+    *out = 0;
+    for (const char *p = text;;) {
+        const char *end = strchr(p, ',');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        int found = -1;
+        for (int k = 0; k < 3; k++)
+            if (strlen(names[k]) == len && strncmp(p, names[k], len) == 0)
+                found = k;
+        if (found < 0)
+            return ps_error_set(err, PS_ERR_PARSE, "%s: --layers: '%.*s' is not direct, caustic or global", prog,
+                                (int)len, p);
+        *out |= 1u << found;
+        if (!end)
+            return PS_OK;
+        p = end + 1;
+    }
+}
+
+bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_status *st, ps_error *err)
+{
+    static const char *const splats[] = {"points", "triangles", "sprites", NULL};
+    static const char *const kernels[] = {"box", "cone", "gauss", "epanechnikov", NULL};
+    static const char *const depths[] = {"8", "float", NULL};
+    static const char *const precisions[] = {"none", "diffusion", "counter", NULL};
+    static const char *const on_off[] = {"off", "on", NULL};
+    /* Times: from a millisecond (a refresh faster than GL can draw is no use) up. */
+    const double min_time = 1e-3, max_time = 1e6;
+    const char *text;
+    if (ps_cli_is(cli, "--tau"))
+        *st = ps_cli_double(cli, min_time, max_time, &o->tau, err);
+    else if (ps_cli_is(cli, "--splat"))
+        *st = ps_cli_choice(cli, splats, &o->splat, err);
+    else if (ps_cli_is(cli, "--kernel"))
+        *st = ps_cli_choice(cli, kernels, &o->kernel, err);
+    else if (ps_cli_is(cli, "--color-depth"))
+        *st = ps_cli_choice(cli, depths, &o->color_depth, err);
+    else if (ps_cli_is(cli, "--precision"))
+        *st = ps_cli_choice(cli, precisions, &o->precision, err);
+    else if (ps_cli_is(cli, "--counter-threshold"))
+        *st = ps_cli_double(cli, 1e-9, 1.0, &o->counter_threshold, err);
+    else if (ps_cli_is(cli, "--point-size"))
+        *st = ps_cli_double(cli, 1.0, 64.0, &o->point_size, err);
+    else if (ps_cli_is(cli, "--shadows"))
+        *st = ps_cli_choice(cli, on_off, &o->shadows, err);
+    else if (ps_cli_is(cli, "--stencil-clip"))
+        *st = ps_cli_choice(cli, on_off, &o->stencil_clip, err);
+    else if (ps_cli_is(cli, "--layers")) {
+        *st = ps_cli_string(cli, &text, err);
+        if (*st == PS_OK)
+            *st = ps_parse_layers(text, prog, &o->layers, err);
+    } else
+        return false;
+    return true;
 }

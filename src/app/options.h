@@ -31,6 +31,29 @@ bool ps_shared_option(ps_cli *cli, const char *prog, ps_shared_options *o, ps_st
 uint64_t ps_shared_photons(const ps_shared_options *o, const ps_scene_defaults *d, ps_map_kind k);
 double ps_shared_radius(const ps_shared_options *o, const ps_scene_defaults *d, ps_map_kind k);
 
+/* The preview's options, shared by photosplat-snap and the window. */
+enum { PS_LAYER_DIRECT = 1, PS_LAYER_CAUSTIC = 2, PS_LAYER_GLOBAL = 4, PS_LAYER_ALL = 7 };
+
+typedef struct ps_preview_options {
+    double tau;               /* seconds between refreshes (0.1) */
+    double counter_threshold; /* the error counter's stopping fraction (0.1) */
+    double point_size;        /* points: side in pixels (1) */
+    int splat;                /* ps_splat_mode (triangles) */
+    int kernel;               /* ps_kernel (cone) */
+    int color_depth;          /* 0: 8 bits, 1: float */
+    int precision;            /* ps_precision (diffusion) */
+    int shadows, stencil_clip; /* on/off (on) */
+    unsigned layers;          /* PS_LAYER_* bits (all) */
+} ps_preview_options;
+
+/* float_depth: whether the colour depth defaults to float (the window) or
+ * 8 bits (photosplat-snap, as the thesis' preview). */
+void ps_preview_options_init(ps_preview_options *o, bool float_depth);
+/* Like ps_shared_option, for the preview's options. */
+bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_status *st, ps_error *err);
+/* "direct,caustic,global" (any non-empty subset) to PS_LAYER_* bits. */
+ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_error *err);
+
 /* --dump-photons: every photon of both maps, written whole or not at all. */
 ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP_COUNT], ps_error *err);
 

@@ -18,13 +18,7 @@
 #include "preview/splat.h"
 #include "scene/scene.h"
 
-/* The error counter's default: stop shooting once this fraction of a
- * refresh's splat energy rounds away in the 8-bit buffer. */
-#define SNAP_COUNTER_THRESHOLD 0.1
-#define SNAP_DEFAULT_TAU 0.1
-#define SNAP_DEFAULT_POINT_SIZE 1.0
 
-enum { LAYER_DIRECT = 1, LAYER_CAUSTIC = 2, LAYER_GLOBAL = 4, LAYER_ALL = 7 };
 
 static const char usage[] =
     "usage: photosplat-snap SCENE.scn -o OUT.png [options]\n"
@@ -62,89 +56,27 @@ static const char usage[] =
 
 typedef struct snap_options {
     ps_shared_options c;
-    double time, tau, counter_threshold, point_size;
-    int splat, kernel, color_depth, precision, shadows, stencil_clip;
-    unsigned layers;
+    ps_preview_options p;
+    double time; /* 0: trace the photon counts and draw once */
 } snap_options;
-
-static ps_status parse_layers(const char *text, unsigned *out, ps_error *err)
-{
-    static const char *const names[3] = {"direct", "caustic", "global"};
-    *out = 0;
-    const char *p = text;
-    while (*p) {
-        const char *end = strchr(p, ',');
-        size_t len = end ? (size_t)(end - p) : strlen(p);
-        int found = -1;
-        for (int k = 0; k < 3; k++)
-            if (strlen(names[k]) == len && strncmp(p, names[k], len) == 0)
-                found = k;
-        if (found < 0)
-            return ps_error_set(err, PS_ERR_PARSE,
-                                "photosplat-snap: --layers: '%.*s' is not direct, caustic or global", (int)len, p);
-        *out |= 1u << found;
-        if (!end)
-            break;
-        p = end + 1;
-        if (!*p)
-            return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --layers: empty name after ','");
-    }
-    if (!*out)
-        return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --layers: no layer named");
-    return PS_OK;
-}
 
 static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, ps_error *err)
 {
-    static const char *const splats[] = {"points", "triangles", "sprites", NULL};
-    static const char *const kernels[] = {"box", "cone", "gauss", "epanechnikov", NULL};
-    static const char *const depths[] = {"8", "float", NULL};
-    static const char *const precisions[] = {"none", "diffusion", "counter", NULL};
-    static const char *const on_off[] = {"off", "on", NULL};
     ps_cli cli = ps_cli_begin("photosplat-snap", argc, argv);
     memset(o, 0, sizeof *o);
     ps_shared_options_init(&o->c);
-    o->tau = SNAP_DEFAULT_TAU;
-    o->counter_threshold = SNAP_COUNTER_THRESHOLD;
-    o->point_size = SNAP_DEFAULT_POINT_SIZE;
-    o->splat = PS_SPLAT_TRIANGLES;
-    o->kernel = PS_KERNEL_CONE;
-    o->precision = PS_PRECISION_DIFFUSION;
-    o->shadows = 1;
-    o->stencil_clip = 1;
-    o->layers = LAYER_ALL;
+    ps_preview_options_init(&o->p, false);
     ps_status st = PS_OK;
-    const char *layers;
     while (st == PS_OK && ps_cli_next(&cli)) {
         if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "-h")) {
             *help = true;
             return PS_OK;
         } else if (ps_shared_option(&cli, "photosplat-snap", &o->c, &st, err)) {
             continue;
+        } else if (ps_preview_option(&cli, "photosplat-snap", &o->p, &st, err)) {
+            continue;
         } else if (ps_cli_is(&cli, "--time")) {
             st = ps_cli_double(&cli, 1e-3, 1e6, &o->time, err);
-        } else if (ps_cli_is(&cli, "--tau")) {
-            st = ps_cli_double(&cli, 1e-3, 1e6, &o->tau, err);
-        } else if (ps_cli_is(&cli, "--splat")) {
-            st = ps_cli_choice(&cli, splats, &o->splat, err);
-        } else if (ps_cli_is(&cli, "--kernel")) {
-            st = ps_cli_choice(&cli, kernels, &o->kernel, err);
-        } else if (ps_cli_is(&cli, "--color-depth")) {
-            st = ps_cli_choice(&cli, depths, &o->color_depth, err);
-        } else if (ps_cli_is(&cli, "--precision")) {
-            st = ps_cli_choice(&cli, precisions, &o->precision, err);
-        } else if (ps_cli_is(&cli, "--counter-threshold")) {
-            st = ps_cli_double(&cli, 1e-9, 1.0, &o->counter_threshold, err);
-        } else if (ps_cli_is(&cli, "--point-size")) {
-            st = ps_cli_double(&cli, 1.0, 64.0, &o->point_size, err);
-        } else if (ps_cli_is(&cli, "--shadows")) {
-            st = ps_cli_choice(&cli, on_off, &o->shadows, err);
-        } else if (ps_cli_is(&cli, "--stencil-clip")) {
-            st = ps_cli_choice(&cli, on_off, &o->stencil_clip, err);
-        } else if (ps_cli_is(&cli, "--layers")) {
-            st = ps_cli_string(&cli, &layers, err);
-            if (st == PS_OK)
-                st = parse_layers(layers, &o->layers, err);
         } else {
             return ps_cli_unknown(&cli, err);
         }
@@ -189,27 +121,27 @@ static ps_status build_splats(snap_run *s, const ps_feed *f, ps_error *err)
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         const ps_photon_map *m = &ps_feed_maps(f)[k];
         ps_splat_batch *b = &s->batch[k];
-        unsigned layer = k == PS_MAP_CAUSTIC ? LAYER_CAUSTIC : LAYER_GLOBAL;
+        unsigned layer = k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL;
         ps_splat_batch_clear(b);
         /* Each frame is built whole, so its round-off carry starts afresh:
          * the same photons give the same picture. */
         b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
         b->wanted = b->lost = 0.0;
-        if (!(o->layers & layer) || m->count == 0 || m->counters.emitted == 0)
+        if (!(o->p.layers & layer) || m->count == 0 || m->counters.emitted == 0)
             continue;
         ps_splat_params p;
         memset(&p, 0, sizeof p);
-        p.mode = (ps_splat_mode)o->splat;
+        p.mode = (ps_splat_mode)o->p.splat;
         p.radius = s->radius[k];
         p.kernel_mean = s->kernel.mean;
         p.kernel_extent = s->kernel.extent;
         /* Powers are normalised for the cap N; n have been emitted so far. */
         p.scale = o->c.exposure * (double)ps_feed_cap(f, (ps_map_kind)k) / (double)m->counters.emitted;
-        p.point_size = o->point_size;
-        p.precision = (ps_precision)o->precision;
-        p.levels = o->color_depth == 0 ? 255 : 0;
+        p.point_size = o->p.point_size;
+        p.precision = (ps_precision)o->p.precision;
+        p.levels = o->p.color_depth == 0 ? 255 : 0;
         p.materials = materials;
-        p.objects = o->stencil_clip ? m->objects : NULL;
+        p.objects = o->p.stencil_clip ? m->objects : NULL;
         p.cam = s->cam;
         ps_status st = ps_splat_build(m->photons, m->materials, m->count, &p, b, err);
         if (st != PS_OK)
@@ -228,9 +160,9 @@ static void draw_frame(snap_run *s)
 {
     const snap_options *o = s->o;
     double t0 = ps_now_seconds();
-    ps_gl_begin_frame(s->gl, &s->cam, o->c.exposure, (o->layers & LAYER_DIRECT) != 0);
+    ps_gl_begin_frame(s->gl, &s->cam, o->c.exposure, (o->p.layers & PS_LAYER_DIRECT) != 0);
     for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_gl_draw_splats(s->gl, &s->batch[k], (ps_splat_mode)o->splat, s->radius[k], o->point_size);
+        ps_gl_draw_splats(s->gl, &s->batch[k], (ps_splat_mode)o->p.splat, s->radius[k], o->p.point_size);
     s->frames++;
     s->splat_seconds += ps_now_seconds() - t0;
 }
@@ -262,10 +194,10 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
 {
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
     int width = o->c.width ? o->c.width : def->width, height = o->c.height ? o->c.height : def->height;
-    GLenum type = o->color_depth == 0 ? GL_UNSIGNED_BYTE : GL_FLOAT;
+    GLenum type = o->p.color_depth == 0 ? GL_UNSIGNED_BYTE : GL_FLOAT;
     if (!OSMesaMakeCurrent(ctx, buffer, type, width, height))
         return ps_error_set(err, PS_ERR_LIMIT, "photosplat-snap: OSMesa cannot draw a %dx%d %s buffer", width, height,
-                            o->color_depth == 0 ? "8-bit" : "float");
+                            o->p.color_depth == 0 ? "8-bit" : "float");
     snap_run s;
     memset(&s, 0, sizeof s);
     s.o = o;
@@ -291,8 +223,8 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     if (st == PS_OK)
         st = ps_preview_mesh_build(scene, &mopt, &mesh, err);
     if (st == PS_OK)
-        st = ps_kernel_texture_make((ps_kernel)o->kernel, PS_KERNEL_TEXTURE_SIZE, &s.kernel, err);
-    ps_gl_options gopt = {o->shadows != 0, o->color_depth != 0, 0};
+        st = ps_kernel_texture_make((ps_kernel)o->p.kernel, PS_KERNEL_TEXTURE_SIZE, &s.kernel, err);
+    ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0};
     if (st == PS_OK)
         st = ps_gl_renderer_create(scene, &mesh, &s.kernel, &gopt, &s.gl, err);
 
@@ -300,11 +232,11 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     uint64_t want[PS_MAP_COUNT] = {ps_shared_photons(&o->c, def, PS_MAP_CAUSTIC), ps_shared_photons(&o->c, def, PS_MAP_GLOBAL)};
     bool active[PS_MAP_COUNT] = {false, false};
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
-        unsigned layer = k == PS_MAP_CAUSTIC ? LAYER_CAUSTIC : LAYER_GLOBAL;
+        unsigned layer = k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL;
         const char *name = ps_map_name((ps_map_kind)k);
         if (!ps_tracer_map_enabled(tracer, (ps_map_kind)k))
             continue;
-        if (!(o->layers & layer))
+        if (!(o->p.layers & layer))
             st = ps_tracer_note_skip(tracer, name, "layer not shown (--layers)");
         else if (want[k] == 0)
             st = ps_tracer_note_skip(tracer, name, "0 photons requested");
@@ -313,7 +245,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         if (st != PS_OK)
             ps_error_set(err, st, "photosplat-snap: out of memory");
     }
-    if (st == PS_OK && !(o->layers & LAYER_DIRECT))
+    if (st == PS_OK && !(o->p.layers & PS_LAYER_DIRECT))
         st = ps_tracer_note_skip(tracer, "direct", "layer not shown (--layers)");
     if (st == PS_OK)
         st = ps_feed_create(tracer, want, active, &feed, err);
@@ -332,7 +264,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     } else if (st == PS_OK) {
         /* Progressive: trace in the background, refresh every tau. */
         st = ps_feed_start(feed, err);
-        double next = t_start + o->tau, end = t_start + o->time;
+        double next = t_start + o->p.tau, end = t_start + o->time;
         while (st == PS_OK) {
             double t = ps_now_seconds();
             double until = next < end ? next : end;
@@ -352,12 +284,12 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
                 first_frame = ps_now_seconds() - t_start;
             /* Thesis 5.1: once a refresh loses this much to round-off, more
              * photons only add noise; stop shooting. */
-            if (o->precision == PS_PRECISION_COUNTER && o->color_depth == 0 && s.lost_fraction > o->counter_threshold) {
+            if (o->p.precision == PS_PRECISION_COUNTER && o->p.color_depth == 0 && s.lost_fraction > o->p.counter_threshold) {
                 counter_stopped = true;
                 counter_at = emitted;
                 break;
             }
-            next += o->tau;
+            next += o->p.tau;
             if (ended || ps_now_seconds() >= end)
                 break;
         }
@@ -404,7 +336,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         ps_stats_add(&rs, "round_off_fraction", s.lost_fraction);
         ps_stats_add(&rs, "counter_stopped", counter_stopped ? 1.0 : 0.0);
         ps_stats_add(&rs, "counter_stopped_at_photons", (double)counter_at);
-        ps_stats_add(&rs, "counter_threshold", o->counter_threshold);
+        ps_stats_add(&rs, "counter_threshold", o->p.counter_threshold);
         if (o->c.stats)
             st = ps_stats_write(o->c.stats, &rs, err);
     }
@@ -412,11 +344,11 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         printf("caustic: %llu emitted, %llu stored; global: %llu emitted, %llu stored; %llu frames; %s splats, %s\n",
                (unsigned long long)rs.emitted[0], (unsigned long long)rs.stored[0], (unsigned long long)rs.emitted[1],
                (unsigned long long)rs.stored[1], (unsigned long long)s.frames,
-               ps_splat_mode_name((ps_splat_mode)o->splat), o->color_depth == 0 ? "8-bit" : "float buffer");
+               ps_splat_mode_name((ps_splat_mode)o->p.splat), o->p.color_depth == 0 ? "8-bit" : "float buffer");
         if (counter_stopped)
             printf("error counter: stopped shooting at %llu photons: %.1f %% of a refresh's splat energy rounded "
                    "away in the 8-bit buffer (threshold %.1f %%)\n",
-                   (unsigned long long)counter_at, 100.0 * s.lost_fraction, 100.0 * o->counter_threshold);
+                   (unsigned long long)counter_at, 100.0 * s.lost_fraction, 100.0 * o->p.counter_threshold);
         for (size_t k = 0; k < rs.skip_count; k++)
             printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
         if (o->c.out_png)
@@ -455,7 +387,7 @@ int main(int argc, char **argv)
     /* RGBA, 24-bit depth, 8-bit stencil, no accumulation buffer (platform
      * notes: it wraps above 1.0 and is no place for photon sums). */
     OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    size_t bytes = (size_t)width * (size_t)height * 4 * (o.color_depth == 0 ? 1 : sizeof(float));
+    size_t bytes = (size_t)width * (size_t)height * 4 * (o.p.color_depth == 0 ? 1 : sizeof(float));
     void *buffer = ctx ? malloc(bytes) : NULL;
     ps_status st;
     if (!ctx)

@@ -28,8 +28,6 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
-#define WIN_DEFAULT_TAU 0.1
-#define WIN_COUNTER_THRESHOLD 0.1
 /* Shadow maps are remade after every light move: half the snapshot's side,
  * a quarter of the fill, for a refresh soon after the move. */
 #define WIN_SHADOW_SIZE 512
@@ -57,7 +55,6 @@
 #define SPLAT_BUDGET_MIN 2048
 #define SPLAT_BUDGET_START 16384
 
-enum { LAYER_DIRECT = 1, LAYER_CAUSTIC = 2, LAYER_GLOBAL = 4, LAYER_ALL = 7 };
 enum { SEL_NONE, SEL_LIGHT, SEL_OBJECT };
 enum { DRAG_NONE, DRAG_ORBIT, DRAG_PAN, DRAG_MOVE };
 
@@ -115,10 +112,9 @@ static const char help_text[] =
 
 typedef struct win_options {
     ps_shared_options c;
+    ps_preview_options p;
     const char *script;
-    double tau, counter_threshold, point_size;
-    int splat, kernel, color_depth, precision, shadows, stencil_clip, overlay;
-    unsigned layers;
+    int overlay;
 } win_options;
 
 typedef struct app {
@@ -177,48 +173,16 @@ typedef struct app {
 
 /* ---- options ---------------------------------------------------------------- */
 
-static ps_status parse_layers(const char *text, unsigned *out, ps_error *err)
-{
-    static const char *const names[3] = {"direct", "caustic", "global"};
-    *out = 0;
-    for (const char *p = text;;) {
-        const char *end = strchr(p, ',');
-        size_t len = end ? (size_t)(end - p) : strlen(p);
-        int found = -1;
-        for (int k = 0; k < 3; k++)
-            if (strlen(names[k]) == len && strncmp(p, names[k], len) == 0)
-                found = k;
-        if (found < 0)
-            return ps_error_set(err, PS_ERR_PARSE, "photosplat: --layers: '%.*s' is not direct, caustic or global",
-                                (int)len, p);
-        *out |= 1u << found;
-        if (!end)
-            return PS_OK;
-        p = end + 1;
-    }
-}
-
 static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, ps_error *err)
 {
-    static const char *const splats[] = {"points", "triangles", "sprites", NULL};
-    static const char *const kernels[] = {"box", "cone", "gauss", "epanechnikov", NULL};
-    static const char *const depths[] = {"8", "float", NULL};
-    static const char *const precisions[] = {"none", "diffusion", "counter", NULL};
     static const char *const on_off[] = {"off", "on", NULL};
     ps_cli cli = ps_cli_begin("photosplat", argc, argv);
     memset(o, 0, sizeof *o);
     ps_shared_options_init(&o->c);
-    o->tau = WIN_DEFAULT_TAU;
-    o->counter_threshold = WIN_COUNTER_THRESHOLD;
-    o->point_size = 1.0;
-    o->splat = PS_SPLAT_TRIANGLES;
-    o->kernel = PS_KERNEL_CONE;
-    o->color_depth = 1;
-    o->precision = PS_PRECISION_DIFFUSION;
-    o->shadows = o->stencil_clip = o->overlay = 1;
-    o->layers = LAYER_ALL;
+    /* Float layers: they take in only new photons each refresh (see gl_render.h). */
+    ps_preview_options_init(&o->p, true);
+    o->overlay = 1;
     ps_status st = PS_OK;
-    const char *text;
     while (st == PS_OK && ps_cli_next(&cli)) {
         if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "-h")) {
             *help = true;
@@ -229,32 +193,12 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
                                 ps_cli_arg(&cli));
         } else if (ps_shared_option(&cli, "photosplat", &o->c, &st, err)) {
             continue;
+        } else if (ps_preview_option(&cli, "photosplat", &o->p, &st, err)) {
+            continue;
         } else if (ps_cli_is(&cli, "--script")) {
             st = ps_cli_string(&cli, &o->script, err);
-        } else if (ps_cli_is(&cli, "--tau")) {
-            st = ps_cli_double(&cli, 1e-3, 1e6, &o->tau, err);
-        } else if (ps_cli_is(&cli, "--splat")) {
-            st = ps_cli_choice(&cli, splats, &o->splat, err);
-        } else if (ps_cli_is(&cli, "--kernel")) {
-            st = ps_cli_choice(&cli, kernels, &o->kernel, err);
-        } else if (ps_cli_is(&cli, "--color-depth")) {
-            st = ps_cli_choice(&cli, depths, &o->color_depth, err);
-        } else if (ps_cli_is(&cli, "--precision")) {
-            st = ps_cli_choice(&cli, precisions, &o->precision, err);
-        } else if (ps_cli_is(&cli, "--counter-threshold")) {
-            st = ps_cli_double(&cli, 1e-9, 1.0, &o->counter_threshold, err);
-        } else if (ps_cli_is(&cli, "--point-size")) {
-            st = ps_cli_double(&cli, 1.0, 64.0, &o->point_size, err);
-        } else if (ps_cli_is(&cli, "--shadows")) {
-            st = ps_cli_choice(&cli, on_off, &o->shadows, err);
-        } else if (ps_cli_is(&cli, "--stencil-clip")) {
-            st = ps_cli_choice(&cli, on_off, &o->stencil_clip, err);
         } else if (ps_cli_is(&cli, "--overlay")) {
             st = ps_cli_choice(&cli, on_off, &o->overlay, err);
-        } else if (ps_cli_is(&cli, "--layers")) {
-            st = ps_cli_string(&cli, &text, err);
-            if (st == PS_OK)
-                st = parse_layers(text, &o->layers, err);
         } else {
             return ps_cli_unknown(&cli, err);
         }
@@ -291,7 +235,7 @@ static ps_status rebuild(app *a, bool geometry, ps_error *err)
         ps_mesh_options mo = ps_mesh_default_options(a->scene);
         if (st == PS_OK)
             st = ps_preview_mesh_build(a->scene, &mo, &a->mesh, err);
-        ps_gl_options go = {a->o.shadows != 0, true, WIN_SHADOW_SIZE};
+        ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE};
         if (st == PS_OK)
             st = ps_gl_renderer_create(a->scene, &a->mesh, &a->kernel, &go, &a->gl, err);
     } else {
@@ -322,7 +266,7 @@ static ps_status rebuild(app *a, bool geometry, ps_error *err)
 
 static ps_camera_frame camera_frame(const app *a) { return ps_camera_frame_make(&a->camera, a->width, a->height); }
 
-static bool float_layers(const app *a) { return a->o.color_depth == 1; }
+static bool float_layers(const app *a) { return a->o.p.color_depth == 1; }
 
 /* How far into map k this refresh draws: with float layers, whole batches
  * beyond what is drawn, at most the budget (but at least one batch); with
@@ -366,7 +310,7 @@ static ps_status build_splats(app *a, size_t first[PS_MAP_COUNT], ps_error *err)
         b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
         b->wanted = b->lost = 0.0;
         const ps_photon_map *m = &maps[k];
-        unsigned layer = k == PS_MAP_CAUSTIC ? LAYER_CAUSTIC : LAYER_GLOBAL;
+        unsigned layer = k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL;
         uint64_t emitted;
         size_t end = prefix(a, k, &emitted);
         first[k] = float_layers(a) ? a->drawn[k] : 0;
@@ -382,11 +326,11 @@ static ps_status build_splats(app *a, size_t first[PS_MAP_COUNT], ps_error *err)
         p.kernel_mean = a->kernel.mean;
         p.kernel_extent = a->kernel.extent;
         p.scale = float_layers(a) ? 1.0 : a->exposure * (double)a->cap[k] / (double)emitted;
-        p.point_size = a->o.point_size;
+        p.point_size = a->o.p.point_size;
         p.precision = a->precision;
         p.levels = float_layers(a) ? 0 : 255;
         p.materials = materials;
-        p.objects = a->o.stencil_clip ? m->objects + first[k] : NULL;
+        p.objects = a->o.p.stencil_clip ? m->objects + first[k] : NULL;
         p.cam = cam;
         st = ps_splat_build(m->photons + first[k], m->materials + first[k], end - first[k], &p, b, err);
         wanted += b->wanted;
@@ -404,7 +348,7 @@ static ps_status compose(app *a, ps_error *err)
 {
     double gain[PS_MAP_COUNT];
     for (int k = 0; k < PS_MAP_COUNT; k++) {
-        unsigned layer = k == PS_MAP_CAUSTIC ? LAYER_CAUSTIC : LAYER_GLOBAL;
+        unsigned layer = k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL;
         gain[k] = !(a->shown & layer) || a->emitted[k] == 0 ? 0.0
                   : float_layers(a)                         ? a->exposure * (double)a->cap[k] / (double)a->emitted[k]
                                                             : 1.0;
@@ -453,8 +397,8 @@ static void draw_overlay(app *a)
                      (unsigned long long)ce, (unsigned long long)a->cap[0], (unsigned long long)ge,
                      (unsigned long long)a->cap[1], state, rate, a->fps, a->tau, 1000.0 * a->frame_seconds,
                      ps_splat_mode_name(a->splat), ps_kernel_name(a->kernel_kind), a->radius[0], a->radius[1],
-                     a->shown & LAYER_DIRECT ? "D" : "-", a->shown & LAYER_CAUSTIC ? "C" : "-",
-                     a->shown & LAYER_GLOBAL ? "G" : "-", float_layers(a) ? "float" : ps_precision_name(a->precision),
+                     a->shown & PS_LAYER_DIRECT ? "D" : "-", a->shown & PS_LAYER_CAUSTIC ? "C" : "-",
+                     a->shown & PS_LAYER_GLOBAL ? "G" : "-", float_layers(a) ? "float" : ps_precision_name(a->precision),
                      a->exposure);
     if (!float_layers(a) && n > 0 && (size_t)n < sizeof text)
         n += snprintf(text + n, sizeof text - (size_t)n, "error counter: %.1f %% of the last refresh rounded away%s\n",
@@ -495,7 +439,7 @@ static ps_status refresh(app *a, ps_error *err)
     double t0 = glfwGetTime();
     ps_camera_frame cam = camera_frame(a);
     if (a->view_dirty) {
-        ps_gl_layers_view(a->layers, a->gl, &cam, float_layers(a) ? 1.0 : a->exposure, (a->shown & LAYER_DIRECT) != 0);
+        ps_gl_layers_view(a->layers, a->gl, &cam, float_layers(a) ? 1.0 : a->exposure, (a->shown & PS_LAYER_DIRECT) != 0);
         a->drawn[0] = a->drawn[1] = 0;
         a->emitted[0] = a->emitted[1] = 0;
         a->view_dirty = false;
@@ -509,7 +453,7 @@ static ps_status refresh(app *a, ps_error *err)
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         if (!float_layers(a))
             ps_gl_layers_clear_map(a->layers, k);
-        ps_gl_layers_add(a->layers, a->gl, k, &a->batch[k], a->splat, a->radius[k], a->o.point_size);
+        ps_gl_layers_add(a->layers, a->gl, k, &a->batch[k], a->splat, a->radius[k], a->o.p.point_size);
         a->drawn[k] = upto[k];
         splats += a->batch[k].splats;
     }
@@ -521,7 +465,7 @@ static ps_status refresh(app *a, ps_error *err)
     /* Thesis 5.1: once a refresh loses this much to round-off, more photons
      * only add noise: stop shooting (until the next edit). */
     if (!float_layers(a) && a->precision == PS_PRECISION_COUNTER && !a->counter_stopped &&
-        a->lost_fraction > a->o.counter_threshold) {
+        a->lost_fraction > a->o.p.counter_threshold) {
         a->counter_stopped = true;
         ps_feed_pause(a->feed, true);
     }
@@ -828,9 +772,9 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_C:
         a->precision = (ps_precision)((a->precision + 1) % PS_PRECISION_COUNT), a->view_dirty = true;
         break;
-    case GLFW_KEY_1: set_layers(a, a->shown ^ LAYER_DIRECT); break;
-    case GLFW_KEY_2: set_layers(a, a->shown ^ LAYER_CAUSTIC); break;
-    case GLFW_KEY_3: set_layers(a, a->shown ^ LAYER_GLOBAL); break;
+    case GLFW_KEY_1: set_layers(a, a->shown ^ PS_LAYER_DIRECT); break;
+    case GLFW_KEY_2: set_layers(a, a->shown ^ PS_LAYER_CAUSTIC); break;
+    case GLFW_KEY_3: set_layers(a, a->shown ^ PS_LAYER_GLOBAL); break;
     case GLFW_KEY_R:
         for (int k = 0; k < PS_MAP_COUNT; k++)
             a->radius[k] *= shift ? 1.0 / KEY_SCALE : KEY_SCALE;
@@ -1014,11 +958,11 @@ static ps_status session(app *a, ps_error *err)
     a->width = a->o.c.width ? a->o.c.width : def->width;
     a->height = a->o.c.height ? a->o.c.height : def->height;
     a->camera = *ps_scene_camera(a->scene);
-    a->splat = (ps_splat_mode)a->o.splat;
-    a->kernel_kind = (ps_kernel)a->o.kernel;
-    a->precision = (ps_precision)a->o.precision;
-    a->shown = a->o.layers;
-    a->tau = a->o.tau;
+    a->splat = (ps_splat_mode)a->o.p.splat;
+    a->kernel_kind = (ps_kernel)a->o.p.kernel;
+    a->precision = (ps_precision)a->o.p.precision;
+    a->shown = a->o.p.layers;
+    a->tau = a->o.p.tau;
     a->exposure = a->o.c.exposure;
     a->overlay = a->o.overlay != 0;
     a->budget = SPLAT_BUDGET_START;
