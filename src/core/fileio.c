@@ -197,3 +197,14 @@ ps_status ps_read_file(const char *path, size_t max_bytes, char **out, size_t *o
         *out_len = len;
     return PS_OK;
 }
+
+int ps_text_nul_line(const char *text, size_t len)
+{
+    const char *nul = memchr(text, '\0', len);
+    if (!nul)
+        return 0;
+    int line = 1;
+    for (const char *c = text; c < nul; c++)
+        line += *c == '\n';
+    return line;
+}

@@ -33,4 +33,8 @@ FILE *ps_open_input(const char *path, ps_error *err);
  * Refuses files larger than max_bytes with PS_ERR_LIMIT. */
 ps_status ps_read_file(const char *path, size_t max_bytes, char **out, size_t *out_len, ps_error *err);
 
+/* The line (from 1) holding the first NUL byte of text[0, len), or 0 when
+ * there is none: text readers refuse binary input by naming where it starts. */
+int ps_text_nul_line(const char *text, size_t len);
+
 #endif

@@ -334,18 +334,6 @@ static ps_status parse_line(parser *p)
 
 /* ---- text -------------------------------------------------------------------- */
 
-/* The line holding the first NUL byte, or 0 when there is none. */
-static int nul_line(const char *text, size_t len)
-{
-    const char *nul = memchr(text, '\0', len);
-    if (!nul)
-        return 0;
-    int line = 1;
-    for (const char *c = text; c < nul; c++)
-        line += *c == '\n';
-    return line;
-}
-
 static ps_status parse_lines(parser *p, const char *text)
 {
     char *buf = malloc(PS_SCRIPT_LINE_MAX + 1);
@@ -419,7 +407,7 @@ static ps_status parse_text(const char *text, size_t len, const char *name, ps_s
     ps_error_clear(err);
     if (len > PS_SCRIPT_MAX_BYTES)
         return ps_error_set(err, PS_ERR_LIMIT, "%s: script larger than %zu bytes", name, PS_SCRIPT_MAX_BYTES);
-    int bin = nul_line(text, len);
+    int bin = ps_text_nul_line(text, len);
     if (bin)
         return ps_error_set(err, PS_ERR_PARSE, "%s:%d: binary data (a NUL byte), not a script", name, bin);
     parser p;

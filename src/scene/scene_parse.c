@@ -963,18 +963,6 @@ static void apply_defaults(parser *p)
         d->global_radius = DEFAULT_GLOBAL_RADIUS_FRACTION * diag;
 }
 
-/* The line holding the first NUL byte, or 0 when there is none. */
-static int nul_line(const char *text, size_t len)
-{
-    const char *nul = memchr(text, '\0', len);
-    if (!nul)
-        return 0;
-    int line = 1;
-    for (const char *c = text; c < nul; c++)
-        line += *c == '\n';
-    return line;
-}
-
 static ps_status parse_text(parser *p, const char *text, size_t len)
 {
     (void)len; /* NUL-free (checked by the caller), so the text ends at its NUL */
@@ -1039,7 +1027,7 @@ static ps_status load_text(const char *text, size_t len, const char *name, const
     p.err = err;
     p.default_material = -1;
     p.s->defaults.caustic_photons = p.s->defaults.global_photons = -1; /* unset */
-    int bin = nul_line(text, len);
+    int bin = ps_text_nul_line(text, len);
     ps_status st = bin ? ps_error_set(err, PS_ERR_PARSE, "%s:%d: binary data (a NUL byte), not a scene file", name, bin)
                        : parse_text(&p, text, len);
     if (st != PS_OK) {
