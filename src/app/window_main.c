@@ -166,6 +166,7 @@ typedef struct app {
     ps_script *script;
     size_t script_next;
     bool quit;
+    char shot_path[64]; /* a screenshot asked for with P, taken after the next refresh */
     ps_status status;
     ps_error err;
     char message[PS_ERROR_MSG_MAX + 64]; /* the last action's one-line report, shown in the overlay */
@@ -785,11 +786,10 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_TAB: select_next(a, shift ? SEL_OBJECT : SEL_LIGHT); break;
     case GLFW_KEY_ESCAPE: a->sel_kind = SEL_NONE; break;
     case GLFW_KEY_P: {
-        char path[64];
+        /* Taken by the main loop after its next refresh: after a swap the
+         * back buffer holds nothing defined. */
         time_t now = time(NULL);
-        strftime(path, sizeof path, "photosplat-%Y%m%d-%H%M%S.png", localtime(&now));
-        if (screenshot(a, path, &err) != PS_OK)
-            snprintf(a->message, sizeof a->message, "%s", err.msg);
+        strftime(a->shot_path, sizeof a->shot_path, "photosplat-%Y%m%d-%H%M%S.png", localtime(&now));
         break;
     }
     case GLFW_KEY_LEFT: move_selection(a, ps_v3_scale(right, -step)); break;
@@ -1016,8 +1016,14 @@ static ps_status session(app *a, ps_error *err)
                 break;
         }
         now = glfwGetTime();
-        if (now >= next || a->view_dirty) {
+        if (now >= next || a->view_dirty || a->shot_path[0]) {
             st = refresh(a, err);
+            if (st == PS_OK && a->shot_path[0]) {
+                ps_error shot_err;
+                if (screenshot(a, a->shot_path, &shot_err) != PS_OK)
+                    snprintf(a->message, sizeof a->message, "%s", shot_err.msg);
+                a->shot_path[0] = '\0';
+            }
             if (st == PS_OK)
                 glfwSwapBuffers(a->win);
             next = now + a->tau;
