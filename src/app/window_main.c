@@ -166,6 +166,7 @@ typedef struct app {
     ps_script *script;
     size_t script_next;
     bool quit;
+    bool release_feed; /* the feed is held until the next refresh is done */
     char shot_path[64]; /* a screenshot asked for with P, taken after the next refresh */
     ps_status status;
     ps_error err;
@@ -252,12 +253,18 @@ static ps_status rebuild(app *a, bool geometry, ps_error *err)
     bool active[PS_MAP_COUNT];
     for (int k = 0; k < PS_MAP_COUNT; k++)
         active[k] = st == PS_OK && ps_tracer_map_enabled(a->tracer, (ps_map_kind)k);
+    /* The first batch is traced here, and the thread starts held until the
+     * first refresh has drawn it: that refresh (shadow maps, direct light,
+     * those splats) then has every core, and the caustic shows at once. */
     if (st == PS_OK)
         st = ps_feed_create(a->tracer, a->cap, active, &a->feed, err);
     if (st == PS_OK)
-        st = ps_feed_start(a->feed, err);
-    if (st == PS_OK && a->paused)
+        st = ps_feed_prime(a->feed, err);
+    if (st == PS_OK) {
         ps_feed_pause(a->feed, true);
+        st = ps_feed_start(a->feed, err);
+        a->release_feed = true;
+    }
     a->counter_stopped = false;
     a->view_dirty = true;
     return st;
@@ -481,6 +488,11 @@ static ps_status refresh(app *a, ps_error *err)
     a->last_refresh = t1;
     if (a->frames++ == 0)
         a->t_first_frame = t1;
+    if (a->release_feed) {
+        a->release_feed = false;
+        if (!a->paused && !a->counter_stopped)
+            ps_feed_pause(a->feed, false);
+    }
     if (a->frames == 1)
         a->first_frame_seconds = t1 - a->start_time;
     else if (a->awaiting_edit_frame) {

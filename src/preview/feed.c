@@ -19,6 +19,8 @@ struct ps_feed {
     size_t mark_count[PS_MAP_COUNT], mark_cap[PS_MAP_COUNT];
     bool stop, paused, ended;         /* under lock */
     bool started;
+    uint64_t next[PS_MAP_COUNT]; /* the feeding thread's: first photon not yet traced */
+    uint64_t round;
     pthread_t thread;
     ps_status status;
     ps_error err;
@@ -72,21 +74,39 @@ static ps_status batch(ps_feed *f, int k, uint64_t first, uint64_t count, ps_err
     return st;
 }
 
-/* Rounds that keep the maps' emitted counts in proportion to their caps, so
- * that all of them finish together. */
-static void *feed_main(void *arg)
+/* One round: each active map up to its share of the next PS_FEED_BATCH
+ * photons of the largest cap, so that all maps finish together. False when
+ * every map has reached its cap (or on an error, in *st). */
+static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
 {
-    ps_feed *f = arg;
-    double t0 = now();
-    uint64_t next[PS_MAP_COUNT] = {0, 0};
     uint64_t biggest = 0;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (f->active[k] && f->cap[k] > biggest)
             biggest = f->cap[k];
-    ps_status st = PS_OK;
-    ps_error err;
-    ps_error_clear(&err);
-    for (uint64_t round = 0; st == PS_OK; round++) {
+    bool more = false;
+    for (int k = 0; k < PS_MAP_COUNT && *st == PS_OK; k++) {
+        if (!f->active[k] || f->next[k] >= f->cap[k])
+            continue;
+        double share = (double)(f->round + 1) * PS_FEED_BATCH / (double)biggest;
+        uint64_t until = share >= 1.0 ? f->cap[k] : (uint64_t)((double)f->cap[k] * share);
+        if (until <= f->next[k])
+            until = f->next[k] + 1;
+        *st = batch(f, k, f->next[k], until - f->next[k], err);
+        f->next[k] = until;
+        more = more || f->next[k] < f->cap[k];
+    }
+    f->round++;
+    return more && *st == PS_OK;
+}
+
+static void *feed_main(void *arg)
+{
+    ps_feed *f = arg;
+    double t0 = now();
+    ps_status st = f->status;
+    ps_error err = f->err;
+    bool more = st == PS_OK && !f->ended;
+    while (more) {
         pthread_mutex_lock(&f->lock);
         while (f->paused && !f->stop)
             pthread_cond_wait(&f->wake, &f->lock);
@@ -94,28 +114,31 @@ static void *feed_main(void *arg)
         pthread_mutex_unlock(&f->lock);
         if (stop)
             break;
-        bool more = false;
-        for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
-            if (!f->active[k] || next[k] >= f->cap[k])
-                continue;
-            double share = (double)(round + 1) * PS_FEED_BATCH / (double)biggest;
-            uint64_t until = share >= 1.0 ? f->cap[k] : (uint64_t)((double)f->cap[k] * share);
-            if (until <= next[k])
-                until = next[k] + 1;
-            st = batch(f, k, next[k], until - next[k], &err);
-            next[k] = until;
-            more = more || next[k] < f->cap[k];
-        }
-        if (!more)
-            break;
+        more = round_once(f, &st, &err);
     }
     pthread_mutex_lock(&f->lock);
     f->status = st;
     f->err = err;
     f->ended = true;
-    f->seconds = now() - t0;
+    f->seconds += now() - t0;
     pthread_mutex_unlock(&f->lock);
     return NULL;
+}
+
+ps_status ps_feed_prime(ps_feed *f, ps_error *err)
+{
+    double t0 = now();
+    ps_status st = PS_OK;
+    ps_error_clear(&f->err);
+    bool more = round_once(f, &st, &f->err);
+    pthread_mutex_lock(&f->lock);
+    f->status = st;
+    f->ended = !more;
+    f->seconds += now() - t0;
+    pthread_mutex_unlock(&f->lock);
+    if (st != PS_OK && err)
+        *err = f->err;
+    return st;
 }
 
 ps_status ps_feed_run(ps_feed *f, ps_error *err)

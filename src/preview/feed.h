@@ -32,6 +32,10 @@ void ps_feed_destroy(ps_feed *f);
 
 /* Traces everything on the calling thread. */
 ps_status ps_feed_run(ps_feed *f, ps_error *err);
+/* Traces the first round (PS_FEED_BATCH photons of the largest map, the
+ * others in proportion) on the calling thread, so that a picture can show
+ * photons at once; run or start go on from there. */
+ps_status ps_feed_prime(ps_feed *f, ps_error *err);
 /* Traces in a background thread until done, stopped, or an error. */
 ps_status ps_feed_start(ps_feed *f, ps_error *err);
 /* Asks the thread to stop after its current batch and waits for it. */
