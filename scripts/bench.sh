@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # bench.sh: runs every benchmark program (build/release/bench/bench_*) in
-# turn from the repository root, as `make bench` does after building them.
+# turn from the repository root, as `make bench` does after building them,
+# then scripts/bench-ref.sh (photosplat-ref against POV-Ray).
 # Exits non-zero when any of them fails.
 set -u
 cd "$(dirname "$0")/.."
@@ -20,6 +21,28 @@ for b in build/release/bench/bench_*; do
     echo "== $(basename "$b"): $((SECONDS - start)) s"
     echo
 done
+# photosplat-ref against POV-Ray on the default scene. It takes about ten
+# minutes until its references are cached (bench/results/cache), a few after;
+# PS_BENCH_REF=0 skips it.
+if [ "${PS_BENCH_REF:-1}" != 0 ]; then
+    echo "== bench-ref"
+    start=$SECONDS
+    if ! scripts/bench-ref.sh; then
+        echo "== bench-ref: FAILED" >&2
+        status=1
+    fi
+    echo "== bench-ref: $((SECONDS - start)) s"
+    echo
+fi
+# The window's frames per second and edit latency, under Xvfb.
+echo "== bench-window"
+start=$SECONDS
+if ! scripts/bench-window.sh; then
+    echo "== bench-window: FAILED" >&2
+    status=1
+fi
+echo "== bench-window: $((SECONDS - start)) s"
+echo
 if [ "$found" -eq 0 ]; then
     echo "bench: no programs under build/release/bench (run make bench)" >&2
     exit 2
