@@ -184,6 +184,8 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
     const ps_camera_frame *cam = &p->cam;
     double r = p->radius;
     double disc = 1.0 / (p->kernel_mean * PS_PI * r * r);
+    /* Whether the 8-bit handling does anything (hoisted: the loop is hot). */
+    bool rounds = p->levels > 0 && p->precision != PS_PRECISION_NONE;
     /* World size of one pixel at unit depth along the view axis. */
     double pixel = 2.0 * cam->tan_half_fov / cam->height;
     for (size_t i = 0; i < count; i++) {
@@ -215,7 +217,7 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
              * distance dist = depth / cos(a) that is side^2 pixel^2 depth^2
              * cos(a) across the ray, and 1 / cos_v more along the surface. */
             double side = p->point_size * pixel * depth;
-            double area = side * side * (depth / dist) / fmax(cos_v, PS_SPLAT_MIN_COS);
+            double area = side * side * (depth / dist) / (cos_v > PS_SPLAT_MIN_COS ? cos_v : PS_SPLAT_MIN_COS);
             c = ps_rgb_scale(c, 1.0 / area);
         } else {
             c = ps_rgb_scale(c, disc);
@@ -234,8 +236,12 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
          * dist / (dist - lift) a side, so its colour shrinks to match. */
         if (p->mode == PS_SPLAT_SPRITES)
             c = ps_rgb_scale(c, ((dist - lift) / dist) * ((dist - lift) / dist));
-        float rgba[4] = {(float)quantise(b, p, 0, c.r), (float)quantise(b, p, 1, c.g), (float)quantise(b, p, 2, c.b),
-                         1.0f};
+        float rgba[4] = {(float)c.r, (float)c.g, (float)c.b, 1.0f};
+        if (rounds) {
+            rgba[0] = (float)quantise(b, p, 0, c.r);
+            rgba[1] = (float)quantise(b, p, 1, c.g);
+            rgba[2] = (float)quantise(b, p, 2, c.b);
+        }
         size_t v = b->vertex_count;
         if (p->mode == PS_SPLAT_TRIANGLES) {
             /* The equilateral triangle around the disc of radius r: corners
