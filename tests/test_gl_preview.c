@@ -351,6 +351,45 @@ static void stencil_clips_haze(void **state)
     preview_free(&p);
 }
 
+/* Area lights are seen as the reference renderer sees them: a disc light
+ * from below shows its radiance P / (pi * pi R^2) in every pixel (times the
+ * exposure), black with the direct layer off; from above, its back, nothing:
+ * the floor under it shows through. */
+static void area_light_seen(void **state)
+{
+    (void)state;
+    const char *below = "camera eye 0 0.5 0 target 0 1 0 up 0 0 -1 fov 10\n"
+                        "material floor diffuse albedo 0.5 0.5 0.5\n"
+                        "quad corner -50 0 50 edge1 100 0 0 edge2 0 0 -100 material floor\n"
+                        "light disc center 0 1 0 normal 0 -1 0 radius 0.3 power 100 100 100\n";
+    const double exposure = 0.01, le = 100.0 / (PS_PI * PS_PI * 0.09);
+    preview p;
+    preview_make(&p, below, 8, 8, PS_KERNEL_BOX);
+    for (int direct = 0; direct < 2; direct++) {
+        ps_gl_begin_frame(p.gl, &p.cam, exposure, direct != 0);
+        ps_image img = read_back(&p);
+        for (int y = 0; y < p.h; y++)
+            for (int x = 0; x < p.w; x++)
+                assert_near(ps_image_at(&img, x, y)[0], direct ? le * exposure : 0.0, 1e-5 * le * exposure);
+        ps_image_destroy(&img);
+    }
+    preview_free(&p);
+    const char *above = "camera eye 0 3 0.001 target 0 0 0 up 0 0 -1 fov 1\n"
+                        "material floor diffuse albedo 0.5 0.5 0.5\n"
+                        "quad corner -50 0 50 edge1 100 0 0 edge2 0 0 -100 material floor\n"
+                        "light disc center 0 1 0 normal 0 -1 0 radius 0.3 power 100 100 100\n";
+    preview_make(&p, above, 8, 8, PS_KERNEL_BOX);
+    ps_gl_begin_frame(p.gl, &p.cam, 1.0, true);
+    ps_image img = read_back(&p);
+    /* The floor lit by the disc: rho / pi * pi L R^2 / (h^2 + R^2), within the
+     * 16 virtual lights' error. */
+    double floor = 0.5 * le * 0.09 / 1.09;
+    printf("disc light from above: floor %.4f, analytic %.4f\n", ps_image_at(&img, 4, 4)[0], floor);
+    assert_near(ps_image_at(&img, 4, 4)[0], floor, 0.03 * floor);
+    ps_image_destroy(&img);
+    preview_free(&p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -358,6 +397,7 @@ int main(void)
         cmocka_unit_test(shadow_of_a_square),
         cmocka_unit_test(caustic_layer_mirror_quad),
         cmocka_unit_test(stencil_clips_haze),
+        cmocka_unit_test(area_light_seen),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/sampling.h"
+#include "scene/tessellate.h"
 #include "gl/gl_api.h"
 
 /* The near plane of a shadow cube, as a fraction of the scene's diagonal. */
@@ -51,6 +52,8 @@ struct ps_gl_renderer {
     bool shadows_valid;
     GLuint fbo, kernel_tex;
     double kernel_extent; /* the texture's half side in splat radii */
+    ps_trimesh *sphere_lights; /* the sphere lights' surfaces, in light order */
+    size_t sphere_light_count;
     double scene_diag;
     ps_aabb bounds;
     int width, height;
@@ -223,9 +226,19 @@ static void free_shadows(ps_gl_renderer *r)
     r->shadows_valid = false;
 }
 
+static void free_sphere_lights(ps_gl_renderer *r)
+{
+    for (size_t i = 0; i < r->sphere_light_count; i++)
+        ps_trimesh_free(&r->sphere_lights[i]);
+    free(r->sphere_lights);
+    r->sphere_lights = NULL;
+    r->sphere_light_count = 0;
+}
+
 static ps_status build_lights(ps_gl_renderer *r, ps_error *err)
 {
     free_shadows(r);
+    free_sphere_lights(r);
     r->light_count = 0;
     size_t cap = 0, n;
     const ps_light *lights = ps_scene_lights(r->scene, &n);
@@ -248,6 +261,21 @@ static ps_status build_lights(ps_gl_renderer *r, ps_error *err)
             return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for GL lights", ps_scene_path(r->scene));
     }
     r->stats.virtual_lights = (unsigned)r->light_count;
+    size_t spheres = 0;
+    for (size_t l = 0; l < n; l++)
+        spheres += lights[l].type == PS_LIGHT_SPHERE;
+    r->sphere_lights = spheres ? calloc(spheres, sizeof *r->sphere_lights) : NULL;
+    if (spheres && !r->sphere_lights)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for GL lights", ps_scene_path(r->scene));
+    for (size_t l = 0; l < n; l++) {
+        if (lights[l].type != PS_LIGHT_SPHERE)
+            continue;
+        ps_status st = ps_sphere_tessellate(lights[l].position, lights[l].radius, PS_SPHERE_DEFAULT_TOLERANCE,
+                                            &r->sphere_lights[r->sphere_light_count], err);
+        if (st != PS_OK)
+            return st;
+        r->sphere_light_count++;
+    }
     return PS_OK;
 }
 
@@ -314,6 +342,68 @@ static void draw_emission(const ps_gl_renderer *r, double exposure)
     }
     glDisable(GL_CULL_FACE);
     glDisableClientState(GL_VERTEX_ARRAY);
+}
+
+/* Area lights as the eye sees them (the reference renderer's emitters): quad
+ * and disc lights from their emitting side, sphere lights from outside, in
+ * their radiance times exposure, or black when the direct layer is off (its
+ * term; the other layers still see them in the way). They are drawn over
+ * the lit scene with depth writes, so splats behind them stay hidden; they
+ * are not in the shadow maps, as photons and shadow rays pass through them. */
+#define DISC_SEGMENTS 64
+
+static void draw_area_lights(const ps_gl_renderer *r, double exposure, bool direct)
+{
+    size_t n;
+    const ps_light *lights = ps_scene_lights(r->scene, &n);
+    glDisable(GL_BLEND);
+    glDisable(GL_LIGHTING);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    /* Their pixels belong to no object: splats are not clipped into them. */
+    glEnable(GL_STENCIL_TEST);
+    glStencilFunc(GL_ALWAYS, 0, 0xff);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+    size_t sphere = 0;
+    for (size_t l = 0; l < n; l++) {
+        const ps_light *L = &lights[l];
+        if (L->type != PS_LIGHT_QUAD && L->type != PS_LIGHT_DISC && L->type != PS_LIGHT_SPHERE)
+            continue;
+        double k = direct ? exposure : 0.0;
+        glColor4f((GLfloat)(L->radiance.r * k), (GLfloat)(L->radiance.g * k), (GLfloat)(L->radiance.b * k), 1.0f);
+        if (L->type == PS_LIGHT_QUAD) {
+            ps_vec3 c[4] = {L->position, ps_v3_add(L->position, L->edge1),
+                            ps_v3_add(ps_v3_add(L->position, L->edge1), L->edge2), ps_v3_add(L->position, L->edge2)};
+            glBegin(GL_QUADS); /* counter-clockwise about edge1 x edge2, the emitting side */
+            for (int i = 0; i < 4; i++)
+                glVertex3d(c[i].x, c[i].y, c[i].z);
+            glEnd();
+        } else if (L->type == PS_LIGHT_DISC) {
+            ps_vec3 t, b;
+            ps_v3_basis(L->direction, &t, &b);
+            glBegin(GL_TRIANGLE_FAN);
+            glVertex3d(L->position.x, L->position.y, L->position.z);
+            for (int i = 0; i <= DISC_SEGMENTS; i++) {
+                double a = 2.0 * PS_PI * i / DISC_SEGMENTS;
+                ps_vec3 q = ps_v3_add(L->position, ps_v3_add(ps_v3_scale(t, L->radius * cos(a)),
+                                                             ps_v3_scale(b, L->radius * sin(a))));
+                glVertex3d(q.x, q.y, q.z);
+            }
+            glEnd();
+        } else if (sphere < r->sphere_light_count) {
+            const ps_trimesh *m = &r->sphere_lights[sphere++];
+            glBegin(GL_TRIANGLES);
+            for (uint32_t i = 0; i < 3 * m->triangle_count; i++) {
+                ps_vec3 q = m->positions[m->indices[i]];
+                glVertex3d(q.x, q.y, q.z);
+            }
+            glEnd();
+        }
+    }
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_CULL_FACE);
 }
 
 /* ---- shadow maps ------------------------------------------------------------ */
@@ -529,15 +619,16 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
     glDisable(GL_STENCIL_TEST);
     glDisable(GL_POLYGON_OFFSET_FILL);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    if (!direct)
-        return;
-    /* Each light adds its pass on top. */
-    glDepthMask(GL_FALSE);
-    glDepthFunc(GL_LEQUAL);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    draw_direct(r, exposure);
-    glDisable(GL_BLEND);
+    if (direct) {
+        /* Each light adds its pass on top. */
+        glDepthMask(GL_FALSE);
+        glDepthFunc(GL_LEQUAL);
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_ONE, GL_ONE);
+        draw_direct(r, exposure);
+        glDisable(GL_BLEND);
+    }
+    draw_area_lights(r, exposure, direct);
 }
 
 /* The batch's primitives; grouped, each group only where its object shows
@@ -715,6 +806,7 @@ void ps_gl_renderer_destroy(ps_gl_renderer *r)
     if (r->kernel_tex)
         glDeleteTextures(1, &r->kernel_tex);
     free(r->lights);
+    free_sphere_lights(r);
     ps_preview_mesh_free(&r->coarse);
     free(r);
 }
