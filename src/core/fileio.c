@@ -208,3 +208,28 @@ int ps_text_nul_line(const char *text, size_t len)
         line += *c == '\n';
     return line;
 }
+
+ps_status ps_text_lines(const char *text, const char *name, size_t max_len, ps_line_fn fn, void *user, int *line,
+                        ps_error *err)
+{
+    char *buf = malloc(max_len + 1);
+    if (!buf)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", name);
+    ps_status st = PS_OK;
+    const char *at = text;
+    while (st == PS_OK && *at) {
+        const char *nl = strchr(at, '\n');
+        size_t n = nl ? (size_t)(nl - at) : strlen(at);
+        (*line)++;
+        if (n > max_len) {
+            st = ps_error_set(err, PS_ERR_PARSE, "%s:%d: line longer than %zu characters", name, *line, max_len);
+            break;
+        }
+        memcpy(buf, at, n);
+        buf[n] = '\0';
+        at = nl ? nl + 1 : at + n;
+        st = fn(user, buf);
+    }
+    free(buf);
+    return st;
+}

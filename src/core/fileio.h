@@ -37,4 +37,14 @@ ps_status ps_read_file(const char *path, size_t max_bytes, char **out, size_t *o
  * there is none: text readers refuse binary input by naming where it starts. */
 int ps_text_nul_line(const char *text, size_t len);
 
+/* Calls fn once for each line of the NUL-terminated text, with its number
+ * (from 1, also kept in *line) and its characters copied without the newline
+ * into a NUL-terminated buffer: the shape every text reader here shares. A
+ * line over max_len characters is "NAME:LINE: line longer than MAX
+ * characters" (PS_ERR_PARSE); the first status other than PS_OK from fn ends
+ * the walk and is returned. */
+typedef ps_status (*ps_line_fn)(void *user, char *text);
+ps_status ps_text_lines(const char *text, const char *name, size_t max_len, ps_line_fn fn, void *user, int *line,
+                        ps_error *err);
+
 #endif

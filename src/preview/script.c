@@ -334,31 +334,16 @@ static ps_status parse_line(parser *p)
 
 /* ---- text -------------------------------------------------------------------- */
 
+static ps_status parse_one_line(void *user, char *text)
+{
+    parser *p = user;
+    split_words(p, text);
+    return p->nword > 0 ? parse_line(p) : PS_OK;
+}
+
 static ps_status parse_lines(parser *p, const char *text)
 {
-    char *buf = malloc(PS_SCRIPT_LINE_MAX + 1);
-    if (!buf)
-        return ps_error_set(p->err, PS_ERR_NOMEM, "%s: out of memory", p->name);
-    ps_status st = PS_OK;
-    const char *at = text;
-    while (st == PS_OK && *at) {
-        const char *nl = strchr(at, '\n');
-        size_t n = nl ? (size_t)(nl - at) : strlen(at);
-        p->line++;
-        if (n > PS_SCRIPT_LINE_MAX) {
-            st = ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: line longer than %d characters", p->name, p->line,
-                              PS_SCRIPT_LINE_MAX);
-            break;
-        }
-        memcpy(buf, at, n);
-        buf[n] = '\0';
-        at = nl ? nl + 1 : at + n;
-        split_words(p, buf);
-        if (p->nword > 0)
-            st = parse_line(p);
-    }
-    free(buf);
-    return st;
+    return ps_text_lines(text, p->name, PS_SCRIPT_LINE_MAX, parse_one_line, p, &p->line, p->err);
 }
 
 /* Time order; the line breaks ties, so equal times keep file order (qsort

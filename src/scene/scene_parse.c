@@ -963,31 +963,17 @@ static void apply_defaults(parser *p)
         d->global_radius = DEFAULT_GLOBAL_RADIUS_FRACTION * diag;
 }
 
+static ps_status parse_one_line(void *user, char *text)
+{
+    parser *p = user;
+    ps_status st = tokenize(p, text);
+    return st == PS_OK && p->ntok > 0 ? parse_statement(p) : st;
+}
+
 static ps_status parse_text(parser *p, const char *text, size_t len)
 {
     (void)len; /* NUL-free (checked by the caller), so the text ends at its NUL */
-    char *buf = malloc(SCN_LINE_MAX);
-    if (!buf)
-        return ps_error_set(p->err, PS_ERR_NOMEM, "%s: out of memory", p->name);
-    ps_status st = PS_OK;
-    const char *at = text;
-    while (st == PS_OK && *at) {
-        const char *nl = strchr(at, '\n');
-        size_t n = nl ? (size_t)(nl - at) : strlen(at);
-        p->line++;
-        if (n >= SCN_LINE_MAX) {
-            st = ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: line longer than %d characters", p->name, p->line,
-                              SCN_LINE_MAX - 1);
-            break;
-        }
-        memcpy(buf, at, n);
-        buf[n] = '\0';
-        at = nl ? nl + 1 : at + n;
-        st = tokenize(p, buf);
-        if (st == PS_OK && p->ntok > 0)
-            st = parse_statement(p);
-    }
-    free(buf);
+    ps_status st = ps_text_lines(text, p->name, SCN_LINE_MAX - 1, parse_one_line, p, &p->line, p->err);
     if (st != PS_OK)
         return st;
     int last = p->line > 0 ? p->line : 1;
