@@ -33,6 +33,8 @@ printf '0.5 screenshot a.png\n1 jump\n' >"$cli_tmp/bad.txt"
 expect_usage_error "bad script" "$win" "$scene" --script "$cli_tmp/bad.txt"
 expect_match "script line" "$cli_err" 'bad\.txt:2: unknown action .jump.'
 expect_usage_error "missing script" "$win" "$scene" --script "$cli_tmp/none.txt"
+expect_usage_error "no display" env -u DISPLAY -u WAYLAND_DISPLAY "$win" "$scene"
+expect_match "says why" "$cli_err" 'cannot open a window'
 
 # The session: the whole picture, then the caustic layer alone before and
 # after the light moves right (x 0 -> 0.6): the caustic under the glass sphere
