@@ -48,6 +48,9 @@ OURS_LEVELS=(
     "spp 4, gather 64 (default)|--spp 4 --gather 64"
     "spp 16, gather 16|--spp 16 --gather 16"
     "spp 4, gather 64, 4x photons|--spp 4 --gather 64 --caustic-photons 800000 --global-photons 200000"
+    "spp 4, gather 16, cache 8|--spp 4 --gather 16 --cache 8"
+    "spp 4, gather 16, cache 4|--spp 4 --gather 16 --cache 4"
+    "spp 4, gather 64, cache 4, 1024 rays|--spp 4 --gather 64 --cache 4 --cache-rays 1024"
 )
 # 8x the default's eye work, 4x its photons, another seed (so that its
 # photons and eye samples are independent of the levels').

@@ -86,6 +86,14 @@ expect_success "render 1 thread" "$ref" "$scene" --hdr "$cli_tmp/t1.pfm" --size 
 expect_success "render 2 threads" "$ref" "$scene" --hdr "$cli_tmp/t2.pfm" --size 16x16 --spp 1 --gather 2 \
     --threads 2 "${small[@]}"
 cmp -s "$cli_tmp/t1.pfm" "$cli_tmp/t2.pfm" && ok || bad "images differ between 1 and 2 threads"
+# ... nor with the irradiance cache, whose records are made in any order.
+for n in 1 2; do
+    expect_success "cache, $n threads" "$ref" "$scene" --hdr "$cli_tmp/k$n.pfm" --size 16x16 --spp 1 --gather 2 \
+        --cache 4 --cache-rays 16 --threads $n "${small[@]}"
+done
+cmp -s "$cli_tmp/k1.pfm" "$cli_tmp/k2.pfm" && ok || bad "cached images differ between 1 and 2 threads"
+cmp -s "$cli_tmp/k1.pfm" "$cli_tmp/t1.pfm" && bad "the cache changed nothing" || ok
+expect_usage_error "negative cache" "$ref" "$scene" -o "$cli_tmp/x.png" --cache -1
 
 # The golden image (scripts/regen-golden.sh remakes it, on purpose only). The
 # renderer is deterministic, so the tolerance only absorbs compiler-level

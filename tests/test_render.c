@@ -207,13 +207,17 @@ static void furnace_sphere(void **state)
                        "light point position 0 0 0 power 39.47841760435743 39.47841760435743 39.47841760435743\n";
     ps_estimate_options est = {200, 0.3, PS_KERNEL_BOX};
     rig r = rig_make(text, 0, 200000, &est, true);
-    int gathers[2] = {16, 0};
-    for (int g = 0; g < 2; g++) {
+    /* Final gathering, the global map directly, and final gathering through
+     * the irradiance cache (a record every 3 pixels). */
+    int gathers[3] = {16, 0, 16}, spacing[3] = {0, 0, 3};
+    for (int g = 0; g < 3; g++) {
         /* Seen directly, the global map needs more photons per estimate for
          * the same noise as gathering, which averages many lookups. */
         ps_estimate_options direct_est = est;
         direct_est.k = gathers[g] ? est.k : 800;
         ps_render_options o = options(16, 16, 4, PS_COMPONENT_ALL, &direct_est, gathers[g]);
+        o.cache_spacing = spacing[g];
+        o.cache_rays = 256;
         ps_image img = render(&r, &o);
         double mean = image_mean(&img, 1), lo = INFINITY, hi = 0;
         for (int y = 0; y < img.height; y++)
@@ -221,8 +225,8 @@ static void furnace_sphere(void **state)
                 lo = fmin(lo, ps_image_at(&img, x, y)[1]);
                 hi = fmax(hi, ps_image_at(&img, x, y)[1]);
             }
-        printf("furnace sphere, gather %d: mean radiance %.4f (pixels %.4f .. %.4f), expected 1\n", gathers[g], mean,
-               lo, hi);
+        printf("furnace sphere, gather %d, cache %d: mean radiance %.4f (pixels %.4f .. %.4f), expected 1\n", gathers[g],
+               spacing[g], mean, lo, hi);
         assert_near(mean, 1.0, 0.02);
         assert_true(lo > 0.9 && hi < 1.1);
         ps_image_destroy(&img);

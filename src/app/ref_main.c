@@ -21,6 +21,7 @@
 #define REF_DEFAULT_SPP 4
 #define REF_DEFAULT_K 100
 #define REF_DEFAULT_GATHER 64
+#define REF_DEFAULT_CACHE_RAYS 256
 /* Final gathering looks irradiance up at every this-many-th photon (Christensen 1999 uses a subset). */
 #define REF_IRRADIANCE_STRIDE 4
 
@@ -53,6 +54,8 @@ static const char usage[] =
     "                           0: the global map's estimate directly)\n"
     "  --kernel box|cone|gauss|epanechnikov  radiance estimate kernel (default cone)\n"
     "  --light-samples N        shadow rays per area light per eye sample (default 1)\n"
+    "  --cache N                irradiance cache: a record every N pixels (default 0: off)\n"
+    "  --cache-rays N           gather rays per cache record (default 256)\n"
     "  --component all|direct|caustic|indirect|specular\n"
     "                           render one term of the split rendering equation\n"
     "  --caustic-cones on|off   aim caustic photons only at specular objects (default on)\n"
@@ -64,7 +67,7 @@ static const char usage[] =
 typedef struct ref_options {
     ps_shared_options c;
     double max_radius; /* 0: the radii */
-    int64_t spp, k, gather, light_samples;
+    int64_t spp, k, gather, light_samples, cache, cache_rays;
     int component, kernel;
     bool photons_only;
     bool cones, first_hit;
@@ -85,6 +88,7 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
     o->k = REF_DEFAULT_K;
     o->gather = REF_DEFAULT_GATHER;
     o->light_samples = 1;
+    o->cache_rays = REF_DEFAULT_CACHE_RAYS;
     o->kernel = PS_KERNEL_CONE;
     ps_status st = PS_OK;
     int choice;
@@ -102,6 +106,10 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
             st = ps_cli_int(&cli, 1, 100000, &o->k, err);
         } else if (ps_cli_is(&cli, "--gather")) {
             st = ps_cli_int(&cli, 0, 100000, &o->gather, err);
+        } else if (ps_cli_is(&cli, "--cache")) {
+            st = ps_cli_int(&cli, 0, 4096, &o->cache, err);
+        } else if (ps_cli_is(&cli, "--cache-rays")) {
+            st = ps_cli_int(&cli, 1, 1000000, &o->cache_rays, err);
         } else if (ps_cli_is(&cli, "--light-samples")) {
             st = ps_cli_int(&cli, 1, 100000, &o->light_samples, err);
         } else if (ps_cli_is(&cli, "--component")) {
@@ -188,6 +196,8 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
     ro.height = o->c.height ? o->c.height : def->height;
     ro.spp = (int)o->spp;
     ro.light_samples = (int)o->light_samples;
+    ro.cache_spacing = (int)o->cache;
+    ro.cache_rays = (int)o->cache_rays;
     ro.gather = (int)o->gather;
     ro.seed = (uint64_t)o->c.seed;
     ro.threads = ps_tracer_threads(r->tracer);
@@ -246,6 +256,7 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
     ps_stats_add(rs, "spp", ro.spp);
     ps_stats_add(rs, "k", (double)ro.caustic.k);
     ps_stats_add(rs, "gather", ro.gather);
+    ps_stats_add(rs, "cache", ro.cache_spacing);
     ps_stats_add(rs, "caustic_radius", ro.caustic.max_radius);
     ps_stats_add(rs, "global_radius", ro.global.max_radius);
     return st;

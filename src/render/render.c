@@ -34,6 +34,10 @@ typedef struct render_job {
     ps_image *img;
     int tiles_x, tiles;
     atomic_int next_tile, done_tiles;
+    /* The irradiance cache: a record every `spacing` pixels (see render.h). */
+    struct irr_record *cache;
+    int cache_w, cache_h;
+    atomic_int next_record;
     atomic_uint_least64_t rays;
 } render_job;
 
@@ -42,6 +46,7 @@ typedef struct worker {
     render_job *job;
     ps_neighbor *scratch;
     uint64_t rays;
+    double px, py; /* the image position of the eye sample being traced */
 } worker;
 
 static size_t max_k(const ps_render_options *o) { return o->caustic.k > o->global.k ? o->caustic.k : o->global.k; }
@@ -121,15 +126,20 @@ static ps_rgb direct_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec3 
  * mirror/glass bounces) and returns the radiance it sends back, from the
  * precomputed irradiance there: albedo / pi * E (Christensen's approximation:
  * the diffuse part only). */
-static ps_rgb gather_ray(worker *wk, ps_ray r, ps_rng *rng)
+static ps_rgb gather_ray(worker *wk, ps_ray r, ps_rng *rng, double *first_t)
 {
     const render_job *job = wk->job;
     ps_rgb beta = ps_rgb_gray(1.0);
     for (int bounce = 0; bounce <= PS_RENDER_GATHER_SPECULAR; bounce++) {
         ps_surface sp;
         wk->rays++;
-        if (!ps_world_intersect(job->world, r, INFINITY, &sp))
+        if (!ps_world_intersect(job->world, r, INFINITY, &sp)) {
+            if (first_t && bounce == 0)
+                *first_t = INFINITY;
             return ps_rgb_gray(0.0);
+        }
+        if (first_t && bounce == 0)
+            *first_t = sp.t;
         const ps_material *m = &job->materials[sp.material];
         bool front = ps_v3_dot(r.d, sp.ng) < 0.0;
         ps_vec3 n = front ? sp.ns : ps_v3_neg(sp.ns);
@@ -164,8 +174,107 @@ static ps_rgb gather_ray(worker *wk, ps_ray r, ps_rng *rng)
  * Phong lobe for the glossy term, whose estimate is f_s L cos / pdf =
  * specular (e + 2) / (e + 1) cos(theta) L. Both are stratified in their
  * first dimension. */
+/* ---- the irradiance cache -------------------------------------------------- */
+
+/* Indirect irradiance at one surface point, with Ward's validity radius: the
+ * harmonic mean distance of what its gather rays met. */
+typedef struct irr_record {
+    ps_vec3 p, n;
+    ps_rgb e;
+    double r;
+    bool valid;
+} irr_record;
+
+/* Indirect irradiance at sp (normal n) from `rays` cosine-distributed gather
+ * rays: pi times their mean radiance; *r the harmonic mean hit distance. */
+static ps_rgb gathered_irradiance(worker *wk, const ps_surface *sp, ps_vec3 n, int rays, ps_rng *rng, double *r)
+{
+    const render_job *job = wk->job;
+    ps_rgb acc = ps_rgb_gray(0.0);
+    double inv_t = 0.0;
+    int counted = 0;
+    for (int k = 0; k < rays; k++) {
+        double u1 = (k + ps_rng_uniform(rng)) / rays, u2 = ps_rng_uniform(rng);
+        ps_vec3 dir = ps_sample_cosine(u1, u2, n);
+        if (ps_v3_dot(dir, sp->ng) * ps_v3_dot(n, sp->ng) <= 0.0)
+            continue; /* an interpolated normal pointed it into the surface */
+        double t = INFINITY;
+        acc = ps_rgb_add(acc, gather_ray(wk, ps_world_spawn(job->world, sp, dir), rng, &t));
+        inv_t += isfinite(t) && t > 0.0 ? 1.0 / t : 0.0;
+        counted++;
+    }
+    *r = inv_t > 0.0 ? counted / inv_t : INFINITY;
+    return ps_rgb_scale(acc, PS_PI / rays);
+}
+
+/* Record (gx, gy): the first diffuse or glossy surface its pixel centre sees. */
+static void cache_record(worker *wk, int index)
+{
+    render_job *job = wk->job;
+    const ps_render_options *o = job->o;
+    irr_record *rec = &job->cache[index];
+    rec->valid = false;
+    int gx = index % job->cache_w, gy = index / job->cache_w;
+    double k = o->cache_spacing;
+    ps_ray ray = ps_camera_ray(&job->cam, (gx + 0.5) * k, (gy + 0.5) * k);
+    ps_surface sp;
+    wk->rays++;
+    if (!ps_world_intersect(job->world, ray, INFINITY, &sp))
+        return;
+    const ps_material *m = &job->materials[sp.material];
+    if (m->type != PS_MAT_DIFFUSE && m->type != PS_MAT_GLOSSY)
+        return;
+    bool front = ps_v3_dot(ray.d, sp.ng) < 0.0;
+    rec->n = front ? sp.ns : ps_v3_neg(sp.ns);
+    rec->p = sp.p;
+    ps_rng rng = ps_rng_make(ps_hash64(o->seed ^ PS_RENDER_CACHE_KEY), PS_STREAM_PIXEL, (uint64_t)index);
+    rec->e = gathered_irradiance(wk, &sp, rec->n, o->cache_rays, &rng, &rec->r);
+    rec->valid = isfinite(rec->r) && rec->r > 0.0 && ps_rgb_isfinite(rec->e);
+}
+
+static void *cache_worker(void *arg)
+{
+    worker *wk = arg;
+    render_job *job = wk->job;
+    int n = job->cache_w * job->cache_h;
+    for (int i; (i = atomic_fetch_add(&job->next_record, 1)) < n;)
+        cache_record(wk, i);
+    return NULL;
+}
+
+/* Ward's interpolation (without gradients) of the records around image
+ * position (px, py): weight 1 / (|x - x_i| / R_i + sqrt(1 - n.n_i)), records
+ * counted when the weight passes 1 / PS_RENDER_CACHE_ERROR. False when none
+ * does (the caller gathers there instead). */
+static bool cache_lookup(const render_job *job, double px, double py, ps_vec3 p, ps_vec3 n, ps_rgb *e)
+{
+    double k = job->o->cache_spacing;
+    int gx0 = (int)floor(px / k - 0.5), gy0 = (int)floor(py / k - 0.5);
+    double wsum = 0.0;
+    ps_rgb acc = ps_rgb_gray(0.0);
+    for (int gy = gy0 - 1; gy <= gy0 + 2; gy++)
+        for (int gx = gx0 - 1; gx <= gx0 + 2; gx++) {
+            if (gx < 0 || gy < 0 || gx >= job->cache_w || gy >= job->cache_h)
+                continue;
+            const irr_record *rec = &job->cache[gy * job->cache_w + gx];
+            double c = ps_v3_dot(n, rec->n);
+            if (!rec->valid || c <= 0.0)
+                continue;
+            double d = ps_v3_len(ps_v3_sub(p, rec->p)) / rec->r + sqrt(fmax(0.0, 1.0 - c));
+            double w = d > 0.0 ? 1.0 / d : 1e30;
+            if (w < 1.0 / PS_RENDER_CACHE_ERROR)
+                continue;
+            wsum += w;
+            acc = ps_rgb_add(acc, ps_rgb_scale(rec->e, w));
+        }
+    if (!(wsum > 0.0))
+        return false;
+    *e = ps_rgb_scale(acc, 1.0 / wsum);
+    return true;
+}
+
 static ps_rgb indirect_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec3 wo, const ps_material *m,
-                             ps_rng *rng)
+                             ps_rng *rng, bool primary)
 {
     const render_job *job = wk->job;
     int g = job->o->gather;
@@ -175,14 +284,18 @@ static ps_rgb indirect_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec
     if (!job->maps->irradiance || !job->maps->full)
         return ps_rgb_gray(0.0);
     ps_rgb sum = ps_rgb_gray(0.0);
-    if (!ps_rgb_is_black(m->albedo)) {
+    ps_rgb cached;
+    if (!ps_rgb_is_black(m->albedo) && primary && job->cache &&
+        cache_lookup(job, wk->px, wk->py, sp->p, n, &cached)) {
+        sum = ps_rgb_scale(ps_rgb_mul(m->albedo, cached), PS_INV_PI);
+    } else if (!ps_rgb_is_black(m->albedo)) {
         ps_rgb acc = ps_rgb_gray(0.0);
         for (int k = 0; k < g; k++) {
             double u1 = (k + ps_rng_uniform(rng)) / g, u2 = ps_rng_uniform(rng);
             ps_vec3 dir = ps_sample_cosine(u1, u2, n);
             if (ps_v3_dot(dir, sp->ng) * ps_v3_dot(n, sp->ng) <= 0.0)
                 continue; /* an interpolated normal pointed it into the surface */
-            acc = ps_rgb_add(acc, gather_ray(wk, ps_world_spawn(job->world, sp, dir), rng));
+            acc = ps_rgb_add(acc, gather_ray(wk, ps_world_spawn(job->world, sp, dir), rng, NULL));
         }
         sum = ps_rgb_mul(m->albedo, ps_rgb_scale(acc, 1.0 / g));
     }
@@ -195,7 +308,7 @@ static ps_rgb indirect_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec
             double cos_t = ps_v3_dot(dir, n);
             if (cos_t <= 0.0 || ps_v3_dot(dir, sp->ng) * ps_v3_dot(n, sp->ng) <= 0.0)
                 continue; /* the lobe reaches below the surface: no light from there */
-            acc = ps_rgb_add(acc, ps_rgb_scale(gather_ray(wk, ps_world_spawn(job->world, sp, dir), rng), cos_t));
+            acc = ps_rgb_add(acc, ps_rgb_scale(gather_ray(wk, ps_world_spawn(job->world, sp, dir), rng, NULL), cos_t));
         }
         double lobe = (m->exponent + 2.0) / (m->exponent + 1.0) / g;
         sum = ps_rgb_add(sum, ps_rgb_mul(m->specular, ps_rgb_scale(acc, lobe)));
@@ -333,7 +446,7 @@ static ps_rgb radiance(worker *wk, ps_ray r, int depth, bool through, uint64_t k
         sum = ps_rgb_add(sum, ps_photon_radiance(job->maps->caustic, m, sp.p, n, wo, &job->o->caustic, wk->scratch));
     if (wants(want, as_indirect)) {
         ps_rng rng = ps_rng_make(key, KEY_GATHER, 0);
-        sum = ps_rgb_add(sum, indirect_light(wk, &sp, n, wo, m, &rng));
+        sum = ps_rgb_add(sum, indirect_light(wk, &sp, n, wo, m, &rng, depth == 0));
     }
     return sum;
 }
@@ -360,6 +473,8 @@ static void render_tile(worker *wk, int tile)
                 double px = x + ((s % sx) + ps_rng_uniform(&rng)) / sx;
                 double py = y + ((s / sx) + ps_rng_uniform(&rng)) / sy;
                 uint64_t key = ((uint64_t)ps_rng_u32(&rng) << 32) | ps_rng_u32(&rng);
+                wk->px = px;
+                wk->py = py;
                 ps_rgb l = radiance(wk, ps_camera_ray(&job->cam, px, py), 0, false, key);
                 if (ps_rgb_isfinite(l))
                     sum = ps_rgb_add(sum, l);
@@ -451,6 +566,25 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     }
     pthread_t tid[MAX_THREADS];
     int started = 0;
+    /* The irradiance cache first, when asked for and the indirect term is
+     * wanted: every record is a pure function of its index, so the threads
+     * may fill it in any order. */
+    bool indirect = o->component == PS_COMPONENT_ALL || o->component == PS_COMPONENT_INDIRECT;
+    if (o->cache_spacing > 0 && o->gather > 0 && indirect && maps->irradiance && maps->full) {
+        job.cache_w = (o->width + o->cache_spacing - 1) / o->cache_spacing;
+        job.cache_h = (o->height + o->cache_spacing - 1) / o->cache_spacing;
+        job.cache = calloc((size_t)job.cache_w * (size_t)job.cache_h, sizeof *job.cache);
+        atomic_init(&job.next_record, 0);
+        if (job.cache) { /* without memory for it, gather everywhere: slower, not wrong */
+            for (; started < threads - 1; started++)
+                if (pthread_create(&tid[started], NULL, cache_worker, &wk[started + 1]) != 0)
+                    break;
+            cache_worker(&wk[0]);
+            for (int i = 0; i < started; i++)
+                pthread_join(tid[i], NULL);
+            started = 0;
+        }
+    }
     for (; started < threads - 1; started++)
         if (pthread_create(&tid[started], NULL, render_worker, &wk[started + 1]) != 0)
             break;
@@ -459,6 +593,7 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
         pthread_join(tid[i], NULL);
     for (int i = 0; i < threads; i++)
         free(wk[i].scratch);
+    free(job.cache);
     if (stats) {
         stats->rays = atomic_load(&job.rays);
         stats->seconds = now() - t0;

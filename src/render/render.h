@@ -39,6 +39,11 @@ const char *ps_component_name(ps_component c);
  * chosen with those probabilities. Splitting where the weight is largest
  * takes most of the noise out of glass for little cost. */
 #define PS_RENDER_SPLIT_DEPTH 2
+/* Cache records count where |x - x_i| / R_i + sqrt(1 - n.n_i) is below this
+ * (Ward's a; the smaller, the more gathering where records do not reach). */
+#define PS_RENDER_CACHE_ERROR 0.5
+/* Mixed into the seed for the records' random numbers. */
+#define PS_RENDER_CACHE_KEY 0x6361636865ULL
 /* Final gather rays that meet mirrors or glass follow at most this many bounces. */
 #define PS_RENDER_GATHER_SPECULAR 4
 
@@ -59,6 +64,14 @@ typedef struct ps_render_options {
     ps_component component;
     ps_estimate_options caustic, global;
     double irradiance_radius; /* how far a gather ray's hit may be from a precomputed irradiance */
+    /* An irradiance cache (Ward 1988) for the diffuse indirect term at the
+     * first surfaces eye rays meet: a record of cache_rays gather rays every
+     * cache_spacing pixels (0: none), made before the image, so it does not
+     * depend on the thread count, and interpolated between (without
+     * gradients) where the records are valid; elsewhere gathering as usual.
+     * It trades noise for smooth interpolation error and much less time. */
+    int cache_spacing;
+    int cache_rays;
     /* Called now and then from one thread with the fraction done (may be NULL). */
     void (*progress)(void *user, double fraction);
     void *progress_user;
