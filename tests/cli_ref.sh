@@ -82,9 +82,9 @@ for c in all direct caustic indirect specular; do
 done
 # Thread count never changes the image.
 expect_success "render 1 thread" "$ref" "$scene" --hdr "$cli_tmp/t1.pfm" --size 16x16 --spp 1 --gather 2 \
-    --threads 1 "${small[@]}"
+    --cache 0 --threads 1 "${small[@]}"
 expect_success "render 2 threads" "$ref" "$scene" --hdr "$cli_tmp/t2.pfm" --size 16x16 --spp 1 --gather 2 \
-    --threads 2 "${small[@]}"
+    --cache 0 --threads 2 "${small[@]}"
 cmp -s "$cli_tmp/t1.pfm" "$cli_tmp/t2.pfm" && ok || bad "images differ between 1 and 2 threads"
 # ... nor with the irradiance cache, whose records are made in any order.
 for n in 1 2; do
