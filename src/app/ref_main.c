@@ -22,8 +22,8 @@
 #define REF_DEFAULT_K 100
 #define REF_DEFAULT_GATHER 16
 /* The irradiance cache by default: at a record every 8 pixels of 256 rays it
- * reached in 3.2 s the error that gathering everywhere (64 rays) reached in
- * 30 s on the default scene (make bench). */
+ * reached in 3.9 s the error that gathering everywhere (64 rays) reached in
+ * 28 s on the default scene (make bench). */
 #define REF_DEFAULT_CACHE 8
 #define REF_DEFAULT_CACHE_RAYS 256
 /* Final gathering looks irradiance up at every this-many-th photon (Christensen 1999 uses a subset). */
