@@ -4,6 +4,7 @@
  * colour buffers, so that what is measured is the method, not 8-bit rounding
  * (the command-line tests cover that). */
 #include "test.h"
+#include "analytic.h"
 
 #include <GL/osmesa.h>
 #include <stdlib.h>
@@ -107,16 +108,6 @@ static ps_image reference(preview *p, ps_component c, const ps_kdtree *caustic, 
     return img;
 }
 
-/* The point of the plane y = 0 that pixel position (x, y) sees. */
-static bool floor_point(const ps_camera_frame *cam, double x, double y, ps_vec3 *p)
-{
-    ps_ray r = ps_camera_ray(cam, x, y);
-    if (!(r.d.y < 0))
-        return false;
-    *p = ps_ray_at(r, -r.o.y / r.d.y);
-    return true;
-}
-
 /* A point light at height 1 over a diffuse plane: GL lights in physical units
  * give rho / pi * I h / (h^2 + x^2)^(3/2) at every pixel centre (within 2 %:
  * Gouraud interpolation over the fine mesh), and the reference renderer's
@@ -141,8 +132,7 @@ static void direct_layer_on_plane(void **state)
             ps_vec3 q;
             if (!floor_point(&p.cam, x + 0.5, y + 0.5, &q) || fabs(q.x) > 1.9 || fabs(q.z) > 1.9)
                 continue;
-            double dx = q.x - 0.3, dz = q.z + 0.2;
-            double expect = 0.5 * PS_INV_PI * intensity / pow(1.0 + dx * dx + dz * dz, 1.5);
+            double expect = floor_radiance(0.5, intensity, 1.0, 0.3, -0.2, q);
             double got = ps_image_at(&img, x, y)[1] / exposure;
             worst = fmax(worst, fabs(got - expect) / expect);
             double r = ps_image_at(&ref, x, y)[1];
@@ -187,7 +177,7 @@ static void shadow_of_a_square(void **state)
             if (!floor_point(&p.cam, x + 0.5, y + 0.5, &q))
                 continue;
             double m = fmax(fabs(q.x), fabs(q.z)), got = ps_image_at(&img, x, y)[1];
-            double expect = 0.5 * PS_INV_PI * intensity / pow(1.0 + q.x * q.x + q.z * q.z, 1.5);
+            double expect = floor_radiance(0.5, intensity, 1.0, 0.0, 0.0, q);
             if (m > 0.13 && m < 0.18) {
                 brightest_shadow = fmax(brightest_shadow, got);
                 dark++;
@@ -256,7 +246,7 @@ static void caustic_layer_mirror_quad(void **state)
                 ps_vec3 q;
                 if (!floor_point(&p.cam, x + 0.5, y + 0.5, &q) || fabs(q.x) > 1.2 || fabs(q.z) > 1.2)
                     continue;
-                double expect = 0.5 * PS_INV_PI * intensity * 3.0 / pow(9.0 + q.x * q.x + q.z * q.z, 1.5);
+                double expect = floor_radiance(0.5, intensity, 3.0, 0.0, 0.0, q); /* the mirror image at height 3 */
                 double got = ps_image_at(&img, x, y)[1] / exposure;
                 worst = fmax(worst, fabs(got - expect) / expect);
                 sum += got / expect;

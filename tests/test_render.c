@@ -2,6 +2,7 @@
  * light on a plane, the furnace inside a sphere, the mirror-quad caustic; the
  * components add up to the whole; thread counts never change the image. */
 #include "test.h"
+#include "analytic.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -108,16 +109,6 @@ static double image_mean(const ps_image *img, int channel)
     return s / ((double)img->width * img->height);
 }
 
-/* The point on the plane y = 0 seen through image position (x, y), or false. */
-static bool floor_point(const ps_camera_frame *cam, double x, double y, ps_vec3 *p)
-{
-    ps_ray r = ps_camera_ray(cam, x, y);
-    if (!(r.d.y < 0))
-        return false;
-    *p = ps_ray_at(r, -r.o.y / r.d.y);
-    return true;
-}
-
 /* Direct light on a diffuse plane from a point light at height h:
  * L = rho / pi * I h / (h^2 + x^2)^(3/2), every pixel within 1 %. */
 static void direct_on_plane(void **state)
@@ -139,10 +130,9 @@ static void direct_on_plane(void **state)
             double expect = 0;
             for (int j = 0; j < 8; j++)
                 for (int i = 0; i < 8; i++) {
-                    ps_vec3 p;
+                    ps_vec3 p = {0, 0, 0};
                     assert_true(floor_point(&cam, x + (i + 0.5) / 8, y + (j + 0.5) / 8, &p));
-                    double dx = p.x - 0.3, dz = p.z + 0.2, h = 1.0;
-                    expect += 0.5 * PS_INV_PI * intensity * h / pow(h * h + dx * dx + dz * dz, 1.5) / 64.0;
+                    expect += floor_radiance(0.5, intensity, 1.0, 0.3, -0.2, p) / 64.0;
                 }
             double got = ps_image_at(&img, x, y)[1];
             worst = fmax(worst, fabs(got - expect) / expect);
@@ -290,7 +280,7 @@ static void mirror_caustic_image(void **state)
              * than the search radius, plus a margin. */
             if (fabs(p.x) > 1.2 || fabs(p.z) > 1.2)
                 continue;
-            double expect = 0.5 * PS_INV_PI * intensity * 3.0 / pow(9.0 + p.x * p.x + p.z * p.z, 1.5);
+            double expect = floor_radiance(0.5, intensity, 3.0, 0.0, 0.0, p); /* the mirror image at height 3 */
             double got = ps_image_at(&img, x, y)[1];
             worst = fmax(worst, fabs(got - expect) / expect);
             sum_err += (got - expect) / expect;

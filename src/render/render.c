@@ -47,6 +47,7 @@ typedef struct worker {
     ps_neighbor *scratch;
     uint64_t rays;
     double px, py; /* the image position of the eye sample being traced */
+    bool reports;  /* the calling thread's: reports progress */
 } worker;
 
 static size_t max_k(const ps_render_options *o) { return o->caustic.k > o->global.k ? o->caustic.k : o->global.k; }
@@ -486,6 +487,8 @@ static void render_tile(worker *wk, int tile)
         }
 }
 
+/* Takes tiles until none are left. The calling thread's worker (`reports`)
+ * also reports progress between its tiles. */
 static void *render_worker(void *arg)
 {
     worker *wk = arg;
@@ -495,26 +498,12 @@ static void *render_worker(void *arg)
         if (t >= job->tiles)
             break;
         render_tile(wk, t);
-        atomic_fetch_add(&job->done_tiles, 1);
-    }
-    atomic_fetch_add(&job->rays, wk->rays);
-    return NULL;
-}
-
-/* The calling thread works too, and reports progress between its tiles. */
-static void main_worker(worker *wk)
-{
-    render_job *job = wk->job;
-    for (;;) {
-        int t = atomic_fetch_add(&job->next_tile, 1);
-        if (t >= job->tiles)
-            break;
-        render_tile(wk, t);
         int done = atomic_fetch_add(&job->done_tiles, 1) + 1;
-        if (job->o->progress)
+        if (wk->reports && job->o->progress)
             job->o->progress(job->o->progress_user, (double)done / job->tiles);
     }
     atomic_fetch_add(&job->rays, wk->rays);
+    return NULL;
 }
 
 static double now(void)
@@ -556,6 +545,7 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     for (int i = 0; i < threads; i++) {
         wk[i].job = &job;
         wk[i].rays = 0;
+        wk[i].reports = i == 0;
         wk[i].scratch = malloc(k * sizeof *wk[i].scratch);
         if (!wk[i].scratch) {
             for (int j = 0; j < i; j++)
@@ -588,7 +578,7 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     for (; started < threads - 1; started++)
         if (pthread_create(&tid[started], NULL, render_worker, &wk[started + 1]) != 0)
             break;
-    main_worker(&wk[0]);
+    render_worker(&wk[0]);
     for (int i = 0; i < started; i++)
         pthread_join(tid[i], NULL);
     for (int i = 0; i < threads; i++)
