@@ -184,3 +184,7 @@ screenshots: deps
 
 clean:
 	rm -rf build bin
+
+# Further targets, one concern a file (fuzzing, stress, soak, valgrind): they
+# use the variables and rules above.
+-include $(sort $(wildcard mk/*.mk))
