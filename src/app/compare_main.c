@@ -10,7 +10,7 @@
 #define PROG "photosplat-compare"
 
 static const char usage[] =
-    "usage: " PROG " A B [--mask MASK] [--linear]\n"
+    "usage: " PROG " A B [--mask MASK] [--linear] [--clamp MAX]\n"
     "\n"
     "Compares image A with the reference image B and prints one line:\n"
     "  rmse=... relmse=... psnr=... mean_a=... mean_b=...\n"
@@ -31,6 +31,8 @@ static const char usage[] =
     "  --mask MASK   only pixels where MASK (PNG or PFM, same size) is white, that\n"
     "                is where the mean of its channels is at least 0.5\n"
     "  --linear      decode PNG images to linear before comparing\n"
+    "  --clamp MAX   clamp both images' values to at most MAX first: compares what a\n"
+    "                display shows, e.g. MAX = 1 / exposure for radiance images\n"
     "  --help        this text\n"
     "\n"
     "Exit status 0 on success, 2 on bad input (one line on stderr).\n";
@@ -41,6 +43,7 @@ typedef struct options {
     const char *mask;
     bool linear;
     bool help;
+    double clamp; /* 0: none */
 } options;
 
 static ps_status parse(int argc, char **argv, options *o, ps_error *err)
@@ -63,6 +66,9 @@ static ps_status parse(int argc, char **argv, options *o, ps_error *err)
                 o->help = true;
             else
                 o->linear = true;
+        } else if (ps_cli_is(&cli, "--clamp")) {
+            if ((st = ps_cli_double(&cli, 1e-30, 1e30, &o->clamp, err)) != PS_OK)
+                return st;
         } else if (ps_cli_is(&cli, "--mask")) {
             if (o->mask)
                 return ps_error_set(err, PS_ERR_PARSE, "%s: option --mask given twice", PROG);
@@ -109,6 +115,11 @@ int main(int argc, char **argv)
         for (int k = 0; k < 2; k++)
             if (linear && format[k] == PS_IMAGE_PNG)
                 ps_image_srgb_to_linear(&img[k]);
+        /* NaN stays NaN (fminf would hide it): the comparison refuses it. */
+        for (int k = 0; k < 2 && o.clamp > 0.0; k++)
+            for (size_t i = 0; i < 3 * (size_t)img[k].width * (size_t)img[k].height; i++)
+                if (img[k].rgb[i] > (float)o.clamp)
+                    img[k].rgb[i] = (float)o.clamp;
         ps_compare_names names = {o.path[0], o.path[1], o.mask};
         st = ps_image_compare(&img[0], &img[1], o.mask ? &mask : NULL, &names, &r, &err);
     }

@@ -97,6 +97,16 @@ void ps_preview_options_init(ps_preview_options *o, bool float_depth)
     o->precision = PS_PRECISION_DIFFUSION;
     o->shadows = o->stencil_clip = 1;
     o->layers = PS_LAYER_ALL;
+    o->radius_schedule = PS_RADIUS_FIXED;
+    o->radius_alpha = PS_RADIUS_ALPHA_DEFAULT;
+}
+
+double ps_preview_radius(const ps_preview_options *o, double r0, const ps_scene_defaults *d, ps_map_kind k,
+                         uint64_t cap, uint64_t emitted)
+{
+    int64_t scene_n = k == PS_MAP_CAUSTIC ? d->caustic_photons : d->global_photons;
+    uint64_t n0 = scene_n > 0 ? (uint64_t)scene_n : cap;
+    return ps_splat_radius_at((ps_radius_schedule)o->radius_schedule, r0, n0, emitted, o->radius_alpha);
 }
 
 ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_error *err)
@@ -127,6 +137,7 @@ bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_
     static const char *const depths[] = {"8", "float", NULL};
     static const char *const precisions[] = {"none", "diffusion", "counter", NULL};
     static const char *const on_off[] = {"off", "on", NULL};
+    static const char *const schedules[] = {"fixed", "progressive", NULL};
     /* Times: from a millisecond (a refresh faster than GL can draw is no use) up. */
     const double min_time = 1e-3, max_time = 1e6;
     const char *text;
@@ -148,6 +159,10 @@ bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_
         *st = ps_cli_choice(cli, on_off, &o->shadows, err);
     else if (ps_cli_is(cli, "--stencil-clip"))
         *st = ps_cli_choice(cli, on_off, &o->stencil_clip, err);
+    else if (ps_cli_is(cli, "--radius-schedule"))
+        *st = ps_cli_choice(cli, schedules, &o->radius_schedule, err);
+    else if (ps_cli_is(cli, "--radius-alpha"))
+        *st = ps_cli_double(cli, 0.01, 1.0, &o->radius_alpha, err);
     else if (ps_cli_is(cli, "--layers")) {
         *st = ps_cli_string(cli, &text, err);
         if (*st == PS_OK)

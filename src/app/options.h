@@ -44,6 +44,8 @@ typedef struct ps_preview_options {
     int precision;            /* ps_precision (diffusion) */
     int shadows, stencil_clip; /* on/off (on) */
     unsigned layers;          /* PS_LAYER_* bits (all) */
+    int radius_schedule;      /* ps_radius_schedule (fixed) */
+    double radius_alpha;      /* progressive schedule's alpha (2/3) */
 } ps_preview_options;
 
 /* float_depth: whether the colour depth defaults to float (the window) or
@@ -51,6 +53,11 @@ typedef struct ps_preview_options {
 void ps_preview_options_init(ps_preview_options *o, bool float_depth);
 /* Like ps_shared_option, for the preview's options. */
 bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_status *st, ps_error *err);
+/* Map k's splat radius after `emitted` photons: r0 under the schedule, its
+ * reference count the scene's photon count for the map (what r0 was chosen
+ * for), else `cap`. */
+double ps_preview_radius(const ps_preview_options *o, double r0, const ps_scene_defaults *d, ps_map_kind k,
+                         uint64_t cap, uint64_t emitted);
 /* "direct,caustic,global" (any non-empty subset) to PS_LAYER_* bits. */
 ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_error *err);
 

@@ -2,6 +2,7 @@
  * the photon tracer feeding splats to src/gl, one snapshot written as PNG
  * and/or PFM. The same frame the window shows, for tests and benchmarks. */
 #include <GL/osmesa.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,6 +11,7 @@
 #include "app/cli.h"
 #include "app/options.h"
 #include "app/stats.h"
+#include "core/fileio.h"
 #include "gl/gl_render.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
@@ -52,13 +54,54 @@ static const char usage[] =
     "  --point-size N           points: side in pixels (default 1)\n"
     "  --shadows on|off         shadow maps for the direct layer (default on)\n"
     "  --stencil-clip on|off    clip each object's splats to its pixels (default on)\n"
+    "  --radius-schedule fixed|progressive  splat radius as photons arrive: fixed, or\n"
+    "                           r^2 ~ n^(alpha-1), the given radius holding at the\n"
+    "                           scene's photon count (default fixed)\n"
+    "  --radius-alpha A         the progressive schedule's alpha in (0, 1] (default 2/3)\n"
+    "  --hdr-layers PREFIX      also each layer alone, linear: PREFIX-direct.pfm,\n"
+    "                           PREFIX-caustic.pfm, PREFIX-global.pfm\n"
+    "  --checkpoints T1,T2,...  progressive mode: at each of these seconds, write the\n"
+    "                           picture and its layers as --checkpoint-prefix P:\n"
+    "                           P-I.pfm, P-I-direct.pfm ... and a row of P.csv\n"
+    "                           (the writing is not counted in the seconds)\n"
+    "  --checkpoint-prefix P    where checkpoints go (needed with --checkpoints)\n"
     "  --help                   this text\n";
+
+/* Enough checkpoints for a log-spaced curve from milliseconds to hours. */
+#define SNAP_MAX_CHECKPOINTS 64
 
 typedef struct snap_options {
     ps_shared_options c;
     ps_preview_options p;
     double time; /* 0: trace the photon counts and draw once */
+    const char *hdr_layers;
+    const char *checkpoint_prefix;
+    double checkpoints[SNAP_MAX_CHECKPOINTS]; /* ascending */
+    int checkpoint_count;
 } snap_options;
+
+/* "0.1,0.5,2": ascending times within --time's range. */
+static ps_status parse_checkpoints(const char *text, snap_options *o, ps_error *err)
+{
+    const char *p = text;
+    o->checkpoint_count = 0;
+    for (;;) {
+        char *end;
+        double t = strtod(p, &end);
+        if (end == p || !(t >= 1e-3 && t <= 1e6) || (*end != ',' && *end != '\0'))
+            return ps_error_set(err, PS_ERR_PARSE,
+                                "photosplat-snap: --checkpoints: '%s' is not a comma list of seconds in [0.001, 1e6]", text);
+        if (o->checkpoint_count == SNAP_MAX_CHECKPOINTS)
+            return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --checkpoints: more than %d times",
+                                SNAP_MAX_CHECKPOINTS);
+        if (o->checkpoint_count > 0 && t <= o->checkpoints[o->checkpoint_count - 1])
+            return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --checkpoints: times must ascend ('%s')", text);
+        o->checkpoints[o->checkpoint_count++] = t;
+        if (*end == '\0')
+            return PS_OK;
+        p = end + 1;
+    }
+}
 
 static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, ps_error *err)
 {
@@ -77,6 +120,15 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
             continue;
         } else if (ps_cli_is(&cli, "--time")) {
             st = ps_cli_double(&cli, 1e-3, 1e6, &o->time, err);
+        } else if (ps_cli_is(&cli, "--hdr-layers")) {
+            st = ps_cli_string(&cli, &o->hdr_layers, err);
+        } else if (ps_cli_is(&cli, "--checkpoint-prefix")) {
+            st = ps_cli_string(&cli, &o->checkpoint_prefix, err);
+        } else if (ps_cli_is(&cli, "--checkpoints")) {
+            const char *text;
+            st = ps_cli_string(&cli, &text, err);
+            if (st == PS_OK)
+                st = parse_checkpoints(text, o, err);
         } else {
             return ps_cli_unknown(&cli, err);
         }
@@ -85,8 +137,13 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
         return st;
     if (!o->c.scene)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: no scene given (see --help)");
-    if (!o->c.out_png && !o->c.out_hdr)
+    if (!o->c.out_png && !o->c.out_hdr && !o->hdr_layers && !o->checkpoint_prefix)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: nothing to write: give -o FILE.png or --hdr FILE.pfm");
+    if ((o->checkpoint_count > 0) != (o->checkpoint_prefix != NULL))
+        return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --checkpoints and --checkpoint-prefix go together");
+    if (o->checkpoint_count > 0 && o->time < o->checkpoints[o->checkpoint_count - 1])
+        return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --checkpoints need --time of at least their last, %g s",
+                            o->checkpoints[o->checkpoint_count - 1]);
     return PS_OK;
 }
 
@@ -99,7 +156,10 @@ typedef struct snap_run {
     ps_gl_renderer *gl;
     ps_kernel_texture kernel;
     ps_splat_batch batch[PS_MAP_COUNT];
-    double radius[PS_MAP_COUNT];
+    const ps_scene_defaults *def;
+    double radius0[PS_MAP_COUNT]; /* as given: the scene's or the options' */
+    double radius[PS_MAP_COUNT];  /* this frame's, under the radius schedule */
+    uint64_t emitted[PS_MAP_COUNT]; /* the photons this frame shows were emitted of */
     uint64_t frames;
     double splat_seconds;
     /* The counter, for the last refresh. */
@@ -127,11 +187,15 @@ static ps_status build_splats(snap_run *s, const ps_feed *f, ps_error *err)
          * the same photons give the same picture. */
         b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
         b->wanted = b->lost = 0.0;
+        s->emitted[k] = 0;
         if (!(o->p.layers & layer) || m->count == 0 || m->counters.emitted == 0)
             continue;
         ps_splat_params p;
         memset(&p, 0, sizeof p);
         p.mode = (ps_splat_mode)o->p.splat;
+        s->emitted[k] = m->counters.emitted;
+        s->radius[k] = ps_preview_radius(&o->p, s->radius0[k], s->def, (ps_map_kind)k, ps_feed_cap(f, (ps_map_kind)k),
+                                         m->counters.emitted);
         p.radius = s->radius[k];
         p.kernel_mean = s->kernel.mean;
         p.kernel_extent = s->kernel.extent;
@@ -167,6 +231,49 @@ static void draw_frame(snap_run *s)
     s->splat_seconds += ps_now_seconds() - t0;
 }
 
+/* The colour buffer as linear radiance: it holds radiance times exposure. */
+static ps_status read_radiance(snap_run *s, ps_image *img, ps_error *err)
+{
+    ps_status st = ps_gl_read(s->gl, img, err);
+    if (st != PS_OK)
+        return st;
+    float inv = s->o->c.exposure > 0.0 ? (float)(1.0 / s->o->c.exposure) : 0.0f;
+    size_t n = 3 * (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n; i++)
+        img->rgb[i] *= inv;
+    return PS_OK;
+}
+
+static ps_status write_radiance(snap_run *s, const char *path, ps_error *err)
+{
+    ps_image img;
+    ps_status st = read_radiance(s, &img, err);
+    if (st == PS_OK)
+        st = ps_pfm_write(&img, path, err);
+    ps_image_destroy(&img);
+    return st;
+}
+
+/* Each layer alone, as the frame's splats draw it, to PREFIX-NAME.pfm. Leaves
+ * the colour buffer holding the last layer: draw the frame again after. */
+static ps_status write_layers(snap_run *s, const char *prefix, ps_error *err)
+{
+    static const char *const names[PS_MAP_COUNT] = {"caustic", "global"};
+    const snap_options *o = s->o;
+    char path[PATH_MAX];
+    ps_status st = PS_OK;
+    for (int layer = -1; layer < PS_MAP_COUNT && st == PS_OK; layer++) {
+        /* layer -1: the direct light alone, no splats. */
+        if (snprintf(path, sizeof path, "%s-%s.pfm", prefix, layer < 0 ? "direct" : names[layer]) >= (int)sizeof path)
+            return ps_error_set(err, PS_ERR_IO, "%s: path too long", prefix);
+        ps_gl_begin_frame(s->gl, &s->cam, o->c.exposure, layer < 0 && (o->p.layers & PS_LAYER_DIRECT));
+        if (layer >= 0)
+            ps_gl_draw_splats(s->gl, &s->batch[layer], (ps_splat_mode)o->p.splat, s->radius[layer], o->p.point_size);
+        st = write_radiance(s, path, err);
+    }
+    return st;
+}
+
 static ps_status write_outputs(snap_run *s, ps_error *err)
 {
     const snap_options *o = s->o;
@@ -186,7 +293,57 @@ static ps_status write_outputs(snap_run *s, ps_error *err)
         st = ps_pfm_write(&img, o->c.out_hdr, err);
     }
     ps_image_destroy(&img);
+    if (st == PS_OK && o->hdr_layers)
+        st = write_layers(s, o->hdr_layers, err);
     return st;
+}
+
+/* Checkpoints: the pictures of a progressive run at given times, for curves
+ * of error against time (photosplat-bench). Their rows are kept until the
+ * end, then written as one CSV. */
+typedef struct snap_checkpoint_row {
+    double requested, seconds, radius[PS_MAP_COUNT], lost_fraction;
+    uint64_t emitted[PS_MAP_COUNT];
+} snap_checkpoint_row;
+
+static ps_status write_checkpoint(snap_run *s, int i, double seconds, snap_checkpoint_row *row, ps_error *err)
+{
+    const snap_options *o = s->o;
+    char path[PATH_MAX];
+    if (snprintf(path, sizeof path, "%s-%d", o->checkpoint_prefix, i) >= (int)sizeof path - 16)
+        return ps_error_set(err, PS_ERR_IO, "%s: path too long", o->checkpoint_prefix);
+    size_t len = strlen(path);
+    snprintf(path + len, sizeof path - len, ".pfm");
+    ps_status st = write_radiance(s, path, err);
+    path[len] = '\0';
+    if (st == PS_OK)
+        st = write_layers(s, path, err);
+    row->requested = o->checkpoints[i];
+    row->seconds = seconds;
+    row->lost_fraction = s->lost_fraction;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        row->radius[k] = s->radius[k];
+        row->emitted[k] = s->emitted[k];
+    }
+    return st;
+}
+
+static ps_status write_checkpoint_csv(const snap_options *o, const snap_checkpoint_row *rows, int count, ps_error *err)
+{
+    char path[PATH_MAX];
+    if (snprintf(path, sizeof path, "%s.csv", o->checkpoint_prefix) >= (int)sizeof path)
+        return ps_error_set(err, PS_ERR_IO, "%s: path too long", o->checkpoint_prefix);
+    ps_outfile *out = ps_outfile_open(path, err);
+    if (!out)
+        return err->status;
+    FILE *fp = ps_outfile_stream(out);
+    fprintf(fp, "index,requested_seconds,seconds,caustic_emitted,global_emitted,caustic_radius,global_radius,"
+                "round_off_fraction\n");
+    for (int i = 0; i < count; i++)
+        fprintf(fp, "%d,%.6g,%.6f,%llu,%llu,%.9g,%.9g,%.6g\n", i, rows[i].requested, rows[i].seconds,
+                (unsigned long long)rows[i].emitted[0], (unsigned long long)rows[i].emitted[1], rows[i].radius[0],
+                rows[i].radius[1], rows[i].lost_fraction);
+    return ps_outfile_commit(out, err);
 }
 
 /* The photons, the frames, the files. */
@@ -203,8 +360,9 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     s.o = o;
     s.scene = scene;
     s.cam = ps_camera_frame_make(ps_scene_camera(scene), width, height);
+    s.def = def;
     for (int k = 0; k < PS_MAP_COUNT; k++)
-        s.radius[k] = ps_shared_radius(&o->c, def, (ps_map_kind)k);
+        s.radius[k] = s.radius0[k] = ps_shared_radius(&o->c, def, (ps_map_kind)k);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_splat_batch_init(&s.batch[k]);
 
@@ -250,6 +408,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     if (st == PS_OK)
         st = ps_feed_create(tracer, want, active, &feed, err);
 
+    snap_checkpoint_row rows[SNAP_MAX_CHECKPOINTS];
     double t_start = ps_now_seconds(), first_frame = -1.0;
     bool counter_stopped = false;
     uint64_t counter_at = 0;
@@ -262,12 +421,17 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
             draw_frame(&s);
         first_frame = ps_now_seconds() - t_start;
     } else if (st == PS_OK) {
-        /* Progressive: trace in the background, refresh every tau. */
+        /* Progressive: trace in the background, refresh every tau. Time
+         * spent writing checkpoints is taken off the clock (the tracer is
+         * held meanwhile), so they measure the preview, not the bench. */
         st = ps_feed_start(feed, err);
-        double next = t_start + o->p.tau, end = t_start + o->time;
+        double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
+        int cp = 0;
         while (st == PS_OK) {
             double t = ps_now_seconds();
             double until = next < end ? next : end;
+            if (cp < o->checkpoint_count && t_start + excluded + o->checkpoints[cp] < until)
+                until = t_start + excluded + o->checkpoints[cp];
             if (t < until) {
                 struct timespec ts = {(time_t)(until - t), (long)((until - t - (double)(time_t)(until - t)) * 1e9)};
                 nanosleep(&ts, NULL);
@@ -280,8 +444,21 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
             if (st != PS_OK)
                 break;
             draw_frame(&s);
+            double now = ps_now_seconds();
             if (first_frame < 0.0)
-                first_frame = ps_now_seconds() - t_start;
+                first_frame = now - t_start;
+            if (cp < o->checkpoint_count && now - t_start - excluded >= o->checkpoints[cp]) {
+                ps_feed_pause(feed, true);
+                st = write_checkpoint(&s, cp, now - t_start - excluded, &rows[cp], err);
+                ps_feed_pause(feed, false);
+                cp++;
+                double spent = ps_now_seconds() - now;
+                excluded += spent;
+                next += spent;
+                end += spent;
+                if (st != PS_OK)
+                    break;
+            }
             /* Thesis 5.1: once a refresh loses this much to round-off, more
              * photons only add noise; stop shooting. */
             if (o->p.precision == PS_PRECISION_COUNTER && o->p.color_depth == 0 && s.lost_fraction > o->p.counter_threshold) {
@@ -301,8 +478,18 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
             st = build_splats(&s, feed, err);
         if (st == PS_OK)
             draw_frame(&s);
+        /* Checkpoints after the end (every cap reached, or the counter
+         * stopped the tracer) show the final picture, at the time it was done. */
+        double done = ps_now_seconds() - t_start - excluded;
+        for (; st == PS_OK && cp < o->checkpoint_count; cp++) {
+            st = write_checkpoint(&s, cp, done, &rows[cp], err);
+            if (st == PS_OK)
+                draw_frame(&s);
+        }
+        if (st == PS_OK && o->checkpoint_count > 0)
+            st = write_checkpoint_csv(o, rows, o->checkpoint_count, err);
     }
-    if (st == PS_OK && (o->c.out_png || o->c.out_hdr))
+    if (st == PS_OK && (o->c.out_png || o->c.out_hdr || o->hdr_layers))
         st = write_outputs(&s, err);
     if (st == PS_OK && o->c.dump)
         st = ps_write_photon_dump(o->c.dump, ps_feed_maps(feed), err);
@@ -337,6 +524,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         ps_stats_add(&rs, "counter_stopped", counter_stopped ? 1.0 : 0.0);
         ps_stats_add(&rs, "counter_stopped_at_photons", (double)counter_at);
         ps_stats_add(&rs, "counter_threshold", o->p.counter_threshold);
+        ps_stats_add(&rs, "radius_progressive", o->p.radius_schedule == PS_RADIUS_PROGRESSIVE ? 1.0 : 0.0);
         if (o->c.stats)
             st = ps_stats_write(o->c.stats, &rs, err);
     }

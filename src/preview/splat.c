@@ -276,3 +276,18 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
         return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory grouping %zu photons", count);
     return PS_OK;
 }
+
+const char *ps_radius_schedule_name(ps_radius_schedule s)
+{
+    return s == PS_RADIUS_PROGRESSIVE ? "progressive" : "fixed";
+}
+
+double ps_splat_radius_at(ps_radius_schedule s, double r0, uint64_t n0, uint64_t n, double alpha)
+{
+    if (s != PS_RADIUS_PROGRESSIVE || n0 == 0)
+        return r0;
+    if (n == 0)
+        return r0 * PS_RADIUS_GROWTH_MAX;
+    double f = pow((double)n / (double)n0, 0.5 * (alpha - 1.0));
+    return r0 * fmin(f, PS_RADIUS_GROWTH_MAX);
+}

@@ -127,6 +127,33 @@ void ps_splat_batch_clear(ps_splat_batch *b);
 ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
                          ps_splat_batch *b, ps_error *err);
 
+/* The splat radius as photons accumulate.
+ *
+ * Thesis departure: the thesis splats every photon with one fixed radius, so
+ * the preview's error falls with the noise but stops at the kernel's bias
+ * (a blur of width r). Progressive photon mapping (Hachisuka et al. 2008)
+ * shrinks the radius as photons arrive, r^2 proportional to n^(alpha - 1)
+ * with 0 < alpha < 1: the bias (ratio r^2) and the noise (ratio 1 / (n r^2))
+ * both go to zero. Here the given radius r0 holds at n0 photons (the scene's
+ * photon count, for which it was chosen): fewer photons get a larger radius,
+ * smoother at first, more a smaller one. The growth is capped so that the
+ * very first frames do not flood the fill rate with huge splats. */
+typedef enum ps_radius_schedule {
+    PS_RADIUS_FIXED,       /* r0 whatever n: the thesis */
+    PS_RADIUS_PROGRESSIVE, /* r0 (n / n0)^((alpha - 1) / 2) */
+    PS_RADIUS_SCHEDULE_COUNT
+} ps_radius_schedule;
+
+/* Hachisuka et al.'s alpha: keeps 2/3 of the photons' density gain for noise. */
+#define PS_RADIUS_ALPHA_DEFAULT (2.0 / 3.0)
+/* The most the progressive radius may exceed r0 (few photons, early frames). */
+#define PS_RADIUS_GROWTH_MAX 4.0
+
+const char *ps_radius_schedule_name(ps_radius_schedule s);
+/* The radius for n photons emitted (n0 > 0 the reference count, alpha in
+ * (0, 1]); n = 0 gives the largest, r0 * PS_RADIUS_GROWTH_MAX. */
+double ps_splat_radius_at(ps_radius_schedule s, double r0, uint64_t n0, uint64_t n, double alpha);
+
 /* The thesis' numerically stable basis (Fig. 11): X perpendicular to unit n
  * from n's two larger components (the smallest is zeroed), Y = n x X so that
  * (X, Y, n) is right-handed (the figure's X x N is its mirror image); both unit. */
