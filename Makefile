@@ -158,8 +158,9 @@ $(GL_BENCHES): build/release/bench/%: bench/%.c $(GLLIB_release) $(LIB_release)
 .PHONY: build-bench
 build-bench: $(BENCHES)
 
-bench: deps
-	@$(MAKE) --no-print-directory -j$(JOBS) build-bench
+bench:
+	@scripts/install-deps.sh --bench
+	@$(MAKE) --no-print-directory -j$(JOBS) all build-bench
 	@scripts/bench.sh
 
 SCENE ?= data/scenes/cornell-caustic.scn

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # bench.sh: runs every benchmark program (build/release/bench/bench_*) in
 # turn from the repository root, as `make bench` does after building them,
-# then scripts/bench-ref.sh (photosplat-ref against POV-Ray).
+# then scripts/bench-ref.sh (photosplat-ref against POV-Ray), photosplat-bench
+# (the preview's error against time) and scripts/bench-window.sh.
 # Exits non-zero when any of them fails.
 set -u
 cd "$(dirname "$0")/.."
@@ -32,6 +33,22 @@ if [ "${PS_BENCH_REF:-1}" != 0 ]; then
         status=1
     fi
     echo "== bench-ref: $((SECONDS - start)) s"
+    echo
+fi
+# The preview's error against time on the four bench scenes (photosplat-bench):
+# bench/results/bench.{csv,md,png}. About 25 minutes on 2 cores with its
+# references cached, 10 more without; PS_BENCH_QUICK=1 runs its --quick
+# subset, PS_BENCH_PREVIEW=0 skips it.
+if [ "${PS_BENCH_PREVIEW:-1}" != 0 ]; then
+    echo "== photosplat-bench"
+    start=$SECONDS
+    quick=()
+    [ "${PS_BENCH_QUICK:-0}" != 0 ] && quick=(--quick)
+    if ! bin/photosplat-bench "${quick[@]}"; then
+        echo "== photosplat-bench: FAILED" >&2
+        status=1
+    fi
+    echo "== photosplat-bench: $((SECONDS - start)) s"
     echo
 fi
 # The window's frames per second and edit latency, under Xvfb.

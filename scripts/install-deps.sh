@@ -2,7 +2,8 @@
 # install-deps.sh: install the Debian 12 packages photosplat needs, skipping
 # what is already there (checked with pkg-config or the command itself).
 # Called by `make test` and `make run`; needs root or sudo only when something
-# is missing.
+# is missing. With --bench, also what `make bench` needs (gnuplot for the
+# photosplat-bench plots).
 set -euo pipefail
 
 missing=()
@@ -28,6 +29,10 @@ need_cmd xauth xauth
 # The sanitizer runtimes come with gcc on Debian but may be trimmed from images.
 [ -e "$(gcc -print-file-name=libasan.so 2>/dev/null)" ] && gcc -print-file-name=libasan.so | grep -q / || missing+=(libasan8)
 [ -e "$(gcc -print-file-name=libubsan.so 2>/dev/null)" ] && gcc -print-file-name=libubsan.so | grep -q / || missing+=(libubsan1)
+
+if [ "${1:-}" = --bench ]; then
+    need_cmd gnuplot gnuplot-nox
+fi
 
 if [ ${#missing[@]} -eq 0 ]; then
     exit 0

@@ -875,6 +875,33 @@ static void precision_counter(void **state)
     }
 }
 
+/* The progressive radius: r0 at the reference count, r^2 proportional to
+ * n^(alpha - 1), so 64 times the photons with alpha 2/3 give 64^(-1/6) = 1/2
+ * the radius; the growth for few photons is capped; fixed ignores n. */
+static void radius_schedule(void **state)
+{
+    (void)state;
+    const double r0 = 0.02, a = PS_RADIUS_ALPHA_DEFAULT;
+    const uint64_t n0 = 200000;
+    assert_float_equal(ps_splat_radius_at(PS_RADIUS_FIXED, r0, n0, 64 * n0, a), r0, 0.0);
+    assert_float_equal(ps_splat_radius_at(PS_RADIUS_PROGRESSIVE, r0, n0, n0, a), r0, 1e-15);
+    assert_float_equal(ps_splat_radius_at(PS_RADIUS_PROGRESSIVE, r0, n0, 64 * n0, a), r0 / 2.0, 1e-12);
+    assert_float_equal(ps_splat_radius_at(PS_RADIUS_PROGRESSIVE, r0, n0, n0 / 64, a), 2.0 * r0, 1e-12);
+    /* r^2 n^(1 - alpha) is constant: the kernel's bias falls as n^(alpha - 1). */
+    for (uint64_t n = 1000; n < 1000000000; n *= 7) {
+        double r = ps_splat_radius_at(PS_RADIUS_PROGRESSIVE, r0, n0, n, a);
+        if (r < r0 * PS_RADIUS_GROWTH_MAX)
+            assert_float_equal(r * r * pow((double)n, 1.0 - a), r0 * r0 * pow((double)n0, 1.0 - a), 1e-9 * r0 * r0 * pow((double)n0, 1.0 - a));
+    }
+    assert_float_equal(ps_splat_radius_at(PS_RADIUS_PROGRESSIVE, r0, n0, 1, a), r0 * PS_RADIUS_GROWTH_MAX, 0.0);
+    assert_float_equal(ps_splat_radius_at(PS_RADIUS_PROGRESSIVE, r0, n0, 0, a), r0 * PS_RADIUS_GROWTH_MAX, 0.0);
+    /* alpha 1: no shrinking; no reference count: r0. */
+    assert_float_equal(ps_splat_radius_at(PS_RADIUS_PROGRESSIVE, r0, n0, 1000 * n0, 1.0), r0, 1e-15);
+    assert_float_equal(ps_splat_radius_at(PS_RADIUS_PROGRESSIVE, r0, 0, 1000, a), r0, 0.0);
+    assert_string_equal(ps_radius_schedule_name(PS_RADIUS_PROGRESSIVE), "progressive");
+    assert_string_equal(ps_radius_schedule_name(PS_RADIUS_FIXED), "fixed");
+}
+
 static void names(void **state)
 {
     (void)state;
@@ -894,7 +921,7 @@ int main(void)
         cmocka_unit_test(kernel_texture), cmocka_unit_test(splat_basis),         cmocka_unit_test(triangles), cmocka_unit_test(sprites),
         cmocka_unit_test(points),         cmocka_unit_test(glossy),              cmocka_unit_test(back_faces),
         cmocka_unit_test(batches), cmocka_unit_test(groups),        cmocka_unit_test(precision_diffusion), cmocka_unit_test(precision_counter),
-        cmocka_unit_test(names),
+        cmocka_unit_test(names), cmocka_unit_test(radius_schedule),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

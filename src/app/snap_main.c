@@ -424,7 +424,11 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         /* Progressive: trace in the background, refresh every tau. Time
          * spent writing checkpoints is taken off the clock (the tracer is
          * held meanwhile), so they measure the preview, not the bench. */
-        st = ps_feed_start(feed, err);
+        /* As the window: the first round traced here, so that the first
+         * frame already shows photons (the rest come in the background). */
+        st = ps_feed_prime(feed, err);
+        if (st == PS_OK)
+            st = ps_feed_start(feed, err);
         double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
         int cp = 0;
         while (st == PS_OK) {

@@ -87,6 +87,10 @@ static const char usage[] =
     "  --point-size N           points: side in pixels (default 1)\n"
     "  --shadows on|off         shadow maps (default on)\n"
     "  --stencil-clip on|off    clip splats to their object's pixels (default on)\n"
+    "  --radius-schedule fixed|progressive  splat radius as photons arrive (default\n"
+    "                           fixed; progressive: r^2 ~ n^(alpha-1), the given\n"
+    "                           radius holding at the scene's photon count)\n"
+    "  --radius-alpha A         the progressive schedule's alpha (default 2/3)\n"
     "  --overlay on|off         the text overlay (default on)\n"
     "  --help                   this text\n";
 
@@ -137,6 +141,9 @@ typedef struct app {
     ps_precision precision;
     unsigned shown;
     double radius[PS_MAP_COUNT], tau, exposure;
+    /* The radius the newest splats were built with: radius[] under the
+     * radius schedule (--radius-schedule), for the photons emitted so far. */
+    double splat_radius[PS_MAP_COUNT];
     bool paused, overlay, help;
     /* What the frames need redone. */
     bool view_dirty, scene_dirty, geometry_dirty;
@@ -330,7 +337,9 @@ static ps_status build_splats(app *a, size_t first[PS_MAP_COUNT], ps_error *err)
         ps_splat_params p;
         memset(&p, 0, sizeof p);
         p.mode = a->splat;
-        p.radius = a->radius[k];
+        a->splat_radius[k] = ps_preview_radius(&a->o.p, a->radius[k], ps_scene_get_defaults(a->scene), (ps_map_kind)k,
+                                               a->cap[k], emitted);
+        p.radius = a->splat_radius[k];
         p.kernel_mean = a->kernel.mean;
         p.kernel_extent = a->kernel.extent;
         p.scale = float_layers(a) ? 1.0 : a->exposure * (double)a->cap[k] / (double)emitted;
@@ -404,7 +413,8 @@ static void draw_overlay(app *a)
                      "%s splats  %s kernel  r %.3g/%.3g  layers %s%s%s  %s  exposure %.3g\n",
                      (unsigned long long)ce, (unsigned long long)a->cap[0], (unsigned long long)ge,
                      (unsigned long long)a->cap[1], state, rate, a->fps, a->tau, 1000.0 * a->frame_seconds,
-                     ps_splat_mode_name(a->splat), ps_kernel_name(a->kernel_kind), a->radius[0], a->radius[1],
+                     ps_splat_mode_name(a->splat), ps_kernel_name(a->kernel_kind), a->splat_radius[0],
+                     a->splat_radius[1],
                      a->shown & PS_LAYER_DIRECT ? "D" : "-", a->shown & PS_LAYER_CAUSTIC ? "C" : "-",
                      a->shown & PS_LAYER_GLOBAL ? "G" : "-", float_layers(a) ? "float" : ps_precision_name(a->precision),
                      a->exposure);
@@ -461,7 +471,7 @@ static ps_status refresh(app *a, ps_error *err)
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         if (!float_layers(a))
             ps_gl_layers_clear_map(a->layers, k);
-        ps_gl_layers_add(a->layers, a->gl, k, &a->batch[k], a->splat, a->radius[k], a->o.p.point_size);
+        ps_gl_layers_add(a->layers, a->gl, k, &a->batch[k], a->splat, a->splat_radius[k], a->o.p.point_size);
         a->drawn[k] = upto[k];
         splats += a->batch[k].splats;
     }
@@ -979,7 +989,7 @@ static ps_status session(app *a, ps_error *err)
     a->overlay = a->o.overlay != 0;
     a->budget = SPLAT_BUDGET_START;
     for (int k = 0; k < PS_MAP_COUNT; k++) {
-        a->radius[k] = ps_shared_radius(&a->o.c, def, (ps_map_kind)k);
+        a->radius[k] = a->splat_radius[k] = ps_shared_radius(&a->o.c, def, (ps_map_kind)k);
         a->cap[k] = ps_shared_photons(&a->o.c, def, (ps_map_kind)k);
         ps_splat_batch_init(&a->batch[k]);
     }

@@ -1,0 +1,113 @@
+#!/usr/bin/env bash
+# cli_bench.sh BIN_DIR: what photosplat-bench is made of, from the outside:
+# snap's per-layer images, checkpoints and radius schedule, compare --clamp,
+# and a tiny photosplat-bench run with its reference cache.
+set -u
+cd "$(dirname "$0")/.."
+bin=${1:-bin}
+. tests/cli_lib.sh
+snap=$bin/photosplat-snap
+compare=$bin/photosplat-compare
+bench=$bin/photosplat-bench
+mirror=tests/data/good/mirror-caustic.scn
+mean_of() { "$compare" "$1" "$1" | sed -n 's/.*mean_a=\([^ ]*\).*/\1/p'; }
+awk_true() { awk "BEGIN { exit !($1) }"; }
+
+# ---- snap: options --------------------------------------------------------------
+expect_usage_error "checkpoints without prefix" "$snap" "$mirror" --time 1 --checkpoints 0.5
+expect_usage_error "prefix without checkpoints" "$snap" "$mirror" --time 1 --checkpoint-prefix "$cli_tmp/c"
+expect_usage_error "checkpoints beyond --time" "$snap" "$mirror" --time 1 --checkpoints 0.5,2 --checkpoint-prefix "$cli_tmp/c"
+expect_match "says which" "$cli_err" 'at least their last, 2 s'
+expect_usage_error "checkpoints descending" "$snap" "$mirror" --time 1 --checkpoints 0.5,0.2 --checkpoint-prefix "$cli_tmp/c"
+expect_usage_error "checkpoints not numbers" "$snap" "$mirror" --time 1 --checkpoints 0.5,x --checkpoint-prefix "$cli_tmp/c"
+expect_usage_error "bad schedule" "$snap" "$mirror" -o "$cli_tmp/x.png" --radius-schedule shrinking
+expect_usage_error "bad alpha" "$snap" "$mirror" -o "$cli_tmp/x.png" --radius-alpha 1.5
+[ ! -e "$cli_tmp/c.csv" ] && ok || bad "a refused run left a checkpoint CSV"
+
+# ---- snap: layers alone add up to the picture (float buffer: no rounding) --------
+expect_success "layers" "$snap" "$mirror" --size 32x32 --color-depth float --caustic-photons 20000 \
+    --hdr "$cli_tmp/w.pfm" --hdr-layers "$cli_tmp/l"
+for l in direct caustic global; do
+    [ "$(head -2 "$cli_tmp/l-$l.pfm" 2>/dev/null | tr '\n' ' ')" = "PF 32 32 " ] && ok || bad "no 32x32 l-$l.pfm"
+done
+whole=$(mean_of "$cli_tmp/w.pfm")
+sum=$(awk -v a="$(mean_of "$cli_tmp/l-direct.pfm")" -v b="$(mean_of "$cli_tmp/l-caustic.pfm")" \
+    -v c="$(mean_of "$cli_tmp/l-global.pfm")" 'BEGIN { print a + b + c }')
+awk_true "$whole > 0 && ($sum - $whole) / $whole < 1e-4 && ($whole - $sum) / $whole < 1e-4" &&
+    ok || bad "layers' means add to $sum, the picture's is $whole"
+# The mirror scene has no global photons: that layer is black; the caustic is not.
+awk_true "$(mean_of "$cli_tmp/l-global.pfm") == 0" && ok || bad "global layer not black"
+awk_true "$(mean_of "$cli_tmp/l-caustic.pfm") > 0" && ok || bad "caustic layer black"
+
+# ---- snap: checkpoints and the progressive radius --------------------------------
+expect_success "checkpoints" "$snap" "$mirror" --size 32x32 --time 1.5 --tau 0.05 --checkpoints 0.1,0.5,1.5 \
+    --checkpoint-prefix "$cli_tmp/cp" --caustic-photons 20000000 --radius-schedule progressive
+[ "$(wc -l <"$cli_tmp/cp.csv")" = 4 ] && ok || bad "cp.csv: $(wc -l <"$cli_tmp/cp.csv") lines, expected 4"
+for i in 0 1 2; do
+    for s in "" -direct -caustic -global; do
+        [ -s "$cli_tmp/cp-$i$s.pfm" ] && ok || bad "no checkpoint image cp-$i$s.pfm"
+    done
+done
+# Rows: seconds at or after the requested time and ascending; photons
+# ascending; the radius as the schedule says for the photons shown (the
+# scene's 400000 caustic photons hold radius 0.15; growth capped at 4x).
+awk -F, 'NR > 1 {
+    if ($3 + 1e-6 < $2) { print "checkpoint " $1 " at " $3 " s, before " $2; bad = 1 }
+    if (NR > 2 && ($3 < s || $4 < n)) { print "checkpoint " $1 " goes back"; bad = 1 }
+    s = $3; n = $4
+    want = 0.15 * exp(-log($4 / 400000) / 6); if (want > 0.6) want = 0.6
+    if ($4 == 0 || ($6 - want) / want > 1e-6 || (want - $6) / want > 1e-6) { print "radius " $6 " for " $4 " photons, want " want; bad = 1 }
+} END { exit bad }' "$cli_tmp/cp.csv" && ok || bad "checkpoint rows wrong: $(cat "$cli_tmp/cp.csv")"
+# Later checkpoints hold more photons: the caustic's noise falls.
+awk_true "$(sed -n 4p "$cli_tmp/cp.csv" | cut -d, -f4) > $(sed -n 2p "$cli_tmp/cp.csv" | cut -d, -f4)" &&
+    ok || bad "no photons arrived between the first and the last checkpoint"
+
+# ---- compare --clamp --------------------------------------------------------------
+expect_usage_error "bad clamp" "$compare" "$cli_tmp/w.pfm" "$cli_tmp/w.pfm" --clamp 0
+expect_success "clamp" "$compare" "$cli_tmp/l-caustic.pfm" "$cli_tmp/l-direct.pfm" --clamp 1e-30
+awk_true "$(printf '%s\n' "$cli_out" | sed -n 's/^rmse=\([^ ]*\) .*/\1/p') < 1e-29" && ok || bad "clamped images differ: $cli_out"
+expect_success "no clamp" "$compare" "$cli_tmp/l-caustic.pfm" "$cli_tmp/l-direct.pfm"
+expect_match "unclamped images differ" "$cli_out" '^rmse=0\.[0-9]'
+
+# ---- photosplat-bench --------------------------------------------------------------
+expect_usage_error "bench: bad budgets" "$bench" --budgets 1,0.5
+expect_usage_error "bench: bad scene exposure" "$bench" --scenes "$mirror:-1"
+expect_usage_error "bench: positional" "$bench" "$mirror"
+expect_usage_error "bench: missing scene" "$bench" --scenes "$cli_tmp/none.scn" --out "$cli_tmp/b0" --bin "$bin"
+expect_match "bench: names the scene" "$cli_err" 'none\.scn'
+# A tiny scene: few photons, so that its references take a second.
+cat >"$cli_tmp/tiny.scn" <<'EOF'
+camera   eye 0 1.5 3  target 0 0 0  fov 40
+image    24 24
+material floor  diffuse albedo 0.5 0.5 0.5
+material mirror mirror  reflectance 1 1 1
+quad     corner -2 0 2  edge1 4 0 0  edge2 0 0 -4  material floor
+quad     corner -0.5 2 -0.5  edge1 1 0 0  edge2 0 0 1  material mirror
+light    point  position 0 1 0  power 100 100 100
+photons  caustic 2000  global 1000
+radius   caustic 0.2  global 0.3
+EOF
+expect_success "bench: tiny" "$bench" --quick --size 24x24 --budgets 0.05,0.3 --scenes "$cli_tmp/tiny.scn:0.5" \
+    --out "$cli_tmp/b" --bin "$bin" --threads 1
+expect_match "bench: rendered the references" "$cli_out" 'reference specular'
+# 4 main configurations x 2 checkpoints, each with finite errors below 1.
+[ "$(tail -n +2 "$cli_tmp/b/bench.csv" | wc -l)" = 8 ] && ok || bad "bench.csv: not 8 rows"
+awk -F, 'NR > 1 { for (i = 13; i <= NF; i++) if (!($i >= 0 && $i < 10)) { print "column " i ": " $i; bad = 1 } } END { exit bad }' \
+    "$cli_tmp/b/bench.csv" && ok || bad "bench.csv has errors out of range"
+grep -q '^| triangles float progressive |' "$cli_tmp/b/bench.md" && ok || bad "bench.md lacks a table row"
+[ -s "$cli_tmp/b/data/tiny.dat" ] && [ -s "$cli_tmp/b/data/plots.gp" ] && ok || bad "no plot data"
+if command -v gnuplot >/dev/null 2>&1; then
+    [ "$(head -c 8 "$cli_tmp/b/bench.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a ] && ok || bad "no bench.png"
+fi
+[ ! -e "$cli_tmp/b/cache/work/cp.csv" ] && ok || bad "scratch files left behind"
+# Again: the references come from the cache; a changed scene renders anew.
+expect_success "bench: cached" "$bench" --quick --size 24x24 --budgets 0.05 --scenes "$cli_tmp/tiny.scn:0.5" \
+    --out "$cli_tmp/b" --bin "$bin" --threads 1
+if printf '%s\n' "$cli_out" | grep -q 'reference '; then bad "bench: references rendered again"; else ok; fi
+grep -q 'from the cache' "$cli_tmp/b/bench.md" && ok || bad "bench.md does not say the cache served"
+sed -i 's/power 100 100 100/power 90 90 90/' "$cli_tmp/tiny.scn"
+expect_success "bench: changed scene" "$bench" --quick --size 24x24 --budgets 0.05 --scenes "$cli_tmp/tiny.scn:0.5" \
+    --out "$cli_tmp/b" --bin "$bin" --threads 1
+expect_match "bench: a changed scene renders anew" "$cli_out" 'reference direct'
+
+cli_summary
