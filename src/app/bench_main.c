@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -43,6 +44,7 @@ static const char usage[] =
     "  bench.csv      every measurement\n"
     "  bench.md       tables: error at each time, per scene and configuration\n"
     "  bench.png      the main plot: whole-image error against seconds, per scene\n"
+    "  bench-photons.png  the same against photons emitted\n"
     "  SCENE.png      per scene: each layer's error against seconds\n"
     "  data/*.dat     the plotted data (gnuplot)\n"
     "\n"
@@ -370,9 +372,42 @@ static bool file_exists(const char *path)
     return stat(path, &sb) == 0 && S_ISREG(sb.st_mode);
 }
 
+/* What the reference renderer is made of. From the source tree when the
+ * bench runs in one (the folders the renderer's code lives in, so that a
+ * change to the preview alone keeps the references), else the binary. */
+static const char *const renderer_sources[] = {"src/core", "src/scene", "src/accel", "src/photon", "src/render",
+                                                "src/image"};
+#define RENDERER_MAIN "src/app/ref_main.c"
+
+static int by_name(const struct dirent **a, const struct dirent **b) { return strcmp((*a)->d_name, (*b)->d_name); }
+
+static ps_status hash_renderer(uint64_t *h, const char *binary, ps_error *err)
+{
+    if (!file_exists(RENDERER_MAIN))
+        return hash_file(h, binary, err);
+    ps_status st = hash_file(h, RENDERER_MAIN, err);
+    for (size_t d = 0; st == PS_OK && d < sizeof renderer_sources / sizeof renderer_sources[0]; d++) {
+        struct dirent **list;
+        int n = scandir(renderer_sources[d], &list, NULL, by_name);
+        if (n < 0)
+            return ps_error_set(err, PS_ERR_IO, "%s: cannot list: %s", renderer_sources[d], strerror(errno));
+        for (int i = 0; i < n; i++) {
+            char path[PATH_MAX];
+            snprintf(path, sizeof path, "%s/%s", renderer_sources[d], list[i]->d_name);
+            if (st == PS_OK && file_exists(path)) {
+                *h = fnv(*h, path, strlen(path) + 1);
+                st = hash_file(h, path, err);
+            }
+            free(list[i]);
+        }
+        free(list);
+    }
+    return st;
+}
+
 /* The scene's key: its text, each .obj it names and the .mtl files beside
- * them (a renamed or edited mesh makes a new reference), the renderer's
- * binary and the settings. */
+ * them (a renamed or edited mesh makes a new reference), the renderer
+ * (hash_renderer) and the settings. */
 static ps_status scene_key(const char *scene, const char *ref, char *const args[], uint64_t *key,
                            ps_error *err)
 {
@@ -406,7 +441,7 @@ static ps_status scene_key(const char *scene, const char *ref, char *const args[
     }
     free(text);
     if (st == PS_OK)
-        st = hash_file(&h, ref, err);
+        st = hash_renderer(&h, ref, err);
     for (int i = 0; st == PS_OK && args[i]; i++)
         h = fnv(h, args[i], strlen(args[i]) + 1);
     *key = h;
@@ -840,22 +875,26 @@ static ps_status write_plots(const bench_state *b, const char *script, ps_error 
         n++;
     }
     int rows = (o->scene_count + 1) / 2, cols = o->scene_count > 1 ? 2 : 1;
-    for (int plot = -1; plot < o->scene_count; plot++) {
+    /* plot -2: whole-image error against photons, -1: against seconds (the
+     * main plot), then one a scene, each layer against seconds. */
+    for (int plot = -2; plot < o->scene_count; plot++) {
         char name[256];
+        bool photons = plot == -2;
         if (plot < 0)
-            fprintf(fp, "set terminal pngcairo size %d,%d\nset output '%s/bench.png'\nset multiplot layout %d,%d\n",
-                    640 * cols, 480 * rows, o->out, rows, cols);
+            fprintf(fp, "set terminal pngcairo size %d,%d\nset output '%s/%s.png'\nset multiplot layout %d,%d\n",
+                    640 * cols, 480 * rows, o->out, photons ? "bench-photons" : "bench", rows, cols);
         else
             fprintf(fp, "set terminal pngcairo size 1280,960\nset output '%s/%s.png'\nset multiplot layout 2,2\n",
                     o->out, stem(o->scenes[plot].path, name, sizeof name));
+        fprintf(fp, "set xlabel '%s'\n", photons ? "photons emitted (both maps)" : "seconds");
         int panels = plot < 0 ? o->scene_count : BENCH_PLOTTED_LAYERS;
         for (int p = 0; p < panels; p++) {
             int si = plot < 0 ? p : plot, layer = plot < 0 ? 0 : p;
             stem(o->scenes[si].path, name, sizeof name);
             fprintf(fp, "set title '%s: %s'\nplot ", name, layer_names[layer]);
             for (int i = 0; i < n; i++)
-                fprintf(fp, "%s'%s/data/%s.dat' index %d using 1:%d with linespoints ls %d title title%d",
-                        i ? ", \\\n     " : "", o->out, name, i, layer + 2, i + 1, i);
+                fprintf(fp, "%s'%s/data/%s.dat' index %d using %d:%d with linespoints ls %d title title%d",
+                        i ? ", \\\n     " : "", o->out, name, i, photons ? BENCH_LAYERS + 2 : 1, layer + 2, i + 1, i);
             fputc('\n', fp);
         }
         fprintf(fp, "unset multiplot\n");
