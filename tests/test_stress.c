@@ -167,6 +167,14 @@ static void check_furnace(rig *r, double phi, double rho, uint64_t n, const char
     ps_photon_map_free(&m);
 }
 
+static void write_file_at(const char *name, const char *text)
+{
+    FILE *f = fopen(test_path(name), "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
 /* ---- RGBE over 60 decades -------------------------------------------------- */
 
 static void rgbe_extremes(void **state)
@@ -224,13 +232,13 @@ static void rgbe_extremes(void **state)
     }
 }
 
-/* Lights of 2^-100, 2^100, 1e-30 and 1e30 W against 1 W: the same photons in
+/* Lights of 2^-100, 2^99, 1e-30 and 1e30 W against 1 W: the same photons in
  * the same places; powers scaled by exactly the factor (a power of two moves
  * only the RGBE exponent), or within the mantissa's rounding. */
 static void light_power_extremes(void **state)
 {
     (void)state;
-    const double powers[] = {1.0, 0x1p-100, 0x1p100, 1e-30, 1e30};
+    const double powers[] = {1.0, 0x1p-100, 0x1p99, 1e-30, 1e30};
     const uint64_t n = photons(20000);
     ps_photon_map maps[5];
     for (int k = 0; k < 5; k++) {
@@ -249,7 +257,7 @@ static void light_power_extremes(void **state)
     }
     for (int k = 1; k < 5; k++) {
         assert_int_equal(maps[k].count, maps[0].count);
-        int shift = k == 1 ? -100 : k == 2 ? 100 : 0;
+        int shift = k == 1 ? -100 : k == 2 ? 99 : 0;
         for (size_t i = 0; i < maps[0].count; i++) {
             const ps_photon *a = &maps[0].photons[i], *b = &maps[k].photons[i];
             assert_memory_equal(a->pos, b->pos, sizeof a->pos);
@@ -266,6 +274,49 @@ static void light_power_extremes(void **state)
     }
     for (int k = 0; k < 5; k++)
         ps_photon_map_free(&maps[k]);
+}
+
+/* Past PS_SCENE_MAX_LIGHT_POWER a photon's RGBE power would clamp (2^127 W)
+ * and three channels near DBL_MAX would sum to infinity, which once turned
+ * the global map off without a word: such lights are refused, in a scene, in
+ * an MTL's Ke, and by the editing API. */
+static void light_power_limit(void **state)
+{
+    (void)state;
+    const char *const too_bright[] = {"1e308", "1.0000001e30", "1e31"};
+    for (size_t k = 0; k < sizeof too_bright / sizeof *too_bright; k++) {
+        char light[256], text[4096];
+        snprintf(light, sizeof light, "light point position 0 0 0 power 1 %s 1\n", too_bright[k]);
+        box_scene(text, sizeof text, 0.5, light);
+        ps_scene *s = NULL;
+        ps_error err;
+        assert_int_equal(ps_scene_load_text(text, "inline.scn", "", NULL, &s, &err), PS_ERR_RANGE);
+        assert_non_null(strstr(err.msg, "inline.scn:11: light: 'power'"));
+        assert_non_null(strstr(err.msg, "is above the 1e+30 W a light may have"));
+        assert_null(s);
+    }
+    /* A Ke mesh light of 1e30 W/m^2/sr over 1 m^2: pi * 1e30 W. */
+    write_file_at("bright.obj", "mtllib bright.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl k\nf 1 2 3 4\n");
+    write_file_at("bright.mtl", "newmtl k\nKd 0 0 0\nKe 1e30 1e30 1e30\n");
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s", test_path("bright.obj"));
+    *strrchr(dir, '/') = '\0';
+    ps_scene *s = NULL;
+    ps_error err;
+    assert_int_equal(ps_scene_load_text("camera eye 0 0 3 target 0 0 0\nmesh bright.obj\n", "inline.scn", dir, NULL, &s,
+                                        &err),
+                     PS_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "inline.scn:2: mesh: its emitting faces' power"));
+    /* The bound itself is fine, and editing past it is refused, scene unchanged. */
+    char text[4096];
+    box_scene(text, sizeof text, 0.5, "light point position 0 0 0 power 1e30 1e30 1e30\n");
+    assert_int_equal(ps_scene_load_text(text, "inline.scn", "", NULL, &s, &err), PS_OK);
+    assert_int_equal(ps_scene_set_light_power(s, 0, ps_rgb_make(1, 1, 2e30), &err), PS_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "is above the 1e+30 W a light may have"));
+    size_t nl;
+    assert_true(ps_scene_lights(s, &nl)[0].power.b == 1e30);
+    assert_int_equal(ps_scene_set_light_power(s, 0, ps_rgb_make(1, 1, 1e30), &err), PS_OK);
+    ps_scene_destroy(s);
 }
 
 /* ---- the default scene scaled by 1e-4 and 1e4 ------------------------------------ */
@@ -936,14 +987,6 @@ static void nan_inf_in_scenes(void **state)
     assert_true(tried > 200);
 }
 
-static void write_file(const char *name, const char *text)
-{
-    FILE *f = fopen(test_path(name), "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
 /* The same for every number of an OBJ (v, vn, vt) and its MTL (Kd, Ks, Ke,
  * Tf, Ns, Ni, d, Tr), loaded through a scene. */
 static void nan_inf_in_obj_mtl(void **state)
@@ -969,8 +1012,8 @@ static void nan_inf_in_obj_mtl(void **state)
                 for (size_t w = 0; w < sizeof bad_numbers / sizeof *bad_numbers; w++) {
                     char bad[1024];
                     assert_true(replace_token(orig, line, idx, bad_numbers[w], bad, sizeof bad));
-                    write_file("s.obj", which ? obj : bad);
-                    write_file("s.mtl", which ? bad : mtl);
+                    write_file_at("s.obj", which ? obj : bad);
+                    write_file_at("s.mtl", which ? bad : mtl);
                     ps_scene *s = NULL;
                     ps_error err;
                     ps_status st = ps_scene_load_text(scene, "inline.scn", dir, NULL, &s, &err);
@@ -985,8 +1028,8 @@ static void nan_inf_in_obj_mtl(void **state)
             }
     }
     /* And the originals load. */
-    write_file("s.obj", obj);
-    write_file("s.mtl", mtl);
+    write_file_at("s.obj", obj);
+    write_file_at("s.mtl", mtl);
     ps_scene *s = NULL;
     ps_error err;
     assert_int_equal(ps_scene_load_text(scene, "inline.scn", dir, NULL, &s, &err), PS_OK);
@@ -1000,6 +1043,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(rgbe_extremes),
         cmocka_unit_test(light_power_extremes),
+        cmocka_unit_test(light_power_limit),
         cmocka_unit_test(scaled_default_scene),
         cmocka_unit_test(degenerate_triangles),
         cmocka_unit_test(coincident_faces),
