@@ -660,6 +660,40 @@ static void light_inside_glass(void **state)
     }
 }
 
+/* A point light inside a closed box of lossless mirrors whose floor alone is
+ * diffuse (albedo a): every watt ends on the floor, so with every diffuse
+ * hit stored (global_direct) the map holds Phi / (1 - a); paths nearly
+ * parallel to the floor may reach the bounce limit first, so what is stored
+ * lies between that less the truncated photons' share and that: never more
+ * (no energy created), and every photon on the floor. */
+static void mirror_furnace(void **state)
+{
+    (void)state;
+    const char *text = "camera eye 0 0 0.5 target 0 0 -1\n"
+                       "material floor diffuse albedo 0.5 0.5 0.5\n"
+                       "material mirror mirror reflectance 1 1 1\n"
+                       "quad corner -1 -1 -1 edge1 0 0 2 edge2 2 0 0 material floor\n"
+                       "quad corner -1 1 -1 edge1 2 0 0 edge2 0 0 2 material mirror\n"
+                       "quad corner -1 -1 -1 edge1 0 2 0 edge2 0 0 2 material mirror\n"
+                       "quad corner 1 -1 -1 edge1 0 0 2 edge2 0 2 0 material mirror\n"
+                       "quad corner -1 -1 -1 edge1 2 0 0 edge2 0 2 0 material mirror\n"
+                       "quad corner -1 -1 1 edge1 0 2 0 edge2 2 0 0 material mirror\n"
+                       "light point position 0.1 0.3 0.2 power 10 10 10\n";
+    ps_tracer_options o = options();
+    o.global_direct = true;
+    rig r = rig_make(text, "", &o, PS_ACCEL_OCTREE);
+    uint64_t n = photons(100000);
+    ps_photon_map m = trace(&r, PS_MAP_GLOBAL, n);
+    double got = check_map(&m, ps_v3(-1, -1, -1), ps_v3(1, -1, 1), "mirror furnace").g;
+    double want = 10.0 / (1.0 - 0.5), cut = (double)m.counters.truncated / (double)n;
+    printf("mirror furnace: stored %.5f W, at most %.5f W; %.4f of the paths truncated\n", got, want, cut);
+    assert_int_equal(m.counters.escaped, 0);
+    assert_true(got <= want * (1.0 + mc_tol(n, 4.0)));
+    assert_true(got >= want * (1.0 - 2.0 * cut - mc_tol(n, 4.0)));
+    ps_photon_map_free(&m);
+    rig_free(&r);
+}
+
 /* A point light 0.1 under the middle of a 1 x 1 mirror: inside the mirror's
  * bounding sphere, so its caustic cone is every direction. The caustic is
  * what the mirror subtends, Phi Omega / (4 pi), with cones or without. */
@@ -1049,6 +1083,7 @@ int main(void)
         cmocka_unit_test(coincident_faces),
         cmocka_unit_test(light_on_mirror_plane),
         cmocka_unit_test(light_inside_glass),
+        cmocka_unit_test(mirror_furnace),
         cmocka_unit_test(light_inside_bounding_sphere),
         cmocka_unit_test(grazing_incidence),
         cmocka_unit_test(ior_one_is_invisible),
