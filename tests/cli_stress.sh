@@ -119,6 +119,7 @@ if [ "${STRESS_LONG:-0}" = 1 ]; then
     expect_match "1e7 counter says why" "$cli_out" 'error counter: stopped shooting at [0-9]+ photons'
     grep -q '"counter_stopped": 1,' "$cli_tmp/c.json" && ok || bad "1e7: stats do not say the counter stopped"
     emitted=$(sed -n 's/.*"emitted_caustic": \([0-9]*\).*/\1/p' "$cli_tmp/c.json")
+    echo "10^7 photons, counter: $(grep -o 'error counter: stopped shooting at [0-9]* photons' <<<"$cli_out")"
     awk_true "$emitted < $n" && ok || bad "1e7: the counter let all $emitted photons through"
 fi
 
