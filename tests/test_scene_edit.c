@@ -420,7 +420,10 @@ static void power_errors(void **state)
                    "edit.scn:5: light 1: power (1e+300 1e+300 1e+300) is too large for its area 1e-154 (the "
                    "radiance would not be finite)");
     ps_error e;
-    ok(ps_scene_set_light_power(s, 1, ps_rgb_gray(1e150), &e), &e);
+    ok(ps_scene_set_light_power(s, 1, ps_rgb_gray(PS_SCENE_MAX_LIGHT_POWER), &e), &e);
+    /* Past PS_SCENE_MAX_LIGHT_POWER a photon's RGBE power would clamp. */
+    assert_refused(s, ps_scene_set_light_power(s, 1, ps_rgb_gray(1e150), rerr),
+                   "edit.scn:5: light 1: power (1e+150 1e+150 1e+150) is above the 1e+30 W a light may have");
     ps_scene_destroy(s);
 }
 

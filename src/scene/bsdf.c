@@ -5,6 +5,11 @@
 
 double ps_fresnel_dielectric(double cos_i, double eta_i, double eta_t)
 {
+    /* Equal indices are no interface at all: nothing reflects, even at
+     * grazing, where the formulas below round sin_t to 1 and would call it
+     * total internal reflection. */
+    if (eta_i == eta_t)
+        return 0.0;
     cos_i = fmin(fmax(cos_i, 0.0), 1.0);
     double sin_t = eta_i / eta_t * sqrt(fmax(0.0, 1.0 - cos_i * cos_i));
     if (sin_t >= 1.0)

@@ -233,6 +233,9 @@ ps_status ps_scene_set_light_power(ps_scene *s, size_t light, ps_rgb power, ps_e
                           ": power (%g %g %g) is too large for its area %g (the radiance would not be finite)",
                           power.r, power.g, power.b, l->area);
     }
+    if (ps_rgb_max(power) > PS_SCENE_MAX_LIGHT_POWER)
+        return refuse(err, s, "light", light, l->line, ": power (%g %g %g) is above the %g W a light may have",
+                      power.r, power.g, power.b, PS_SCENE_MAX_LIGHT_POWER);
     if (l->type == PS_LIGHT_MESH) {
         /* The faces are drawn and seen with their material's emission; that
          * MTL material was made for this mesh statement and emits only here. */

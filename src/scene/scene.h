@@ -23,6 +23,10 @@
 #define PS_SCENE_MAX_TRIANGLES 50000000
 #define PS_SCENE_MAX_IMAGE_SIDE 16384
 #define PS_SCENE_MAX_PHOTONS 1000000000LL
+/* The most flux a light may have, W per channel: a photon record's RGBE
+ * power ends at 2^127 W (about 1.7e38), and three channels of more than
+ * about 1e308 W no longer add up to a finite total. */
+#define PS_SCENE_MAX_LIGHT_POWER 1e30
 
 typedef struct ps_camera {
     ps_vec3 eye, target, up; /* up need not be orthogonal to the view direction */

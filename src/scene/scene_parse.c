@@ -175,6 +175,9 @@ static ps_status check_power(parser *p, ps_rgb c)
 {
     if (c.r < 0 || c.g < 0 || c.b < 0)
         return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: light: 'power' must not be negative", p->name, p->line);
+    if (ps_rgb_max(c) > PS_SCENE_MAX_LIGHT_POWER)
+        return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: light: 'power' %g W is above the %g W a light may have",
+                            p->name, p->line, ps_rgb_max(c), PS_SCENE_MAX_LIGHT_POWER);
     if (ps_rgb_is_black(c))
         ps_warn(p->warn, "%s:%d: light has zero power and will emit nothing", p->name, p->line);
     return PS_OK;
@@ -585,6 +588,10 @@ static ps_status add_mesh_lights(parser *p, const ps_object *o, uint32_t object,
         l->radiance = mat->emission;
         /* A one-sided Lambertian emitter of radiance L emits pi * L per unit area. */
         l->power = ps_rgb_scale(mat->emission, PS_PI * area);
+        if (!(ps_rgb_max(l->power) <= PS_SCENE_MAX_LIGHT_POWER))
+            return ps_error_set(p->err, PS_ERR_RANGE,
+                                "%s:%d: mesh: its emitting faces' power %g W is above the %g W a light may have",
+                                p->name, p->line, ps_rgb_max(l->power), PS_SCENE_MAX_LIGHT_POWER);
         l->position = ps_aabb_center(o->bounds);
     }
     return PS_OK;
