@@ -9,8 +9,20 @@
 #include "scene/tessellate.h"
 #include "gl/gl_api.h"
 
-/* The near plane of a shadow cube, as a fraction of the scene's diagonal. */
+/* The near plane of a shadow cube: this share of the distance from the light
+ * to the nearest geometry (so nothing is clipped), but never nearer than
+ * SHADOW_NEAR_FRACTION of the scene's diagonal. Far is better: the shadow
+ * test's slack below lets light leak by slack * distance / near. */
+#define SHADOW_NEAR_SHARE 0.5
 #define SHADOW_NEAR_FRACTION 1e-4
+/* The shadow test's slack for single-precision texgen. GL computes the
+ * compared depth R/Q from eye coordinates in floats, with an error of a few
+ * ulps of the coordinates' size (eye, scene and light positions, E), which
+ * is E / distance-to-light depth units: tens of units for the ceiling above
+ * a light (stress suite), beyond any polygon offset. Taking this many ulps
+ * of E off R (not R/Q) moves the test by that error's own 1/distance law. */
+#define SHADOW_TEXGEN_ULPS 32.0
+#define FLOAT_ULP 1.1920928955078125e-07 /* 2^-23 */
 /* The camera's near plane: never nearer than this fraction of its far plane,
  * which keeps 24-bit depth fine enough for the depth prepass and the splats. */
 #define CAMERA_DEPTH_RATIO 4096.0
@@ -35,6 +47,7 @@ typedef struct vlight {
     ps_rgb intensity;  /* W/sr along dir (all directions when omnidirectional) */
     unsigned faces;    /* the cube faces that can see light (bit per face) */
     GLuint shadow[6];
+    double znear;      /* its shadow cube's near plane (make_shadow_maps) */
 } vlight;
 
 struct ps_gl_renderer {
@@ -55,6 +68,9 @@ struct ps_gl_renderer {
     ps_trimesh *sphere_lights; /* the sphere lights' surfaces, in light order */
     size_t sphere_light_count;
     double scene_diag;
+    /* The size of the eye coordinates GL computes this frame: the eye's
+     * distance from the origin plus the farthest scene point's from the eye. */
+    double eye_extent;
     ps_aabb bounds;
     int width, height;
     double view[16], proj[16];
@@ -172,7 +188,7 @@ static bool add_area_light(ps_gl_renderer *r, size_t *cap, const ps_light *L)
     ps_rgb each = ps_rgb_scale(L->power, PS_INV_PI / count);
     if (L->type == PS_LIGHT_SPHERE) {
         /* Outside it, a Lambertian sphere lights like a point at its centre. */
-        vlight v = {L->position, {0, 0, 0}, 180.0, 0.0, ps_rgb_scale(L->power, 0.25 * PS_INV_PI), 0, {0}};
+        vlight v = {L->position, {0, 0, 0}, 180.0, 0.0, ps_rgb_scale(L->power, 0.25 * PS_INV_PI), 0, {0}, 0.0};
         return push_light(r, cap, v);
     }
     size_t ntri = 0, nem = 0;
@@ -187,7 +203,7 @@ static bool add_area_light(ps_gl_renderer *r, size_t *cap, const ps_light *L)
     for (int j = 0; j < side; j++)
         for (int i = 0; i < side; i++) {
             double u = (i + 0.5) / side, w = (j + 0.5) / side;
-            vlight v = {{0, 0, 0}, L->direction, 90.0, 1.0, each, 0, {0}};
+            vlight v = {{0, 0, 0}, L->direction, 90.0, 1.0, each, 0, {0}, 0.0};
             if (L->type == PS_LIGHT_QUAD) {
                 v.pos = ps_v3_add(L->position, ps_v3_add(ps_v3_scale(L->edge1, u), ps_v3_scale(L->edge2, w)));
             } else if (L->type == PS_LIGHT_DISC) {
@@ -248,11 +264,11 @@ static ps_status build_lights(ps_gl_renderer *r, ps_error *err)
         const ps_light *L = &lights[l];
         bool ok;
         if (L->type == PS_LIGHT_POINT) {
-            vlight v = {L->position, {0, 0, 0}, 180.0, 0.0, ps_rgb_scale(L->power, 0.25 * PS_INV_PI), 0, {0}};
+            vlight v = {L->position, {0, 0, 0}, 180.0, 0.0, ps_rgb_scale(L->power, 0.25 * PS_INV_PI), 0, {0}, 0.0};
             ok = push_light(r, &cap, v);
         } else if (L->type == PS_LIGHT_SPOT) {
             double solid = 2.0 * PS_PI * (1.0 - L->cos_angle);
-            vlight v = {L->position, L->direction, L->angle_deg, 0.0, ps_rgb_scale(L->power, 1.0 / solid), 0, {0}};
+            vlight v = {L->position, L->direction, L->angle_deg, 0.0, ps_rgb_scale(L->power, 1.0 / solid), 0, {0}, 0.0};
             ok = push_light(r, &cap, v);
         } else {
             ok = add_area_light(r, &cap, L);
@@ -408,13 +424,59 @@ static void draw_area_lights(const ps_gl_renderer *r, double exposure, bool dire
 
 /* ---- shadow maps ------------------------------------------------------------ */
 
+/* Squared distance from p to the triangle abc: the closest point lies in the
+ * face, on an edge or at a corner, told apart by barycentric signs
+ * (Ericson, Real-Time Collision Detection, 5.1.5). */
+static double point_triangle_dist2(ps_vec3 p, ps_vec3 a, ps_vec3 b, ps_vec3 c)
+{
+    ps_vec3 ab = ps_v3_sub(b, a), ac = ps_v3_sub(c, a), ap = ps_v3_sub(p, a);
+    double d1 = ps_v3_dot(ab, ap), d2 = ps_v3_dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0)
+        return ps_v3_len2(ap);
+    ps_vec3 bp = ps_v3_sub(p, b);
+    double d3 = ps_v3_dot(ab, bp), d4 = ps_v3_dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3)
+        return ps_v3_len2(bp);
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0)
+        return ps_v3_len2(ps_v3_sub(p, ps_v3_madd(a, ab, d1 / (d1 - d3))));
+    ps_vec3 cp = ps_v3_sub(p, c);
+    double d5 = ps_v3_dot(ab, cp), d6 = ps_v3_dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6)
+        return ps_v3_len2(cp);
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0)
+        return ps_v3_len2(ps_v3_sub(p, ps_v3_madd(a, ac, d2 / (d2 - d6))));
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0)
+        return ps_v3_len2(ps_v3_sub(p, ps_v3_madd(b, ps_v3_sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+    double denom = va + vb + vc;
+    if (!(denom > 0.0)) /* a degenerate triangle: its corners are near enough */
+        return fmin(ps_v3_len2(ap), fmin(ps_v3_len2(bp), ps_v3_len2(cp)));
+    double v = vb / denom, w = vc / denom;
+    return ps_v3_len2(ps_v3_sub(p, ps_v3_madd(ps_v3_madd(a, ab, v), ac, w)));
+}
+
+/* The distance from p to the nearest triangle of the depth-only mesh. */
+static double nearest_geometry(const ps_gl_renderer *r, ps_vec3 p)
+{
+    const ps_preview_mesh *m = &r->coarse;
+    double best = HUGE_VAL;
+    for (size_t i = 0; i + 2 < m->vertex_count; i += 3) {
+        const float *q = m->positions + 3 * i;
+        ps_vec3 a = ps_v3(q[0], q[1], q[2]), b = ps_v3(q[3], q[4], q[5]), c = ps_v3(q[6], q[7], q[8]);
+        best = fmin(best, point_triangle_dist2(p, a, b, c));
+    }
+    return sqrt(best);
+}
+
 static void light_face_matrices(const ps_gl_renderer *r, const vlight *v, int f, double proj[16], double view[16])
 {
     ps_vec3 fw, rt, up;
     face_frame(f, &fw, &rt, &up);
     double nearest, farthest;
     box_range(r->bounds, v->pos, &nearest, &farthest);
-    double znear = fmax(SHADOW_NEAR_FRACTION * r->scene_diag, 1e-300);
+    double znear = v->znear;
     mat_perspective(1.0, 1.0, znear, fmax(farthest * 1.01, 2.0 * znear), proj);
     mat_look(v->pos, fw, rt, up, view);
 }
@@ -434,6 +496,10 @@ static void make_shadow_maps(ps_gl_renderer *r)
     glPolygonOffset(SHADOW_OFFSET_FACTOR, SHADOW_OFFSET_UNITS);
     for (size_t i = 0; i < r->light_count; i++) {
         vlight *v = &r->lights[i];
+        double floor_near = fmax(SHADOW_NEAR_FRACTION * r->scene_diag, 1e-300);
+        v->znear = fmax(SHADOW_NEAR_SHARE * nearest_geometry(r, v->pos), floor_near);
+        if (!isfinite(v->znear)) /* no geometry at all */
+            v->znear = floor_near;
         for (int f = 0; f < 6; f++) {
             if (!(v->faces & (1u << f)))
                 continue;
@@ -502,7 +568,7 @@ static void set_gl_light(const vlight *v, double exposure)
 /* Texgen planes that take world points to the shadow map's [0,1]^3 (the
  * rows of bias * projection * view), set while the modelview is the camera's
  * view so that GL's eye-linear planes see world coordinates. */
-static void set_shadow_texgen(const double light_proj[16], const double light_view[16])
+static void set_shadow_texgen(const double light_proj[16], const double light_view[16], double slack)
 {
     static const double bias[16] = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 0.5, 0.5, 0.5, 1};
     double t[16];
@@ -511,7 +577,7 @@ static void set_shadow_texgen(const double light_proj[16], const double light_vi
     const GLenum coords[4] = {GL_S, GL_T, GL_R, GL_Q};
     const GLenum gens[4] = {GL_TEXTURE_GEN_S, GL_TEXTURE_GEN_T, GL_TEXTURE_GEN_R, GL_TEXTURE_GEN_Q};
     for (int k = 0; k < 4; k++) {
-        GLdouble plane[4] = {t[k], t[4 + k], t[8 + k], t[12 + k]};
+        GLdouble plane[4] = {t[k], t[4 + k], t[8 + k], t[12 + k] - (k == 2 ? slack : 0.0)};
         glTexGeni(coords[k], GL_TEXTURE_GEN_MODE, GL_EYE_LINEAR);
         glTexGendv(coords[k], GL_EYE_PLANE, plane);
         glEnable(gens[k]);
@@ -547,21 +613,29 @@ static void draw_direct(ps_gl_renderer *r, double exposure)
         glEnable(GL_TEXTURE_2D);
         glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
         glEnable(GL_CLIP_PLANE0);
+        glEnable(GL_CLIP_PLANE1);
         for (int f = 0; f < 6; f++) {
             if (!(v->faces & (1u << f)))
                 continue;
             double proj[16], view[16];
             light_face_matrices(r, v, f, proj, view);
-            set_shadow_texgen(proj, view);
+            set_shadow_texgen(proj, view, SHADOW_TEXGEN_ULPS * FLOAT_ULP * (r->eye_extent + ps_v3_len(v->pos)));
             /* Only the half-space in front of the face: behind the light the
              * projection would fold points back into the map. */
             GLdouble plane[4] = {face_dirs[f].x, face_dirs[f].y, face_dirs[f].z, -ps_v3_dot(face_dirs[f], v->pos)};
             glClipPlane(GL_CLIP_PLANE0, plane);
+            /* Nor what lies nearer than the near plane: outside the face's
+             * square its depth would pass the test against the border's 0.
+             * Every point this face owns lies beyond (at least nearest /
+             * sqrt 3 > SHADOW_NEAR_SHARE * nearest away along the axis). */
+            plane[3] -= v->znear;
+            glClipPlane(GL_CLIP_PLANE1, plane);
             glBindTexture(GL_TEXTURE_2D, v->shadow[f]);
             draw_mesh(r, true);
             r->stats.light_passes++;
         }
         glDisable(GL_CLIP_PLANE0);
+        glDisable(GL_CLIP_PLANE1);
         disable_texgen();
         glBindTexture(GL_TEXTURE_2D, 0);
         glDisable(GL_TEXTURE_2D);
@@ -594,6 +668,7 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
 
     double nearest, farthest;
     box_range(r->bounds, cam->eye, &nearest, &farthest);
+    r->eye_extent = ps_v3_len(cam->eye) + farthest;
     double zfar = fmax(farthest * 1.01, 1e-300);
     double znear = fmax(nearest * 0.5, zfar / CAMERA_DEPTH_RATIO);
     mat_perspective(cam->tan_half_fov, cam->aspect, znear, zfar, r->proj);
