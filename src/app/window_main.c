@@ -69,8 +69,8 @@ static const char usage[] =
     "options:\n"
     "  --size WxH               window size (default from the scene)\n"
     "  --exposure E             radiance multiplier before display (default 1)\n"
-    "  --caustic-photons N      caustic photons to trace before stopping (default from the scene)\n"
-    "  --global-photons N       global photons likewise\n"
+    "  --caustic-photons N      caustic photon cap: traced, then refining stops (default from the scene)\n"
+    "  --global-photons N       global photon cap likewise; each edit restarts both maps\n"
     "  --caustic-radius R       caustic splat radius, scene units\n"
     "  --global-radius R        global splat radius, scene units\n"
     "  --seed S                 photon i depends only on (scene, seed, i) (default 0)\n"
@@ -165,6 +165,10 @@ typedef struct app {
     /* The script. */
     ps_script *script;
     size_t script_next;
+    /* wait done: the later actions are held while waiting; then the script
+     * clock is set back to the wait's time (script_delay seconds behind). */
+    bool script_waiting;
+    double wait_time, script_delay;
     bool quit;
     bool release_feed; /* the feed is held until the next refresh is done */
     char shot_path[64]; /* a screenshot asked for with P, taken after the next refresh */
@@ -396,7 +400,7 @@ static void draw_overlay(app *a)
     double rate = elapsed > 0.0 ? (double)(ce + ge) / elapsed : 0.0;
     const char *state = a->counter_stopped ? "stopped by the error counter"
                         : a->paused        ? "paused"
-                        : ended            ? "done"
+                        : ended            ? "cap reached"
                                            : "tracing";
     int n = snprintf(text, sizeof text,
                      "caustic %llu/%llu  global %llu/%llu  %s\n"
@@ -909,6 +913,10 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
     case PS_SCRIPT_ORBIT:
         orbit(a, act->yaw, act->pitch);
         return PS_OK;
+    case PS_SCRIPT_WAIT:
+        a->script_waiting = true;
+        a->wait_time = act->time;
+        return PS_OK;
     case PS_SCRIPT_QUIT:
         a->quit = true;
         return PS_OK;
@@ -931,6 +939,23 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
         return PS_OK;
     }
     return PS_OK;
+}
+
+/* Whether a script's wait done is over: every map at its cap and all of it
+ * drawn, with no edit or view change pending; or tracing paused (by the
+ * user, a script or the error counter), which would otherwise never end it. */
+static bool script_wait_over(app *a)
+{
+    if (a->scene_dirty || a->view_dirty)
+        return false;
+    if (a->paused || a->counter_stopped)
+        return true;
+    ps_feed_lock(a->feed);
+    bool over = ps_feed_ended(a->feed);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        over = over && a->drawn[k] >= ps_feed_maps(a->feed)[k].count;
+    ps_feed_unlock(a->feed);
+    return over;
 }
 
 /* ---- the session ---------------------------------------------------------------------- */
@@ -1006,7 +1031,13 @@ static ps_status session(app *a, ps_error *err)
         /* Script actions that are due, in order; times count from the first frame. */
         while (st == PS_OK && a->script && a->frames > 0 && a->script_next < ps_script_count(a->script)) {
             const ps_script_action *act = ps_script_at(a->script, a->script_next);
-            if (act->time > glfwGetTime() - a->t_first_frame)
+            if (a->script_waiting) {
+                if (!script_wait_over(a))
+                    break;
+                a->script_waiting = false;
+                a->script_delay = glfwGetTime() - a->t_first_frame - a->wait_time;
+            }
+            if (act->time + a->script_delay > glfwGetTime() - a->t_first_frame)
                 break;
             a->script_next++;
             if (act->kind == PS_SCRIPT_SCREENSHOT) /* the window as it is now: refresh first */
@@ -1050,6 +1081,8 @@ static ps_status write_stats(app *a, ps_error *err)
 {
     ps_run_stats rs;
     memset(&rs, 0, sizeof rs);
+    bool cap_reached = false;
+    double map_bytes = 0.0; /* what the current maps hold allocated: bounded by the caps */
     if (a->feed) {
         ps_feed_lock(a->feed);
         for (int k = 0; k < PS_MAP_COUNT; k++) {
@@ -1057,7 +1090,10 @@ static ps_status write_stats(app *a, ps_error *err)
             rs.emitted[k] = m->counters.emitted;
             rs.stored[k] = m->counters.stored;
             rs.rays += m->counters.rays;
+            map_bytes += (double)(m->cap * sizeof *m->photons + m->mcap * sizeof *m->materials +
+                                  m->ocap * sizeof *m->objects);
         }
+        cap_reached = ps_feed_ended(a->feed);
         ps_feed_unlock(a->feed);
         rs.skips = ps_tracer_skips(a->tracer, &rs.skip_count);
     }
@@ -1075,6 +1111,10 @@ static ps_status write_stats(app *a, ps_error *err)
                  a->edit_latency_count ? a->edit_latency_sum / (double)a->edit_latency_count : 0.0);
     ps_stats_add(&rs, "tau", a->tau);
     ps_stats_add(&rs, "counter_stopped", a->counter_stopped ? 1.0 : 0.0);
+    ps_stats_add(&rs, "caustic_cap", (double)a->cap[PS_MAP_CAUSTIC]);
+    ps_stats_add(&rs, "global_cap", (double)a->cap[PS_MAP_GLOBAL]);
+    ps_stats_add(&rs, "cap_reached", cap_reached ? 1.0 : 0.0);
+    ps_stats_add(&rs, "photon_map_bytes", map_bytes);
     return ps_stats_write(a->o.c.stats, &rs, err);
 }
 
