@@ -59,6 +59,28 @@ echo "photon maps: $stored photons stored, $bytes bytes allocated"
 awk_true "$bytes >= $stored * $PHOTON_BYTES && $bytes <= 2 * $stored * $PHOTON_BYTES" && ok ||
     bad "the maps hold $bytes bytes for $stored photons (expected $PHOTON_BYTES to $((2 * PHOTON_BYTES)) a photon)"
 
+# The memory cap: tracing stops once the maps store --max-photons photons
+# (checked between batches of 16384 caustic photons and a quarter as many
+# global ones), before the caps; wait done ends there too.
+limit=20000
+printf '0 wait done\n0 screenshot %s\n0.1 quit\n' "$cli_tmp/limited.png" >"$cli_tmp/limited.txt"
+expect_success "memory cap" xrun "$win" "$scene" "${common[@]}" --max-photons $limit --script "$cli_tmp/limited.txt" \
+    --stats "$cli_tmp/limited.json"
+s=$cli_tmp/limited.json
+stored=$(($(stat_of stored_caustic "$s") + $(stat_of stored_global "$s")))
+echo "memory cap $limit: $stored photons stored, $(stat_of emitted_caustic "$s") + $(stat_of emitted_global "$s") emitted"
+[ "$(stat_of max_photons_reached "$s")" = 1 ] && [ "$(stat_of cap_reached "$s")" = 0 ] && ok ||
+    bad "memory cap: max_photons_reached $(stat_of max_photons_reached "$s"), cap_reached $(stat_of cap_reached "$s")"
+awk_true "$stored >= $limit && $stored < $limit + 2 * 20480 && $(stat_of emitted_caustic "$s") < $caustic" && ok ||
+    bad "memory cap: $stored stored, $(stat_of emitted_caustic "$s") caustic emitted"
+# Fewer photons, the same estimate: nearer the capped picture than the first
+# refresh (one batch) was.
+off=$("$bin/photosplat-compare" "$cli_tmp/limited.png" "$cli_tmp/a.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
+echo "memory-capped picture against the capped one: rmse $off (the first refresh: $early)"
+awk_true "$off < $early" && ok || bad "memory cap: the picture is off the capped one by rmse $off"
+expect_usage_error "negative memory cap" "$win" "$scene" --max-photons -1
+expect_match "says which" "$cli_err" 'max-photons'
+
 # Paused, the caps are never reached: the wait ends at once, the script goes on.
 printf '0 set pause on\n0 wait done\n0.2 quit\n' >"$cli_tmp/paused.txt"
 expect_success "wait while paused" timeout 60 xvfb-run -a -s "-screen 0 1024x768x24" "$win" "$scene" "${common[@]}" \

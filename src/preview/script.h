@@ -24,8 +24,9 @@
  *     power light INDEX R G B          new flux in watts per channel (each >= 0)
  *     angle light INDEX DEGREES        a spot's half-angle, in (0, 90]
  *     wait done                        hold the later actions until every photon
- *                                      map has reached its cap and all of it is
- *                                      drawn (or tracing is paused); their times
+ *                                      map has reached its cap (or the memory
+ *                                      cap) and all of it is drawn (or tracing
+ *                                      is paused); their times
  *                                      then count on from when the wait ended
  *     quit
  * (power, angle and wait are extras beyond the contract: editing lights, and
