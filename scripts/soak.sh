@@ -111,7 +111,7 @@ edits_expected=$((MOVES + 3))
 pidfile=$DIR/window.pid
 rss=$DIR/rss.tsv
 echo "soak: $MOVES moves over ${SECONDS_} s of script (seed $SEED), $scene; RSS every ${SAMPLE_SECONDS} s into $rss"
-t_start=$(date +%s.%N)
+t_start=$EPOCHREALTIME
 # The window is started by a shell inside xvfb-run that writes its pid, so
 # that /proc/PID is the window's own, not xvfb-run's or the X server's.
 xvfb-run -a -s "-screen 0 1024x768x24" bash -c 'echo $$ >"$1"; shift; exec "$@"' _ "$pidfile" \
@@ -123,16 +123,16 @@ pid=$(cat "$pidfile" 2>/dev/null || true)
 [ -n "$pid" ] || { kill "$runner" 2>/dev/null; echo "soak: FAIL: the window did not start" >&2; exit 1; }
 : >"$rss"
 while kill -0 "$pid" 2>/dev/null; do
-    kb=$(awk '/^VmRSS:/ { r = $2 } /^VmHWM:/ { h = $2 } END { if (r) print r "\t" h }' "/proc/$pid/status" 2>/dev/null || true)
-    [ -n "$kb" ] && printf '%.2f\t%s\n' "$(echo "$(date +%s.%N) - $t_start" | bc)" "$kb" >>"$rss"
+    # seconds since the start, VmRSS and VmHWM in KiB
+    awk -v now="$EPOCHREALTIME" -v t0="$t_start" '/^VmRSS:/ { r = $2 } /^VmHWM:/ { h = $2 }
+        END { if (r) printf "%.2f\t%s\t%s\n", now - t0, r, h }' "/proc/$pid/status" >>"$rss" 2>/dev/null || true
     sleep "$SAMPLE_SECONDS"
 done
 set +e
 wait "$runner"
 rc=$?
 set -e
-t_end=$(date +%s.%N)
-wall=$(echo "$t_end - $t_start" | bc)
+wall=$(awk -v now="$EPOCHREALTIME" -v t0="$t_start" 'BEGIN { print now - t0 }')
 
 # ---- verdict ---------------------------------------------------------------------
 fails=0
@@ -147,7 +147,7 @@ if [ -s "$DIR/stats.json" ]; then
         "$(stat_of edit_to_frame_seconds_max)"
     printf 'photon maps at the end: %s + %s photons stored of caps %s + %s, %.1f MiB allocated, cap reached: %s\n' \
         "$(stat_of stored_caustic)" "$(stat_of stored_global)" "$(stat_of caustic_cap)" "$(stat_of global_cap)" \
-        "$(echo "$(stat_of photon_map_bytes) / 1048576" | bc -l)" "$(stat_of cap_reached)"
+        "$(awk -v b="$(stat_of photon_map_bytes)" 'BEGIN { print b / 1048576 }')" "$(stat_of cap_reached)"
     [ "$(stat_of edits)" = "$edits_expected" ] || fail "the window counted $(stat_of edits) edits, not $edits_expected"
 else
     echo "no stats"
