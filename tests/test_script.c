@@ -295,6 +295,29 @@ static void comments_and_blank_lines(void **state)
     ps_script_destroy(s);
 }
 
+/* wait done: the action alone, in time order among the others, every field
+ * but its time and line zero. */
+static void wait_done(void **state)
+{
+    (void)state;
+    ps_script *s = parse_ok("2 quit\n"
+                            "0.5 wait done # the caps reached\n"
+                            "0.5\twait\tdone\r\n"
+                            "1 screenshot b.png\n");
+    assert_int_equal(ps_script_count(s), 4);
+    static const ps_script_kind kinds[] = {PS_SCRIPT_WAIT, PS_SCRIPT_WAIT, PS_SCRIPT_SCREENSHOT, PS_SCRIPT_QUIT};
+    static const int lines[] = {2, 3, 4, 1};
+    for (size_t i = 0; i < 4; i++) {
+        const ps_script_action *a = ps_script_at(s, i);
+        assert_int_equal(a->kind, kinds[i]);
+        assert_int_equal(a->line, lines[i]);
+    }
+    const ps_script_action *a = ps_script_at(s, 0);
+    assert_near(a->time, 0.5, 0);
+    assert_rest_zero(a, false, false, false, false, false, false, false);
+    ps_script_destroy(s);
+}
+
 static void empty_scripts(void **state)
 {
     (void)state;
@@ -406,6 +429,11 @@ static const bad_case BAD[] = {
     {"0 angle light 0 90.0000001\n", PS_ERR_PARSE, "s.txt:1: angle light: '90.0000001' must be a number in (0, 90]"},
     {"0 angle light 0\n", PS_ERR_PARSE, "s.txt:1: angle light: expected 2 numbers"},
     {"0 angle object 0 45\n", PS_ERR_PARSE, "s.txt:1: angle: expected 'light', got 'object'"},
+    /* wait */
+    {"0 wait\n", PS_ERR_PARSE, "s.txt:1: wait: expected 'done'"},
+    {"0 wait 5\n", PS_ERR_PARSE, "s.txt:1: wait: expected 'done', got '5'"},
+    {"0 wait Done\n", PS_ERR_PARSE, "s.txt:1: wait: expected 'done', got 'Done'"},
+    {"0 quit\n0 wait done 5\n", PS_ERR_PARSE, "s.txt:2: wait done: expected no arguments"},
 };
 
 static void malformed_inputs(void **state)
@@ -562,6 +590,7 @@ int main(void)
         cmocka_unit_test(choices_match_enums),
         cmocka_unit_test(sorted_by_time_stable),
         cmocka_unit_test(comments_and_blank_lines),
+        cmocka_unit_test(wait_done),
         cmocka_unit_test(empty_scripts),
         cmocka_unit_test(malformed_inputs),
         cmocka_unit_test(limits),

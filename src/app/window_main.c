@@ -54,6 +54,10 @@
 #define SPLAT_TIME_SHARE 0.5
 #define SPLAT_BUDGET_MIN 2048
 #define SPLAT_BUDGET_START 16384
+/* --max-photons: the maps store at most this many photons together by
+ * default (26 bytes each: 0.8 GiB, 1.6 GiB of capacity at worst), whatever
+ * the scene's albedo makes of the caps (preview/feed.h). */
+#define WIN_MAX_PHOTONS_DEFAULT ((int64_t)1 << 25)
 
 enum { SEL_NONE, SEL_LIGHT, SEL_OBJECT };
 enum { DRAG_NONE, DRAG_ORBIT, DRAG_PAN, DRAG_MOVE };
@@ -69,8 +73,9 @@ static const char usage[] =
     "options:\n"
     "  --size WxH               window size (default from the scene)\n"
     "  --exposure E             radiance multiplier before display (default 1)\n"
-    "  --caustic-photons N      caustic photons to trace before stopping (default from the scene)\n"
-    "  --global-photons N       global photons likewise\n"
+    "  --caustic-photons N      caustic photon cap: traced, then refining stops (default from the scene)\n"
+    "  --global-photons N       global photon cap likewise; each edit restarts both maps\n"
+    "  --max-photons N          memory cap: stop once the maps store N photons (default 2^25, 0: none)\n"
     "  --caustic-radius R       caustic splat radius, scene units\n"
     "  --global-radius R        global splat radius, scene units\n"
     "  --seed S                 photon i depends only on (scene, seed, i) (default 0)\n"
@@ -119,6 +124,7 @@ typedef struct win_options {
     ps_preview_options p;
     const char *script;
     int overlay;
+    int64_t max_photons; /* stored photons of both maps; 0: no bound */
 } win_options;
 
 typedef struct app {
@@ -172,6 +178,10 @@ typedef struct app {
     /* The script. */
     ps_script *script;
     size_t script_next;
+    /* wait done: the later actions are held while waiting; then the script
+     * clock is set back to the wait's time (script_delay seconds behind). */
+    bool script_waiting;
+    double wait_time, script_delay;
     bool quit;
     bool release_feed; /* the feed is held until the next refresh is done */
     char shot_path[64]; /* a screenshot asked for with P, taken after the next refresh */
@@ -191,6 +201,7 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
     /* Float layers: they take in only new photons each refresh (see gl_render.h). */
     ps_preview_options_init(&o->p, true);
     o->overlay = 1;
+    o->max_photons = WIN_MAX_PHOTONS_DEFAULT;
     ps_status st = PS_OK;
     while (st == PS_OK && ps_cli_next(&cli)) {
         if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "-h")) {
@@ -208,6 +219,8 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
             st = ps_cli_string(&cli, &o->script, err);
         } else if (ps_cli_is(&cli, "--overlay")) {
             st = ps_cli_choice(&cli, on_off, &o->overlay, err);
+        } else if (ps_cli_is(&cli, "--max-photons")) {
+            st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->max_photons, err);
         } else {
             return ps_cli_unknown(&cli, err);
         }
@@ -265,6 +278,8 @@ static ps_status rebuild(app *a, bool geometry, ps_error *err)
      * those splats) then has every core, and the caustic shows at once. */
     if (st == PS_OK)
         st = ps_feed_create(a->tracer, a->cap, active, &a->feed, err);
+    if (st == PS_OK)
+        ps_feed_set_store_limit(a->feed, (size_t)a->o.max_photons);
     if (st == PS_OK)
         st = ps_feed_prime(a->feed, err);
     if (st == PS_OK) {
@@ -399,13 +414,14 @@ static void draw_overlay(app *a)
     ps_feed_lock(a->feed);
     const ps_photon_map *maps = ps_feed_maps(a->feed);
     uint64_t ce = maps[0].counters.emitted, ge = maps[1].counters.emitted;
-    bool ended = ps_feed_ended(a->feed);
+    bool ended = ps_feed_ended(a->feed), limited = ps_feed_store_limited(a->feed);
     ps_feed_unlock(a->feed);
     double elapsed = glfwGetTime() - a->edit_time;
     double rate = elapsed > 0.0 ? (double)(ce + ge) / elapsed : 0.0;
     const char *state = a->counter_stopped ? "stopped by the error counter"
                         : a->paused        ? "paused"
-                        : ended            ? "done"
+                        : limited          ? "memory cap reached (--max-photons)"
+                        : ended            ? "cap reached"
                                            : "tracing";
     int n = snprintf(text, sizeof text,
                      "caustic %llu/%llu  global %llu/%llu  %s\n"
@@ -919,6 +935,10 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
     case PS_SCRIPT_ORBIT:
         orbit(a, act->yaw, act->pitch);
         return PS_OK;
+    case PS_SCRIPT_WAIT:
+        a->script_waiting = true;
+        a->wait_time = act->time;
+        return PS_OK;
     case PS_SCRIPT_QUIT:
         a->quit = true;
         return PS_OK;
@@ -941,6 +961,23 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
         return PS_OK;
     }
     return PS_OK;
+}
+
+/* Whether a script's wait done is over: every map at its cap and all of it
+ * drawn, with no edit or view change pending; or tracing paused (by the
+ * user, a script or the error counter), which would otherwise never end it. */
+static bool script_wait_over(app *a)
+{
+    if (a->scene_dirty || a->view_dirty)
+        return false;
+    if (a->paused || a->counter_stopped)
+        return true;
+    ps_feed_lock(a->feed);
+    bool over = ps_feed_ended(a->feed);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        over = over && a->drawn[k] >= ps_feed_maps(a->feed)[k].count;
+    ps_feed_unlock(a->feed);
+    return over;
 }
 
 /* ---- the session ---------------------------------------------------------------------- */
@@ -1016,7 +1053,13 @@ static ps_status session(app *a, ps_error *err)
         /* Script actions that are due, in order; times count from the first frame. */
         while (st == PS_OK && a->script && a->frames > 0 && a->script_next < ps_script_count(a->script)) {
             const ps_script_action *act = ps_script_at(a->script, a->script_next);
-            if (act->time > glfwGetTime() - a->t_first_frame)
+            if (a->script_waiting) {
+                if (!script_wait_over(a))
+                    break;
+                a->script_waiting = false;
+                a->script_delay = glfwGetTime() - a->t_first_frame - a->wait_time;
+            }
+            if (act->time + a->script_delay > glfwGetTime() - a->t_first_frame)
                 break;
             a->script_next++;
             if (act->kind == PS_SCRIPT_SCREENSHOT) /* the window as it is now: refresh first */
@@ -1060,6 +1103,8 @@ static ps_status write_stats(app *a, ps_error *err)
 {
     ps_run_stats rs;
     memset(&rs, 0, sizeof rs);
+    bool cap_reached = false, store_limited = false;
+    double map_bytes = 0.0; /* what the current maps hold allocated: bounded by the caps */
     if (a->feed) {
         ps_feed_lock(a->feed);
         for (int k = 0; k < PS_MAP_COUNT; k++) {
@@ -1067,7 +1112,11 @@ static ps_status write_stats(app *a, ps_error *err)
             rs.emitted[k] = m->counters.emitted;
             rs.stored[k] = m->counters.stored;
             rs.rays += m->counters.rays;
+            map_bytes += (double)(m->cap * sizeof *m->photons + m->mcap * sizeof *m->materials +
+                                  m->ocap * sizeof *m->objects);
         }
+        store_limited = ps_feed_store_limited(a->feed);
+        cap_reached = ps_feed_ended(a->feed) && !store_limited;
         ps_feed_unlock(a->feed);
         rs.skips = ps_tracer_skips(a->tracer, &rs.skip_count);
     }
@@ -1085,6 +1134,12 @@ static ps_status write_stats(app *a, ps_error *err)
                  a->edit_latency_count ? a->edit_latency_sum / (double)a->edit_latency_count : 0.0);
     ps_stats_add(&rs, "tau", a->tau);
     ps_stats_add(&rs, "counter_stopped", a->counter_stopped ? 1.0 : 0.0);
+    ps_stats_add(&rs, "caustic_cap", (double)a->cap[PS_MAP_CAUSTIC]);
+    ps_stats_add(&rs, "global_cap", (double)a->cap[PS_MAP_GLOBAL]);
+    ps_stats_add(&rs, "cap_reached", cap_reached ? 1.0 : 0.0);
+    ps_stats_add(&rs, "photon_map_bytes", map_bytes);
+    ps_stats_add(&rs, "max_photons", (double)a->o.max_photons);
+    ps_stats_add(&rs, "max_photons_reached", store_limited ? 1.0 : 0.0);
     return ps_stats_write(a->o.c.stats, &rs, err);
 }
 

@@ -18,6 +18,8 @@ struct ps_feed {
     ps_feed_mark *marks[PS_MAP_COUNT];  /* under lock: batch ends */
     size_t mark_count[PS_MAP_COUNT], mark_cap[PS_MAP_COUNT];
     bool stop, paused, ended;         /* under lock */
+    bool store_limited;               /* under lock: ended at max_stored */
+    size_t max_stored;                /* 0: no limit */
     bool started;
     uint64_t next[PS_MAP_COUNT]; /* the feeding thread's: first photon not yet traced */
     uint64_t round;
@@ -79,6 +81,13 @@ static ps_status batch(ps_feed *f, int k, uint64_t first, uint64_t count, ps_err
  * every map has reached its cap (or on an error, in *st). */
 static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
 {
+    /* Only this thread appends, so the counts can be read without the lock. */
+    if (f->max_stored && f->maps[PS_MAP_CAUSTIC].count + f->maps[PS_MAP_GLOBAL].count >= f->max_stored) {
+        pthread_mutex_lock(&f->lock);
+        f->store_limited = true;
+        pthread_mutex_unlock(&f->lock);
+        return false;
+    }
     uint64_t biggest = 0;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (f->active[k] && f->cap[k] > biggest)
@@ -181,6 +190,8 @@ void ps_feed_lock(ps_feed *f) { pthread_mutex_lock(&f->lock); }
 void ps_feed_unlock(ps_feed *f) { pthread_mutex_unlock(&f->lock); }
 const ps_photon_map *ps_feed_maps(const ps_feed *f) { return f->maps; }
 bool ps_feed_ended(const ps_feed *f) { return f->ended; }
+bool ps_feed_store_limited(const ps_feed *f) { return f->store_limited; }
+void ps_feed_set_store_limit(ps_feed *f, size_t max_stored) { f->max_stored = max_stored; }
 
 const ps_feed_mark *ps_feed_marks(const ps_feed *f, ps_map_kind k, size_t *count)
 {

@@ -30,6 +30,17 @@ ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const 
 /* Stops (and joins) a started feed first. Accepts NULL. */
 void ps_feed_destroy(ps_feed *f);
 
+/* A bound on memory as well as on photons: tracing ends once the maps store
+ * max_stored photons together (0: no bound, the default), even before the
+ * caps. The caps bound photons emitted; stored photons per emitted one depend
+ * on the scene (up to PS_PHOTON_MAX_BOUNCES in the global map of a white
+ * room), so this is the bound that holds for any scene. It is checked between
+ * batches: the maps may pass it by one batch's photons. A feed ended here
+ * still shows a correct picture, scaled by N/n for the n emitted (thesis 5.1:
+ * more photons would refine it, not change it). Call before run, prime or
+ * start. */
+void ps_feed_set_store_limit(ps_feed *f, size_t max_stored);
+
 /* Traces everything on the calling thread. */
 ps_status ps_feed_run(ps_feed *f, ps_error *err);
 /* Traces the first round (PS_FEED_BATCH photons of the largest map, the
@@ -50,6 +61,8 @@ void ps_feed_unlock(ps_feed *f);
  * (every cap reached, stopped, or failed). */
 const ps_photon_map *ps_feed_maps(const ps_feed *f);
 bool ps_feed_ended(const ps_feed *f);
+/* Under the lock: whether it ended at the store limit, not at the caps. */
+bool ps_feed_store_limited(const ps_feed *f);
 
 /* Under the lock: where each handed-over batch of map k ended, as (stored
  * photons, emitted photons) pairs in order. A frame that draws a prefix of

@@ -295,6 +295,16 @@ static ps_status parse_action(parser *p, ps_script_action *a)
         ps_status st = read_number(p, action, arg[0], &a->yaw);
         return st != PS_OK ? st : read_number(p, action, arg[1], &a->pitch);
     }
+    if (strcmp(action, "wait") == 0) {
+        /* One thing to wait for so far; the word leaves room for others. */
+        a->kind = PS_SCRIPT_WAIT;
+        if (nargs < 1)
+            return wrong_count(p, action, "'done'");
+        if (strcmp(arg[0], "done") != 0)
+            return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: wait: expected 'done', got '%s'", p->name, p->line,
+                                arg[0]);
+        return nargs != 1 ? wrong_count(p, "wait done", "no arguments") : PS_OK;
+    }
     if (strcmp(action, "quit") == 0) {
         a->kind = PS_SCRIPT_QUIT;
         return nargs != 0 ? wrong_count(p, action, "no arguments") : PS_OK;

@@ -23,8 +23,14 @@
  *     orbit YAW PITCH                  camera yaw/pitch in degrees about the target
  *     power light INDEX R G B          new flux in watts per channel (each >= 0)
  *     angle light INDEX DEGREES        a spot's half-angle, in (0, 90]
+ *     wait done                        hold the later actions until every photon
+ *                                      map has reached its cap (or the memory
+ *                                      cap) and all of it is drawn (or tracing
+ *                                      is paused); their times
+ *                                      then count on from when the wait ended
  *     quit
- * (power and angle are extras beyond the contract, for editing lights.)
+ * (power, angle and wait are extras beyond the contract: editing lights, and
+ * pictures at a known photon count whatever the machine's speed.)
  * Numbers are strict (core/number.h); indices are integers in [0, 2^32 - 1],
  * checked against the scene by the window, not here.
  *
@@ -56,6 +62,7 @@ typedef enum ps_script_kind {
     PS_SCRIPT_ORBIT,
     PS_SCRIPT_POWER,
     PS_SCRIPT_ANGLE,
+    PS_SCRIPT_WAIT,
     PS_SCRIPT_QUIT
 } ps_script_kind;
 

@@ -1,0 +1,171 @@
+/* test_feed.c: the progressive preview's photon feed (preview/feed.h): it
+ * stops at the caps, and with a store limit it stops at that many stored
+ * photons instead, between batches, holding exactly the first photons of the
+ * capped maps (photon i depends only on scene, seed and i), so that memory is
+ * bounded for any scene and the picture stays a correct estimate. */
+#include "test.h"
+
+#include <string.h>
+#include <time.h>
+
+#include "photon/tracer.h"
+#include "photon/world.h"
+#include "preview/feed.h"
+#include "scene/scene.h"
+
+#define SCENE "data/scenes/cornell-caustic.scn"
+/* Two rounds of PS_FEED_BATCH caustic photons (and a quarter as many global
+ * ones) store about 38 000 photons in this scene, one round about 19 000. */
+#define CAUSTIC_CAP 40000
+#define GLOBAL_CAP 10000
+#define STORE_LIMIT 25000
+
+typedef struct rig {
+    ps_scene *scene;
+    ps_world *world;
+    ps_tracer *tracer;
+} rig;
+
+static rig rig_make(void)
+{
+    rig r;
+    memset(&r, 0, sizeof r);
+    ps_error err;
+    if (ps_scene_load(SCENE, NULL, &r.scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    if (ps_world_create(r.scene, NULL, &r.world, &err) != PS_OK)
+        fail_msg("world: %s", err.msg);
+    ps_tracer_options o = ps_tracer_default_options();
+    o.seed = 3;
+    o.threads = 2;
+    if (ps_tracer_create(r.world, &o, &r.tracer, &err) != PS_OK)
+        fail_msg("tracer: %s", err.msg);
+    return r;
+}
+
+static void rig_free(rig *r)
+{
+    ps_tracer_destroy(r->tracer);
+    ps_world_destroy(r->world);
+    ps_scene_destroy(r->scene);
+}
+
+/* A feed of both maps run to its end on this thread, with store limit `limit`. */
+static ps_feed *run_feed(rig *r, size_t limit)
+{
+    const uint64_t caps[PS_MAP_COUNT] = {CAUSTIC_CAP, GLOBAL_CAP};
+    const bool active[PS_MAP_COUNT] = {true, true};
+    ps_feed *f = NULL;
+    ps_error err;
+    if (ps_feed_create(r->tracer, caps, active, &f, &err) != PS_OK)
+        fail_msg("feed: %s", err.msg);
+    ps_feed_set_store_limit(f, limit);
+    if (ps_feed_run(f, &err) != PS_OK)
+        fail_msg("run: %s", err.msg);
+    return f;
+}
+
+static size_t stored(const ps_feed *f)
+{
+    const ps_photon_map *m = ps_feed_maps(f);
+    return m[PS_MAP_CAUSTIC].count + m[PS_MAP_GLOBAL].count;
+}
+
+/* No limit: every map traced to its cap, and the last mark says so. */
+static void ends_at_the_caps(void **state)
+{
+    (void)state;
+    rig r = rig_make();
+    ps_feed *f = run_feed(&r, 0);
+    assert_true(ps_feed_ended(f));
+    assert_false(ps_feed_store_limited(f));
+    const ps_photon_map *m = ps_feed_maps(f);
+    assert_int_equal(m[PS_MAP_CAUSTIC].counters.emitted, CAUSTIC_CAP);
+    assert_int_equal(m[PS_MAP_GLOBAL].counters.emitted, GLOBAL_CAP);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        size_t n;
+        const ps_feed_mark *marks = ps_feed_marks(f, (ps_map_kind)k, &n);
+        assert_true(n >= 2);
+        assert_int_equal(marks[n - 1].stored, m[k].count);
+        assert_int_equal(marks[n - 1].emitted, m[k].counters.emitted);
+    }
+    assert_true(stored(f) > STORE_LIMIT); /* else the limit below would not bite */
+    ps_feed_destroy(f);
+    rig_free(&r);
+}
+
+/* A store limit ends the feed at the first batch boundary at or past it: the
+ * maps hold at least the limit, the round before held less, fewer photons
+ * than the caps were emitted, and those stored are the capped maps' first
+ * photons, byte for byte. */
+static void ends_at_the_store_limit(void **state)
+{
+    (void)state;
+    rig r = rig_make();
+    ps_feed *full = run_feed(&r, 0);
+    ps_feed *f = run_feed(&r, STORE_LIMIT);
+    assert_true(ps_feed_ended(f));
+    assert_true(ps_feed_store_limited(f));
+    assert_true(stored(f) >= STORE_LIMIT);
+    size_t before = 0;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        size_t n;
+        const ps_feed_mark *marks = ps_feed_marks(f, (ps_map_kind)k, &n);
+        assert_true(n >= 2);
+        before += marks[n - 2].stored;
+    }
+    assert_true(before < STORE_LIMIT);
+    const ps_photon_map *m = ps_feed_maps(f), *all = ps_feed_maps(full);
+    assert_true(m[PS_MAP_CAUSTIC].counters.emitted < CAUSTIC_CAP);
+    assert_true(m[PS_MAP_GLOBAL].counters.emitted < GLOBAL_CAP);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        assert_true(m[k].count > 0 && m[k].count < all[k].count);
+        assert_memory_equal(m[k].photons, all[k].photons, m[k].count * sizeof *m[k].photons);
+        assert_memory_equal(m[k].objects, all[k].objects, m[k].count * sizeof *m[k].objects);
+    }
+    ps_feed_destroy(f);
+    ps_feed_destroy(full);
+    rig_free(&r);
+}
+
+/* The limit holds from the background thread too (start, then wait for the end). */
+static void background_thread_stops(void **state)
+{
+    (void)state;
+    rig r = rig_make();
+    const uint64_t caps[PS_MAP_COUNT] = {CAUSTIC_CAP, GLOBAL_CAP};
+    const bool active[PS_MAP_COUNT] = {true, true};
+    ps_feed *f = NULL;
+    ps_error err;
+    assert_int_equal(ps_feed_create(r.tracer, caps, active, &f, &err), PS_OK);
+    ps_feed_set_store_limit(f, STORE_LIMIT);
+    assert_int_equal(ps_feed_prime(f, &err), PS_OK);
+    assert_int_equal(ps_feed_start(f, &err), PS_OK);
+    bool ended = false;
+    while (!ended) {
+        ps_feed_lock(f);
+        ended = ps_feed_ended(f);
+        ps_feed_unlock(f);
+        if (!ended) {
+            struct timespec ms = {0, 1000000};
+            nanosleep(&ms, NULL);
+        }
+    }
+    ps_feed_stop(f);
+    assert_int_equal(ps_feed_status(f, &err), PS_OK);
+    assert_true(ps_feed_store_limited(f));
+    assert_true(stored(f) >= STORE_LIMIT);
+    assert_true(ps_feed_maps(f)[PS_MAP_CAUSTIC].counters.emitted < CAUSTIC_CAP);
+    ps_feed_destroy(f);
+    rig_free(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(ends_at_the_caps),
+        cmocka_unit_test(ends_at_the_store_limit),
+        cmocka_unit_test(background_thread_stops),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
