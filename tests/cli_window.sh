@@ -64,8 +64,10 @@ echo "caustic peak at x = $x1 px before the light moved right, $x2 px after"
 awk_true "$x2 < $x1 - 3" && ok || bad "the caustic did not move left with the light: $x1 -> $x2"
 latency=$(stat_of edit_to_frame_seconds_max "$cli_tmp/session.json")
 echo "first frame after the move: $latency s (tau 0.1 s)"
-# Ten tau in the release build; the sanitizer build runs several times slower.
-if [[ $bin == *asan* ]]; then most=3.0; else most=1.0; fi
+# Twenty tau in the release build (a loaded 2-core machine once took 1.09 s:
+# this guards against a lost edit or a hung refresh, bench-window.sh measures
+# the latency); the sanitizer build runs several times slower.
+if [[ $bin == *asan* ]]; then most=4.0; else most=2.0; fi
 awk_true "$latency > 0 && $latency < $most" && ok || bad "the frame after the move came $latency s later (over $most s)"
 [ "$(stat_of edits "$cli_tmp/session.json")" = 1 ] && ok || bad "stats do not count one edit"
 
