@@ -238,7 +238,7 @@ static void *cache_worker(void *arg)
     worker *wk = arg;
     render_job *job = wk->job;
     int n = job->cache_w * job->cache_h;
-    for (int i; (i = atomic_fetch_add(&job->next_record, 1)) < n;)
+    for (int i; !ps_cancelled(job->o->cancel) && (i = atomic_fetch_add(&job->next_record, 1)) < n;)
         cache_record(wk, i);
     return NULL;
 }
@@ -494,6 +494,8 @@ static void *render_worker(void *arg)
     worker *wk = arg;
     render_job *job = wk->job;
     for (;;) {
+        if (ps_cancelled(job->o->cancel))
+            break; /* between tiles: every finished tile is whole */
         int t = atomic_fetch_add(&job->next_tile, 1);
         if (t >= job->tiles)
             break;
@@ -584,9 +586,16 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     for (int i = 0; i < threads; i++)
         free(wk[i].scratch);
     free(job.cache);
+    int done = atomic_load(&job.done_tiles);
     if (stats) {
         stats->rays = atomic_load(&job.rays);
         stats->seconds = now() - t0;
+        stats->fraction = (double)done / job.tiles;
+    }
+    if (done < job.tiles) { /* only the cancel flag stops workers early */
+        ps_image_destroy(out);
+        return ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.0f %% of the image",
+                            100.0 * done / job.tiles);
     }
     return PS_OK;
 }
