@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "app/cli.h"
+#include "app/interrupt.h"
 #include "app/options.h"
 #include "app/stats.h"
 #include "gl/gl_render.h"
@@ -58,7 +59,17 @@ typedef struct snap_options {
     ps_shared_options c;
     ps_preview_options p;
     double time; /* 0: trace the photon counts and draw once */
+    const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM */
 } snap_options;
+
+/* The memory plan (ps_check_run_memory). A photon: its map entry and its
+ * splat geometry (triangles: 3 vertices of position, colour and texture
+ * coordinate floats, the largest mode). A pixel: besides the colour buffer,
+ * OSMesa's 24-bit depth + 8-bit stencil, the float read-back and the image. */
+#define SNAP_SPLAT_BYTES (3 * (3 + 4 + 2) * sizeof(float))
+#define SNAP_PHOTON_BYTES (PS_PHOTON_PLAN_BYTES + SNAP_SPLAT_BYTES)
+#define SNAP_PIXEL_BYTES (4 + 2 * 3 * sizeof(float))
+#define SNAP_MAPS_AT_ONCE 2
 
 static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, ps_error *err)
 {
@@ -217,6 +228,8 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     ps_tracer_options topt = ps_tracer_default_options();
     topt.seed = (uint64_t)o->c.seed;
     topt.threads = (int)o->c.threads;
+    topt.cancel = o->cancel;
+    topt.max_stored = ps_photon_cap(SNAP_MAPS_AT_ONCE, SNAP_PHOTON_BYTES);
     if (st == PS_OK)
         st = ps_tracer_create(world, &topt, &tracer, err);
     ps_mesh_options mopt = ps_mesh_default_options(scene);
@@ -266,6 +279,11 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         st = ps_feed_start(feed, err);
         double next = t_start + o->p.tau, end = t_start + o->time;
         while (st == PS_OK) {
+            if (ps_cancelled(o->cancel)) {
+                st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.1f s of %.1f s",
+                                  ps_now_seconds() - t_start, o->time);
+                break;
+            }
             double t = ps_now_seconds();
             double until = next < end ? next : end;
             if (t < until) {
@@ -302,6 +320,8 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         if (st == PS_OK)
             draw_frame(&s);
     }
+    if (st == PS_OK && ps_cancelled(o->cancel))
+        st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted before writing the snapshot");
     if (st == PS_OK && (o->c.out_png || o->c.out_hdr))
         st = write_outputs(&s, err);
     if (st == PS_OK && o->c.dump)
@@ -379,11 +399,22 @@ int main(int argc, char **argv)
         fputs(usage, stdout);
         return PS_EXIT_OK;
     }
+    if (ps_check_outputs(&o.c, &err) != PS_OK)
+        return ps_cli_fail(&err);
+    o.cancel = ps_interrupt_install();
     ps_scene *scene;
     if (ps_scene_load(o.c.scene, NULL, &scene, &err) != PS_OK)
         return ps_cli_fail(&err);
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
     int width = o.c.width ? o.c.width : def->width, height = o.c.height ? o.c.height : def->height;
+    /* Refuse what would not fit before the buffer or a photon. */
+    uint64_t photons = ps_shared_photons(&o.c, def, PS_MAP_CAUSTIC) + ps_shared_photons(&o.c, def, PS_MAP_GLOBAL);
+    uint64_t pixel_bytes = SNAP_PIXEL_BYTES + 4 * (o.p.color_depth == 0 ? 1 : sizeof(float));
+    if (ps_check_run_memory("photosplat-snap", photons, SNAP_PHOTON_BYTES, width, height, pixel_bytes, &err) !=
+        PS_OK) {
+        ps_scene_destroy(scene);
+        return ps_cli_fail(&err);
+    }
     /* RGBA, 24-bit depth, 8-bit stencil, no accumulation buffer (platform
      * notes: it wraps above 1.0 and is no place for photon sums). */
     OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
@@ -400,5 +431,7 @@ int main(int argc, char **argv)
         OSMesaDestroyContext(ctx);
     free(buffer);
     ps_scene_destroy(scene);
+    if (st == PS_ERR_INTERRUPTED)
+        return ps_interrupt_fail("photosplat-snap", &err);
     return st == PS_OK ? PS_EXIT_OK : ps_cli_fail(&err);
 }

@@ -62,10 +62,12 @@ ps_status ps_memory_check(uint64_t bytes, const char *who, const char *what, ps_
     char need[32], have[32];
     format_size(bytes, need, sizeof need);
     format_size(budget, have, sizeof have);
+    const char *sep = who ? ": " : "";
+    who = who ? who : "";
     if (ps_memory_parse_size(getenv(PS_MEMORY_LIMIT_ENV), &v))
-        return ps_error_set(err, PS_ERR_LIMIT, "%s: %s would need %s, more than the memory budget of %s (set by %s)",
-                            who, what, need, have, PS_MEMORY_LIMIT_ENV);
+        return ps_error_set(err, PS_ERR_LIMIT, "%s%s%s would need %s, more than the memory budget of %s (set by %s)",
+                            who, sep, what, need, have, PS_MEMORY_LIMIT_ENV);
     return ps_error_set(err, PS_ERR_LIMIT,
-                        "%s: %s would need %s, more than the memory budget of %s (%.0f %% of physical memory)", who,
-                        what, need, have, 100.0 * PS_MEMORY_FRACTION);
+                        "%s%s%s would need %s, more than the memory budget of %s (%.0f %% of physical memory)", who,
+                        sep, what, need, have, 100.0 * PS_MEMORY_FRACTION);
 }

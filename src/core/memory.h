@@ -32,7 +32,8 @@ uint64_t ps_memory_mul(uint64_t a, uint64_t b);
 
 /* PS_OK when `bytes` fit in the budget; otherwise PS_ERR_LIMIT with the
  * one-line message "WHO: WHAT needs N GiB, more than the memory budget of
- * M GiB (...)". `who` names the program or file, `what` the thing. */
+ * M GiB (...)". `who` names the program or file (NULL: no "WHO: "), `what`
+ * the thing. */
 ps_status ps_memory_check(uint64_t bytes, const char *who, const char *what, ps_error *err);
 
 #endif

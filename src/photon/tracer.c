@@ -673,7 +673,7 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
                           path, ps_map_name(kind), (unsigned long long)max_stored);
     else if (done < job.chunks)
         st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.0f %% of the %s photons",
-                          100.0 * (double)done / (double)job.chunks, ps_map_name(kind));
+                          100.0 * ((double)first + (double)done * PS_PHOTON_CHUNK) / (double)total, ps_map_name(kind));
     for (size_t k = 0; k < job.chunks && st == PS_OK; k++) {
         if (job.outs[k].failed)
             st = PS_ERR_NOMEM;
