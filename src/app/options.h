@@ -68,6 +68,13 @@ ps_status ps_check_outputs(const ps_shared_options *o, ps_error *err);
  * (ps_photon_cap) catches as it grows. */
 #define PS_PHOTON_PLAN_BYTES (2 * PS_PHOTON_MAP_BYTES + sizeof(ps_photon) + sizeof(uint32_t))
 
+/* A photon of the preview (snap, window): its map entry and its splat
+ * geometry (triangles: 3 vertices of position, colour and texture coordinate
+ * floats, the largest splat mode). */
+#define PS_PREVIEW_PHOTON_BYTES (PS_PHOTON_PLAN_BYTES + 3 * (3 + 4 + 2) * sizeof(float))
+/* The preview holds both maps at once. */
+#define PS_PREVIEW_MAPS 2
+
 /* The most photons one map may hold when `maps` maps of `bytes_each` bytes a
  * photon share the memory budget (ps_tracer_options.max_stored). */
 uint64_t ps_photon_cap(int maps, uint64_t bytes_each);

@@ -62,14 +62,9 @@ typedef struct snap_options {
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM */
 } snap_options;
 
-/* The memory plan (ps_check_run_memory). A photon: its map entry and its
- * splat geometry (triangles: 3 vertices of position, colour and texture
- * coordinate floats, the largest mode). A pixel: besides the colour buffer,
- * OSMesa's 24-bit depth + 8-bit stencil, the float read-back and the image. */
-#define SNAP_SPLAT_BYTES (3 * (3 + 4 + 2) * sizeof(float))
-#define SNAP_PHOTON_BYTES (PS_PHOTON_PLAN_BYTES + SNAP_SPLAT_BYTES)
+/* The memory plan (ps_check_run_memory): a pixel, besides the colour buffer,
+ * is OSMesa's 24-bit depth + 8-bit stencil, the float read-back and the image. */
 #define SNAP_PIXEL_BYTES (4 + 2 * 3 * sizeof(float))
-#define SNAP_MAPS_AT_ONCE 2
 
 static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, ps_error *err)
 {
@@ -229,7 +224,7 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     topt.seed = (uint64_t)o->c.seed;
     topt.threads = (int)o->c.threads;
     topt.cancel = o->cancel;
-    topt.max_stored = ps_photon_cap(SNAP_MAPS_AT_ONCE, SNAP_PHOTON_BYTES);
+    topt.max_stored = ps_photon_cap(PS_PREVIEW_MAPS, PS_PREVIEW_PHOTON_BYTES);
     if (st == PS_OK)
         st = ps_tracer_create(world, &topt, &tracer, err);
     ps_mesh_options mopt = ps_mesh_default_options(scene);
@@ -410,7 +405,7 @@ int main(int argc, char **argv)
     /* Refuse what would not fit before the buffer or a photon. */
     uint64_t photons = ps_shared_photons(&o.c, def, PS_MAP_CAUSTIC) + ps_shared_photons(&o.c, def, PS_MAP_GLOBAL);
     uint64_t pixel_bytes = SNAP_PIXEL_BYTES + 4 * (o.p.color_depth == 0 ? 1 : sizeof(float));
-    if (ps_check_run_memory("photosplat-snap", photons, SNAP_PHOTON_BYTES, width, height, pixel_bytes, &err) !=
+    if (ps_check_run_memory("photosplat-snap", photons, PS_PREVIEW_PHOTON_BYTES, width, height, pixel_bytes, &err) !=
         PS_OK) {
         ps_scene_destroy(scene);
         return ps_cli_fail(&err);

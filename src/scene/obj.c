@@ -8,7 +8,9 @@
 
 #include "core/array.h"
 #include "core/fileio.h"
+#include "core/memory.h"
 #include "core/number.h"
+#include "scene/scene.h"
 
 /* Larger files are refused before reading: 1 GiB of OBJ text is ~20 M triangles,
  * far past what the interactive preview is for. */
@@ -361,6 +363,15 @@ ps_status ps_obj_load(const char *path, ps_obj_mesh *out, const ps_warn_sink *wa
         st = scan_obj(&ps, text);
     if (st == PS_OK && ps.faces == 0)
         st = ps_error_set(err, PS_ERR_PARSE, "%s: no faces: not a mesh (empty file, or not an OBJ file?)", path);
+    /* Before tinyobjloader copies it all: every face is at least a triangle. */
+    if (st == PS_OK && ps.faces > PS_SCENE_MAX_TRIANGLES)
+        st = ps_error_set(err, PS_ERR_LIMIT, "%s: %zu faces, more than the limit of %d triangles", path, ps.faces,
+                          PS_SCENE_MAX_TRIANGLES);
+    if (st == PS_OK) {
+        char what[64];
+        snprintf(what, sizeof what, "%zu faces", ps.faces);
+        st = ps_memory_check((uint64_t)ps.faces * PS_SCENE_PLAN_TRIANGLE_BYTES, path, what, err);
+    }
     if (st == PS_OK) {
         char msg[512];
         if (ps_tinyobj_parse(text, len, ps.mtl_text ? ps.mtl_text : "", ps.mtl_len, out, msg, sizeof msg) != 0)

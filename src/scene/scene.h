@@ -23,6 +23,12 @@
 #define PS_SCENE_MAX_TRIANGLES 50000000
 #define PS_SCENE_MAX_IMAGE_SIDE 16384
 #define PS_SCENE_MAX_PHOTONS 1000000000LL
+/* What a triangle is planned at against the memory budget (core/memory.h):
+ * the scene's soup, the OBJ reader's text and copies, the ray accelerator
+ * and the preview's mesh. Measured: 470 bytes a triangle at the peak of
+ * photosplat-snap on a 980 000-triangle OBJ (320 for photosplat-ref). So
+ * PS_SCENE_MAX_TRIANGLES fit only on a machine with about 32 GiB. */
+#define PS_SCENE_PLAN_TRIANGLE_BYTES 512
 
 typedef struct ps_camera {
     ps_vec3 eye, target, up; /* up need not be orthogonal to the view direction */
