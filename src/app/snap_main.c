@@ -315,7 +315,10 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         if (st == PS_OK)
             draw_frame(&s);
     }
-    if (st == PS_OK && ps_cancelled(o->cancel))
+    if (st == PS_OK && ps_cancelled(o->cancel) && o->time > 0.0)
+        st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.1f s of %.1f s", ps_now_seconds() - t_start,
+                          o->time);
+    else if (st == PS_OK && ps_cancelled(o->cancel))
         st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted before writing the snapshot");
     if (st == PS_OK && (o->c.out_png || o->c.out_hdr))
         st = write_outputs(&s, err);
