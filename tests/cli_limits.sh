@@ -189,7 +189,7 @@ interrupt() {
 interrupt "ref SIGINT" INT 130 \
     '^photosplat-ref: interrupted after [0-9]+ % of the (image|caustic photons|global photons); nothing written$' \
     "$ref" "$scene" -o "$out/a.png" --hdr "$out/a.pfm" --stats "$out/s.json" --dump-photons "$out/d.txt" \
-    --size 512x512 --spp 1024
+    --size 512x512 --spp 64
 interrupt "ref SIGTERM" TERM 143 '^photosplat-ref: interrupted after [0-9]+ % of the global photons; nothing written$' \
     "$ref" "$scene" --photons-only --stats "$out/s.json" --caustic-photons 0 --global-photons 50000000
 interrupt "snap SIGINT" INT 130 '^photosplat-snap: interrupted after [0-9.]+ s of 60\.0 s; nothing written$' \

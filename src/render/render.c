@@ -454,7 +454,9 @@ static ps_rgb radiance(worker *wk, ps_ray r, int depth, bool through, uint64_t k
 
 /* ---- pixels, tiles, threads ---------------------------------------------- */
 
-static void render_tile(worker *wk, int tile)
+/* Renders one tile; false when the cancel flag stopped it partway (checked
+ * every row, so that a tile of many samples still stops within moments). */
+static bool render_tile(worker *wk, int tile)
 {
     render_job *job = wk->job;
     const ps_render_options *o = job->o;
@@ -466,7 +468,9 @@ static void render_tile(worker *wk, int tile)
     while (o->spp % sx)
         sx--;
     int sy = o->spp / sx;
-    for (int y = y0; y < y1; y++)
+    for (int y = y0; y < y1; y++) {
+        if (ps_cancelled(o->cancel))
+            return false;
         for (int x = x0; x < x1; x++) {
             ps_rng rng = ps_rng_make(o->seed, PS_STREAM_PIXEL, (uint64_t)y * (uint64_t)o->width + (uint64_t)x);
             ps_rgb sum = ps_rgb_gray(0.0);
@@ -485,6 +489,8 @@ static void render_tile(worker *wk, int tile)
             dst[1] = (float)(sum.g / o->spp);
             dst[2] = (float)(sum.b / o->spp);
         }
+    }
+    return true;
 }
 
 /* Takes tiles until none are left. The calling thread's worker (`reports`)
@@ -499,7 +505,8 @@ static void *render_worker(void *arg)
         int t = atomic_fetch_add(&job->next_tile, 1);
         if (t >= job->tiles)
             break;
-        render_tile(wk, t);
+        if (!render_tile(wk, t))
+            break;
         int done = atomic_fetch_add(&job->done_tiles, 1) + 1;
         if (wk->reports && job->o->progress)
             job->o->progress(job->o->progress_user, (double)done / job->tiles);

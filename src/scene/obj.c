@@ -71,14 +71,18 @@ static int split(char *s, char **tok, int max)
  * next line, or NULL at the end. */
 static const char *next_line(const char *at, char *dst, size_t dst_size, bool *too_long)
 {
-    const char *nl = strchr(at, '\n');
-    size_t n = nl ? (size_t)(nl - at) : strlen(at);
+    /* A plain loop, not strchr: ASan's strict string checks make each strchr
+     * scan to the end of the file, quadratic in its length. */
+    const char *e = at;
+    while (*e && *e != '\n')
+        e++;
+    size_t n = (size_t)(e - at);
     *too_long = n >= dst_size;
     if (*too_long)
         n = dst_size - 1;
     memcpy(dst, at, n);
     dst[n] = '\0';
-    return nl ? nl + 1 : (*at ? at + strlen(at) : NULL);
+    return *e ? e + 1 : (*at ? e : NULL);
 }
 
 static ps_status check_numbers(const char *path, int line, char **tok, int ntok, int min, int max,
