@@ -1118,7 +1118,8 @@ int main(int argc, char **argv)
         st = ps_scene_load(a.o.c.scene, NULL, &a.scene, &err);
     if (st == PS_OK) {
         const ps_scene_defaults *def = ps_scene_get_defaults(a.scene);
-        uint64_t photons = ps_shared_photons(&a.o.c, def, PS_MAP_CAUSTIC) + ps_shared_photons(&a.o.c, def, PS_MAP_GLOBAL);
+        uint64_t photons =
+            ps_shared_photons(&a.o.c, def, PS_MAP_CAUSTIC) + ps_shared_photons(&a.o.c, def, PS_MAP_GLOBAL);
         st = ps_check_run_memory("photosplat", photons, PS_PREVIEW_PHOTON_BYTES, a.o.c.width ? a.o.c.width : def->width,
                                  a.o.c.height ? a.o.c.height : def->height, WIN_PIXEL_BYTES, &err);
     }

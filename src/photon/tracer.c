@@ -647,8 +647,9 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
     atomic_init(&job.over, false);
     uint64_t max_stored = t->opt.max_stored;
     if (max_stored && m->count >= max_stored)
-        return ps_error_set(err, PS_ERR_LIMIT, "%s: the %s photon map is full: %llu photons, the most the memory budget allows",
-                            path, ps_map_name(kind), (unsigned long long)m->count);
+        return ps_error_set(err, PS_ERR_LIMIT,
+                            "%s: the %s photon map is full: %llu photons, the most the memory budget allows", path,
+                            ps_map_name(kind), (unsigned long long)m->count);
     job.room = max_stored ? max_stored - m->count : 0;
     job.outs = calloc(job.chunks, sizeof *job.outs);
     if (!job.outs)
