@@ -1,12 +1,15 @@
-/* test_core.c: vectors, boxes, transforms, strict numbers and atomic output. */
+/* test_core.c: vectors, boxes, transforms, strict numbers, atomic output, the
+ * memory budget and the interrupt flag. */
 #include "test.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include <dirent.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "app/interrupt.h"
 #include "core/fileio.h"
 #include "core/memory.h"
 #include "core/number.h"
@@ -320,6 +323,28 @@ static void output_checks(void **state)
     assert_string_equal(err.msg, "/dev/full: write failed: No space left on device");
 }
 
+/* The programs' SIGINT/SIGTERM flag: the signal's number, the exit status
+ * 128 + it, the handler gone after the first signal; SIGXFSZ ignored. */
+static void interrupt_flag(void **state)
+{
+    (void)state;
+    const ps_cancel_flag *flag = ps_interrupt_install();
+    assert_false(ps_cancelled(flag));
+    assert_int_equal(ps_interrupt_exit_status(), 130); /* none yet: as for SIGINT */
+    raise(SIGTERM);
+    assert_true(ps_cancelled(flag));
+    assert_int_equal(*flag, SIGTERM);
+    assert_int_equal(ps_interrupt_exit_status(), 143);
+    struct sigaction sa;
+    assert_int_equal(sigaction(SIGTERM, NULL, &sa), 0);
+    assert_true(sa.sa_handler == SIG_DFL); /* a second SIGTERM would end the program */
+    assert_int_equal(sigaction(SIGXFSZ, NULL, &sa), 0);
+    assert_true(sa.sa_handler == SIG_IGN);
+    signal(SIGINT, SIG_DFL);
+    signal(SIGXFSZ, SIG_DFL);
+    signal(SIGPIPE, SIG_DFL);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -333,6 +358,7 @@ int main(void)
         cmocka_unit_test(error_messages_are_one_line),
         cmocka_unit_test(memory_budget),
         cmocka_unit_test(output_checks),
+        cmocka_unit_test(interrupt_flag),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
