@@ -1,11 +1,17 @@
-/* test_core.c: vectors, boxes, transforms, strict numbers and atomic output. */
+/* test_core.c: vectors, boxes, transforms, strict numbers, atomic output, the
+ * memory budget and the interrupt flag. */
 #include "test.h"
 
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include "app/interrupt.h"
 #include "core/fileio.h"
+#include "core/memory.h"
 #include "core/number.h"
 #include "core/rng.h"
 #include "core/transform.h"
@@ -239,6 +245,106 @@ static void error_messages_are_one_line(void **state)
     assert_string_equal(ps_status_name(PS_ERR_NOMEM), "out of memory");
 }
 
+/* PS_MEMORY_LIMIT sets the budget; sizes parse with K/M/G; a check over it
+ * is PS_ERR_LIMIT with the one-line message; products saturate. */
+static void memory_budget(void **state)
+{
+    (void)state;
+    uint64_t v = 0;
+    assert_true(ps_memory_parse_size("512M", &v));
+    assert_true(v == 512ull << 20);
+    assert_true(ps_memory_parse_size("3g", &v) && v == 3ull << 30);
+    assert_true(ps_memory_parse_size("4096", &v) && v == 4096);
+    assert_false(ps_memory_parse_size("0", &v));
+    assert_false(ps_memory_parse_size("-1G", &v));
+    assert_false(ps_memory_parse_size("12T", &v));
+    assert_false(ps_memory_parse_size("", &v));
+    assert_false(ps_memory_parse_size(NULL, &v));
+    assert_true(ps_memory_mul(UINT64_MAX / 2, 3) == UINT64_MAX);
+    assert_true(ps_memory_mul(0, UINT64_MAX) == 0);
+
+    setenv(PS_MEMORY_LIMIT_ENV, "64M", 1);
+    assert_true(ps_memory_budget() == 64ull << 20);
+    ps_error err;
+    assert_int_equal(ps_memory_check(64ull << 20, "prog", "it", &err), PS_OK);
+    assert_int_equal(ps_memory_check((64ull << 20) + 1, "prog", "a thing", &err), PS_ERR_LIMIT);
+    assert_string_equal(err.msg, "prog: a thing would need 64 MiB, more than the memory budget of 64 MiB (set by "
+                                 "PS_MEMORY_LIMIT)");
+    assert_int_equal(ps_memory_check(3ull << 30, NULL, "it", &err), PS_ERR_LIMIT);
+    assert_string_equal(err.msg, "it would need 3.0 GiB, more than the memory budget of 64 MiB (set by PS_MEMORY_LIMIT)");
+    /* Without the variable (or with junk in it): 3/4 of physical memory. */
+    setenv(PS_MEMORY_LIMIT_ENV, "lots", 1);
+    uint64_t physical = (uint64_t)sysconf(_SC_PHYS_PAGES) * (uint64_t)sysconf(_SC_PAGESIZE);
+    assert_true(ps_memory_budget() == (uint64_t)((double)physical * PS_MEMORY_FRACTION));
+    unsetenv(PS_MEMORY_LIMIT_ENV);
+    assert_int_equal(ps_memory_check(UINT64_MAX, "prog", "everything", &err), PS_ERR_LIMIT);
+    assert_non_null(strstr(err.msg, "(75 % of physical memory)"));
+}
+
+/* Output paths are checked before any work: nothing is left by the check;
+ * a FIFO without a reader fails at once; a device that fills up fails at
+ * commit and leaves nothing. */
+static void output_checks(void **state)
+{
+    (void)state;
+    ps_error err;
+    char dir[1024], path[1100];
+    snprintf(dir, sizeof dir, "%s", test_path("outcheck"));
+    mkdir(dir, 0777);
+    snprintf(path, sizeof path, "%s/a.png", dir);
+    remove(path);
+    assert_int_equal(ps_check_output_path(path, &err), PS_OK);
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    int entries = 0;
+    for (struct dirent *e; (e = readdir(d));)
+        entries += e->d_name[0] != '.';
+    closedir(d);
+    assert_int_equal(entries, 0); /* the probe's temporary file is gone */
+    assert_int_equal(ps_check_output_path(dir, &err), PS_ERR_IO);
+    assert_non_null(strstr(err.msg, "is a directory"));
+    snprintf(path, sizeof path, "%s/none/a.png", dir);
+    assert_int_equal(ps_check_output_path(path, &err), PS_ERR_IO);
+    assert_non_null(strstr(err.msg, "none/a.png: cannot create: No such file or directory"));
+    assert_int_equal(ps_check_output_path("/dev/null", &err), PS_OK);
+
+    snprintf(path, sizeof path, "%s/fifo", dir);
+    remove(path);
+    assert_int_equal(mkfifo(path, 0600), 0);
+    assert_null(ps_outfile_open(path, &err)); /* no reader: ENXIO, not a hang */
+    assert_non_null(strstr(err.msg, "fifo: cannot open: No such device or address"));
+    remove(path);
+
+    ps_outfile *f = ps_outfile_open("/dev/full", &err);
+    assert_non_null(f);
+    for (int i = 0; i < 10000; i++)
+        fputs("more than a stdio buffer ", ps_outfile_stream(f));
+    assert_int_equal(ps_outfile_commit(f, &err), PS_ERR_IO);
+    assert_string_equal(err.msg, "/dev/full: write failed: No space left on device");
+}
+
+/* The programs' SIGINT/SIGTERM flag: the signal's number, the exit status
+ * 128 + it, the handler gone after the first signal; SIGXFSZ ignored. */
+static void interrupt_flag(void **state)
+{
+    (void)state;
+    const ps_cancel_flag *flag = ps_interrupt_install();
+    assert_false(ps_cancelled(flag));
+    assert_int_equal(ps_interrupt_exit_status(), 130); /* none yet: as for SIGINT */
+    raise(SIGTERM);
+    assert_true(ps_cancelled(flag));
+    assert_int_equal(*flag, SIGTERM);
+    assert_int_equal(ps_interrupt_exit_status(), 143);
+    struct sigaction sa;
+    assert_int_equal(sigaction(SIGTERM, NULL, &sa), 0);
+    assert_true(sa.sa_handler == SIG_DFL); /* a second SIGTERM would end the program */
+    assert_int_equal(sigaction(SIGXFSZ, NULL, &sa), 0);
+    assert_true(sa.sa_handler == SIG_IGN);
+    signal(SIGINT, SIG_DFL);
+    signal(SIGXFSZ, SIG_DFL);
+    signal(SIGPIPE, SIG_DFL);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -250,6 +356,9 @@ int main(void)
         cmocka_unit_test(atomic_output),
         cmocka_unit_test(read_file_limits),
         cmocka_unit_test(error_messages_are_one_line),
+        cmocka_unit_test(memory_budget),
+        cmocka_unit_test(output_checks),
+        cmocka_unit_test(interrupt_flag),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -369,12 +369,41 @@ static void defaults_and_errors(void **state)
     ps_preview_mesh_free(NULL);
 }
 
+/* Ten spheres are 98 000 triangles, 13.5 MiB planned: refused under a 4 MiB
+ * budget before anything is allocated, built under 16 MiB. */
+static void memory_budget(void **state)
+{
+    (void)state;
+    char text[2048];
+    int n = snprintf(text, sizeof text, "camera eye 0 0 30 target 0 0 0\nlight point position 0 9 0 power 1 1 1\n");
+    for (int i = 0; i < 10; i++)
+        n += snprintf(text + n, sizeof text - (size_t)n, "sphere center %d 0 0 radius 0.4\n", i);
+    ps_scene *s;
+    ps_error err;
+    if (ps_scene_load_text(text, "spheres.scn", "", NULL, &s, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_mesh_options o = ps_mesh_default_options(s);
+    ps_preview_mesh m;
+    setenv("PS_MEMORY_LIMIT", "4M", 1);
+    assert_int_equal(ps_preview_mesh_build(s, &o, &m, &err), PS_ERR_LIMIT);
+    assert_string_equal(err.msg, "spheres.scn: the preview mesh of 98000 triangles would need 13 MiB, more than the "
+                                 "memory budget of 4 MiB (set by PS_MEMORY_LIMIT)");
+    assert_null(m.positions);
+    setenv("PS_MEMORY_LIMIT", "16M", 1);
+    assert_int_equal(ps_preview_mesh_build(s, &o, &m, &err), PS_OK);
+    assert_int_equal(m.vertex_count, 3 * 98000);
+    unsetenv("PS_MEMORY_LIMIT");
+    ps_preview_mesh_free(&m);
+    ps_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(room),
         cmocka_unit_test(split_limits),
         cmocka_unit_test(defaults_and_errors),
+        cmocka_unit_test(memory_budget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -367,6 +367,34 @@ static void camera_matches_projection(void **state)
     assert_near(acos(ps_v3_dot(top.d, to)) * 180 / PS_PI, 20.0, 1e-9);
 }
 
+/* A raised cancel flag stops the render between rows: PS_ERR_INTERRUPTED
+ * with the share finished, no image; lowered, the same render completes. */
+static void cancelled_render(void **state)
+{
+    (void)state;
+    const char *text = "camera eye 0 3 0.01 target 0 0 0 up 0 0 -1 fov 50\n"
+                       "quad corner -50 0 50 edge1 100 0 0 edge2 0 0 -100\n"
+                       "light point position 0 1 0 power 100 100 100\n";
+    ps_estimate_options est = {50, 0.05, PS_KERNEL_BOX};
+    rig r = rig_make(text, 0, 0, &est, false);
+    ps_render_options o = options(40, 40, 1, PS_COMPONENT_DIRECT, &est, 0);
+    ps_cancel_flag flag = 2; /* as a SIGINT handler leaves it */
+    o.cancel = &flag;
+    ps_render_maps maps = {r.trees[PS_MAP_CAUSTIC], r.trees[PS_MAP_GLOBAL], NULL, NULL};
+    ps_image img;
+    ps_render_stats st;
+    ps_error err;
+    assert_int_equal(ps_render(r.world, r.ls, &maps, &o, &img, &st, &err), PS_ERR_INTERRUPTED);
+    assert_null(img.rgb);
+    assert_near(st.fraction, 0.0, 0.0);
+    assert_string_equal(err.msg, "interrupted after 0 % of the image");
+    flag = 0;
+    assert_int_equal(ps_render(r.world, r.ls, &maps, &o, &img, &st, &err), PS_OK);
+    assert_near(st.fraction, 1.0, 0.0);
+    ps_image_destroy(&img);
+    rig_free(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -374,7 +402,7 @@ int main(void)
         cmocka_unit_test(disc_light),
         cmocka_unit_test(furnace_sphere),
         cmocka_unit_test(glossy_in_furnace),            cmocka_unit_test(mirror_caustic_image),
-        cmocka_unit_test(components_add_up),
+        cmocka_unit_test(components_add_up),            cmocka_unit_test(cancelled_render),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -94,12 +94,30 @@ static void counts_and_refusals(void **state)
     assert_null(m.positions);
 }
 
+/* The count callers check against memory is the count the mesh has. */
+static void count_before_building(void **state)
+{
+    (void)state;
+    const double tolerances[] = {0.5, 0.1, 1e-3, 1e-5, 1e-9};
+    for (size_t i = 0; i < sizeof tolerances / sizeof tolerances[0]; i++) {
+        ps_trimesh m;
+        ps_error err;
+        assert_int_equal(ps_sphere_tessellate(ps_v3(0, 0, 0), 1.0, tolerances[i], &m, &err), PS_OK);
+        assert_int_equal(ps_sphere_triangle_count(tolerances[i]), m.triangle_count);
+        ps_trimesh_free(&m);
+    }
+    assert_int_equal(ps_sphere_triangle_count(PS_SPHERE_DEFAULT_TOLERANCE), 9800);
+    assert_int_equal(ps_sphere_triangle_count(0.0), 0);
+    assert_int_equal(ps_sphere_triangle_count(0.6), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(default_tolerance),
         cmocka_unit_test(coarse_fine_and_extreme_scales),
         cmocka_unit_test(counts_and_refusals),
+        cmocka_unit_test(count_before_building),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

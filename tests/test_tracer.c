@@ -497,13 +497,46 @@ static void photon_materials(void **state)
     rig_free(&r);
 }
 
+/* A raised cancel flag stops a trace before its first chunk; a cap on the
+ * stored photons stops one that would pass it. Either way the map keeps what
+ * it had, and the next trace within the cap appends as usual. */
+static void cancel_and_cap(void **state)
+{
+    (void)state;
+    ps_tracer_options o = options(2);
+    ps_cancel_flag flag = 15; /* SIGTERM */
+    o.cancel = &flag;
+    o.max_stored = 3000;
+    char text[2048];
+    box_scene(text, sizeof text, 0.9);
+    rig r = rig_make(text, "", &o, PS_ACCEL_AUTO);
+    ps_photon_map m;
+    ps_photon_map_init(&m, PS_MAP_GLOBAL);
+    ps_error err;
+    assert_int_equal(ps_tracer_trace(r.tracer, PS_MAP_GLOBAL, 0, 5000, 5000, &m, &err), PS_ERR_INTERRUPTED);
+    assert_string_equal(err.msg, "interrupted after 0 % of the global photons");
+    assert_int_equal(m.count, 0);
+    flag = 0;
+    /* A closed box of albedo 0.9 stores several photons per path: 100 paths
+     * fit, 20000 would pass 3000 (about 9 a path). */
+    assert_int_equal(ps_tracer_trace(r.tracer, PS_MAP_GLOBAL, 0, 100, 20000, &m, &err), PS_OK);
+    size_t kept = m.count;
+    assert_true(kept > 100 && kept <= 3000);
+    assert_int_equal(ps_tracer_trace(r.tracer, PS_MAP_GLOBAL, 100, 19900, 20000, &m, &err), PS_ERR_LIMIT);
+    assert_non_null(strstr(err.msg, "the global photon map would hold more than 3000 photons"));
+    assert_int_equal(m.count, kept);
+    assert_int_equal(m.counters.emitted, 100);
+    ps_photon_map_free(&m);
+    rig_free(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(furnace_box),    cmocka_unit_test(photons_per_light), cmocka_unit_test(mirror_caustic),
         cmocka_unit_test(overlapping_cones), cmocka_unit_test(no_leaks),      cmocka_unit_test(determinism),
         cmocka_unit_test(scale_invariance), cmocka_unit_test(skips),
-        cmocka_unit_test(photon_materials),
+        cmocka_unit_test(photon_materials), cmocka_unit_test(cancel_and_cap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

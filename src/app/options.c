@@ -1,8 +1,11 @@
 /* options.c: the shared options, the photon dump, the clock. */
 #include "app/options.h"
 
+#include <stdio.h>
 #include <string.h>
 #include <time.h>
+
+#include "core/memory.h"
 
 #include "core/fileio.h"
 #include "photon/estimate.h"
@@ -76,6 +79,36 @@ ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_photon_map_write_text(ps_outfile_stream(out), &maps[k]);
     return ps_outfile_commit(out, err);
+}
+
+ps_status ps_check_outputs(const ps_shared_options *o, ps_error *err)
+{
+    const char *paths[] = {o->out_png, o->out_hdr, o->stats, o->dump};
+    for (size_t k = 0; k < sizeof paths / sizeof paths[0]; k++)
+        if (paths[k] && ps_check_output_path(paths[k], err) != PS_OK)
+            return err->status;
+    return PS_OK;
+}
+
+uint64_t ps_photon_cap(int maps, uint64_t bytes_each)
+{
+    uint64_t per = ps_memory_mul((uint64_t)(maps > 0 ? maps : 1), bytes_each ? bytes_each : 1);
+    uint64_t cap = ps_memory_budget() / per;
+    return cap ? cap : 1;
+}
+
+ps_status ps_check_run_memory(const char *prog, uint64_t photons, uint64_t photon_bytes, int width, int height,
+                              uint64_t pixel_bytes, ps_error *err)
+{
+    uint64_t pixels = (uint64_t)(width > 0 ? width : 0) * (uint64_t)(height > 0 ? height : 0);
+    uint64_t a = ps_memory_mul(photons, photon_bytes), b = ps_memory_mul(pixels, pixel_bytes);
+    uint64_t total = a > UINT64_MAX - b ? UINT64_MAX : a + b;
+    char what[128];
+    if (pixels)
+        snprintf(what, sizeof what, "%llu photons and a %dx%d image", (unsigned long long)photons, width, height);
+    else
+        snprintf(what, sizeof what, "%llu photons", (unsigned long long)photons);
+    return ps_memory_check(total, prog, what, err);
 }
 
 double ps_now_seconds(void)

@@ -64,6 +64,34 @@ ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_
 /* --dump-photons: every photon of both maps, written whole or not at all. */
 ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP_COUNT], ps_error *err);
 
+/* Every output file the options name can be made (ps_check_output_path):
+ * checked before any work, so a typo does not cost a whole render. */
+ps_status ps_check_outputs(const ps_shared_options *o, ps_error *err);
+
+/* What one emitted photon is planned at when checking a run against the
+ * memory budget: its map entry twice (the chunks and the map while they are
+ * joined) and its kd-tree node with the build's index. One stored photon per
+ * emitted one: the global map may store more, which the tracer's cap
+ * (ps_photon_cap) catches as it grows. */
+#define PS_PHOTON_PLAN_BYTES (2 * PS_PHOTON_MAP_BYTES + sizeof(ps_photon) + sizeof(uint32_t))
+
+/* A photon of the preview (snap, window): its map entry and its splat
+ * geometry (triangles: 3 vertices of position, colour and texture coordinate
+ * floats, the largest splat mode). */
+#define PS_PREVIEW_PHOTON_BYTES (PS_PHOTON_PLAN_BYTES + 3 * (3 + 4 + 2) * sizeof(float))
+/* The preview holds both maps at once. */
+#define PS_PREVIEW_MAPS 2
+
+/* The most photons one map may hold when `maps` maps of `bytes_each` bytes a
+ * photon share the memory budget (ps_tracer_options.max_stored). */
+uint64_t ps_photon_cap(int maps, uint64_t bytes_each);
+
+/* Refuses (PS_ERR_LIMIT, "PROG: N photons and a WxH image need ...") a run
+ * whose photons at photon_bytes each and image at pixel_bytes a pixel would
+ * not fit in the memory budget, before anything is allocated. */
+ps_status ps_check_run_memory(const char *prog, uint64_t photons, uint64_t photon_bytes, int width, int height,
+                              uint64_t pixel_bytes, ps_error *err);
+
 /* Seconds on a monotonic clock. */
 double ps_now_seconds(void);
 

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "app/cli.h"
+#include "app/interrupt.h"
 #include "app/options.h"
 #include "app/stats.h"
 #include "photon/estimate.h"
@@ -28,6 +29,11 @@
 #define REF_DEFAULT_CACHE_RAYS 256
 /* Final gathering looks irradiance up at every this-many-th photon (Christensen 1999 uses a subset). */
 #define REF_IRRADIANCE_STRIDE 4
+/* The memory plan (ps_check_run_memory): maps in memory at once (caustic,
+ * global, and the global map with direct hits for final gathering), and a
+ * pixel's bytes (the float image; the PNG encoder works a row at a time). */
+#define REF_MAPS_AT_ONCE 3
+#define REF_PIXEL_BYTES (3 * sizeof(float))
 
 static const char usage[] =
     "usage: photosplat-ref SCENE.scn --photons-only [options]\n"
@@ -76,6 +82,7 @@ typedef struct ref_options {
     bool photons_only;
     bool cones, first_hit;
     int accel;
+    const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM */
 } ref_options;
 
 static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, ps_error *err)
@@ -212,6 +219,7 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
     ro.caustic.max_radius = o->max_radius > 0.0 ? o->max_radius : radius[PS_MAP_CAUSTIC];
     ro.global.max_radius = o->max_radius > 0.0 ? o->max_radius : radius[PS_MAP_GLOBAL];
     ro.irradiance_radius = ro.global.max_radius;
+    ro.cancel = o->cancel;
 
     double t0 = ps_now_seconds();
     ps_status st = ps_light_sampler_create(scene, &r->lights, err);
@@ -244,13 +252,9 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
         ro.progress = show_progress;
         ro.progress_user = &pr;
     }
-    ps_render_stats stats = {0, 0.0};
+    ps_render_stats stats = {0, 0.0, 0.0};
     if (st == PS_OK)
         st = ps_render(r->world, r->lights, &maps, &ro, &r->image, &stats, err);
-    if (st == PS_OK && o->c.out_hdr)
-        st = ps_pfm_write(&r->image, o->c.out_hdr, err);
-    if (st == PS_OK && o->c.out_png)
-        st = ps_png_write(&r->image, o->c.out_png, (float)o->c.exposure, err);
     rs->rays += stats.rays;
     rs->ray_seconds = rs->trace_seconds + t_prep + stats.seconds;
     ps_stats_add(rs, "maps_seconds", t_prep);
@@ -287,6 +291,8 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
     topt.threads = (int)o->c.threads;
     topt.caustic_cones = o->cones;
     topt.first_hit_test = o->first_hit;
+    topt.cancel = o->cancel;
+    topt.max_stored = ps_photon_cap(REF_MAPS_AT_ONCE, PS_PHOTON_PLAN_BYTES);
     if (st == PS_OK)
         st = ps_tracer_create(r.world, &topt, &r.tracer, err);
 
@@ -309,8 +315,6 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
 
     ps_run_stats rs;
     memset(&rs, 0, sizeof rs);
-    if (st == PS_OK && o->c.dump)
-        st = ps_write_photon_dump(o->c.dump, r.maps, err);
     if (st == PS_OK) {
         for (int k = 0; k < PS_MAP_COUNT; k++) {
             rs.emitted[k] = r.maps[k].counters.emitted;
@@ -332,6 +336,16 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
     }
     if (st == PS_OK && !o->photons_only)
         st = render_image(o, scene, &r, &topt, want[PS_MAP_GLOBAL], radius, &rs, err);
+    /* Every file at the end, after the last chance of an interruption: a
+     * stopped run writes none of them. */
+    if (st == PS_OK && ps_cancelled(o->cancel))
+        st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after the whole image, before writing it");
+    if (st == PS_OK && !o->photons_only && o->c.out_hdr)
+        st = ps_pfm_write(&r.image, o->c.out_hdr, err);
+    if (st == PS_OK && !o->photons_only && o->c.out_png)
+        st = ps_png_write(&r.image, o->c.out_png, (float)o->c.exposure, err);
+    if (st == PS_OK && o->c.dump)
+        st = ps_write_photon_dump(o->c.dump, r.maps, err);
     if (st == PS_OK && o->c.stats)
         st = ps_stats_write(o->c.stats, &rs, err);
     if (st == PS_OK) {
@@ -362,10 +376,25 @@ int main(int argc, char **argv)
         fputs(usage, stdout);
         return PS_EXIT_OK;
     }
+    if (ps_check_outputs(&o.c, &err) != PS_OK)
+        return ps_cli_fail(&err);
+    o.cancel = ps_interrupt_install();
     ps_scene *scene;
     if (ps_scene_load(o.c.scene, NULL, &scene, &err) != PS_OK)
         return ps_cli_fail(&err);
-    ps_status st = run(&o, scene, &err);
+    /* Refuse what would not fit before tracing a photon. */
+    const ps_scene_defaults *def = ps_scene_get_defaults(scene);
+    uint64_t photons = ps_shared_photons(&o.c, def, PS_MAP_CAUSTIC) + ps_shared_photons(&o.c, def, PS_MAP_GLOBAL);
+    if (o.gather > 0 && !o.photons_only)
+        photons += ps_shared_photons(&o.c, def, PS_MAP_GLOBAL); /* the map with direct hits */
+    int width = o.photons_only ? 0 : o.c.width ? o.c.width : def->width;
+    int height = o.photons_only ? 0 : o.c.height ? o.c.height : def->height;
+    ps_status st = ps_check_run_memory("photosplat-ref", photons, PS_PHOTON_PLAN_BYTES, width, height,
+                                       REF_PIXEL_BYTES, &err);
+    if (st == PS_OK)
+        st = run(&o, scene, &err);
     ps_scene_destroy(scene);
+    if (st == PS_ERR_INTERRUPTED)
+        return ps_interrupt_fail("photosplat-ref", &err);
     return st == PS_OK ? PS_EXIT_OK : ps_cli_fail(&err);
 }

@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "app/cli.h"
+#include "app/interrupt.h"
 #include "app/options.h"
 #include "app/stats.h"
 #include "core/fileio.h"
@@ -78,7 +79,12 @@ typedef struct snap_options {
     const char *checkpoint_prefix;
     double checkpoints[SNAP_MAX_CHECKPOINTS]; /* ascending */
     int checkpoint_count;
+    const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM */
 } snap_options;
+
+/* The memory plan (ps_check_run_memory): a pixel, besides the colour buffer,
+ * is OSMesa's 24-bit depth + 8-bit stencil, the float read-back and the image. */
+#define SNAP_PIXEL_BYTES (4 + 2 * 3 * sizeof(float))
 
 /* "0.1,0.5,2": ascending times within --time's range. */
 static ps_status parse_checkpoints(const char *text, snap_options *o, ps_error *err)
@@ -375,6 +381,8 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     ps_tracer_options topt = ps_tracer_default_options();
     topt.seed = (uint64_t)o->c.seed;
     topt.threads = (int)o->c.threads;
+    topt.cancel = o->cancel;
+    topt.max_stored = ps_photon_cap(PS_PREVIEW_MAPS, PS_PREVIEW_PHOTON_BYTES);
     if (st == PS_OK)
         st = ps_tracer_create(world, &topt, &tracer, err);
     ps_mesh_options mopt = ps_mesh_default_options(scene);
@@ -432,6 +440,11 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
         int cp = 0;
         while (st == PS_OK) {
+            if (ps_cancelled(o->cancel)) {
+                st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.1f s of %.1f s",
+                                  ps_now_seconds() - t_start, o->time);
+                break;
+            }
             double t = ps_now_seconds();
             double until = next < end ? next : end;
             if (cp < o->checkpoint_count && t_start + excluded + o->checkpoints[cp] < until)
@@ -493,6 +506,11 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
         if (st == PS_OK && o->checkpoint_count > 0)
             st = write_checkpoint_csv(o, rows, o->checkpoint_count, err);
     }
+    if (st == PS_OK && ps_cancelled(o->cancel) && o->time > 0.0)
+        st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.1f s of %.1f s", ps_now_seconds() - t_start,
+                          o->time);
+    else if (st == PS_OK && ps_cancelled(o->cancel))
+        st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted before writing the snapshot");
     if (st == PS_OK && (o->c.out_png || o->c.out_hdr || o->hdr_layers))
         st = write_outputs(&s, err);
     if (st == PS_OK && o->c.dump)
@@ -559,6 +577,26 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     return st;
 }
 
+/* The layer and checkpoint files, checked before any work like the others
+ * (one name of each kind stands for all: they share a folder). */
+static ps_status check_prefixed_outputs(const snap_options *o, ps_error *err)
+{
+    char path[PATH_MAX];
+    if (o->hdr_layers) {
+        if (snprintf(path, sizeof path, "%s-direct.pfm", o->hdr_layers) >= (int)sizeof path)
+            return ps_error_set(err, PS_ERR_IO, "%s: path too long", o->hdr_layers);
+        if (ps_check_output_path(path, err) != PS_OK)
+            return err->status;
+    }
+    if (o->checkpoint_prefix) {
+        if (snprintf(path, sizeof path, "%s.csv", o->checkpoint_prefix) >= (int)sizeof path)
+            return ps_error_set(err, PS_ERR_IO, "%s: path too long", o->checkpoint_prefix);
+        if (ps_check_output_path(path, err) != PS_OK)
+            return err->status;
+    }
+    return PS_OK;
+}
+
 int main(int argc, char **argv)
 {
     ps_error err;
@@ -571,11 +609,22 @@ int main(int argc, char **argv)
         fputs(usage, stdout);
         return PS_EXIT_OK;
     }
+    if (ps_check_outputs(&o.c, &err) != PS_OK || check_prefixed_outputs(&o, &err) != PS_OK)
+        return ps_cli_fail(&err);
+    o.cancel = ps_interrupt_install();
     ps_scene *scene;
     if (ps_scene_load(o.c.scene, NULL, &scene, &err) != PS_OK)
         return ps_cli_fail(&err);
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
     int width = o.c.width ? o.c.width : def->width, height = o.c.height ? o.c.height : def->height;
+    /* Refuse what would not fit before the buffer or a photon. */
+    uint64_t photons = ps_shared_photons(&o.c, def, PS_MAP_CAUSTIC) + ps_shared_photons(&o.c, def, PS_MAP_GLOBAL);
+    uint64_t pixel_bytes = SNAP_PIXEL_BYTES + 4 * (o.p.color_depth == 0 ? 1 : sizeof(float));
+    if (ps_check_run_memory("photosplat-snap", photons, PS_PREVIEW_PHOTON_BYTES, width, height, pixel_bytes, &err) !=
+        PS_OK) {
+        ps_scene_destroy(scene);
+        return ps_cli_fail(&err);
+    }
     /* RGBA, 24-bit depth, 8-bit stencil, no accumulation buffer (platform
      * notes: it wraps above 1.0 and is no place for photon sums). */
     OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
@@ -592,5 +641,7 @@ int main(int argc, char **argv)
         OSMesaDestroyContext(ctx);
     free(buffer);
     ps_scene_destroy(scene);
+    if (st == PS_ERR_INTERRUPTED)
+        return ps_interrupt_fail("photosplat-snap", &err);
     return st == PS_OK ? PS_EXIT_OK : ps_cli_fail(&err);
 }

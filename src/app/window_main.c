@@ -14,6 +14,8 @@
 #include <time.h>
 
 #include "app/cli.h"
+#include "app/interrupt.h"
+#include "core/fileio.h"
 #include "app/options.h"
 #include "app/stats.h"
 #include "gl/gl_font.h"
@@ -31,6 +33,9 @@
 /* Shadow maps are remade after every light move: half the snapshot's side,
  * a quarter of the fill, for a refresh soon after the move. */
 #define WIN_SHADOW_SIZE 512
+/* The memory plan (ps_check_run_memory): a pixel is the 8-bit picture, its
+ * float copy, the float splat layers and the window's own colour and depth. */
+#define WIN_PIXEL_BYTES (3 + 3 * sizeof(float) + 3 * 3 * sizeof(float) + 4 + 4)
 /* Camera controls, as in Blender: degrees of orbit per pixel dragged, the
  * dolly factor per wheel notch, pan in units of the target distance per pixel. */
 #define ORBIT_DEG_PER_PIXEL 0.4
@@ -125,6 +130,7 @@ typedef struct win_options {
     const char *script;
     int overlay;
     int64_t max_photons; /* stored photons of both maps; 0: no bound */
+    const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM: the session ends */
 } win_options;
 
 typedef struct app {
@@ -268,6 +274,8 @@ static ps_status rebuild(app *a, bool geometry, ps_error *err)
     /* One core is left to drawing (llvmpipe draws on the CPU too): with every
      * core tracing, the picture after a light move took four times as long. */
     to.threads = a->o.c.threads > 0 ? (int)a->o.c.threads : (ps_online_cores() > 1 ? ps_online_cores() - 1 : 1);
+    to.cancel = a->o.cancel;
+    to.max_stored = ps_photon_cap(PS_PREVIEW_MAPS, PS_PREVIEW_PHOTON_BYTES);
     if (st == PS_OK)
         st = ps_tracer_create(a->world, &to, &a->tracer, err);
     bool active[PS_MAP_COUNT];
@@ -1045,6 +1053,10 @@ static ps_status session(app *a, ps_error *err)
     a->awaiting_edit_frame = true;
     double next = 0.0;
     while (st == PS_OK && !a->quit && !glfwWindowShouldClose(a->win)) {
+        if (ps_cancelled(a->o.cancel)) {
+            st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %llu frames", (unsigned long long)a->frames);
+            break;
+        }
         double now = glfwGetTime();
         if (now < next && !a->view_dirty && !a->scene_dirty)
             glfwWaitEventsTimeout(next - now);
@@ -1161,11 +1173,28 @@ int main(int argc, char **argv)
     /* Bad input is refused before a window opens. */
     if (a.o.script && ps_script_load(a.o.script, &a.script, &err) != PS_OK)
         return ps_cli_fail(&err);
-    if (ps_scene_load(a.o.c.scene, NULL, &a.scene, &err) != PS_OK) {
+    ps_status st = ps_check_outputs(&a.o.c, &err);
+    for (size_t i = 0; st == PS_OK && a.script && i < ps_script_count(a.script); i++) {
+        const ps_script_action *act = ps_script_at(a.script, i);
+        if (act->kind == PS_SCRIPT_SCREENSHOT)
+            st = ps_check_output_path(act->path, &err);
+    }
+    if (st == PS_OK)
+        st = ps_scene_load(a.o.c.scene, NULL, &a.scene, &err);
+    if (st == PS_OK) {
+        const ps_scene_defaults *def = ps_scene_get_defaults(a.scene);
+        uint64_t photons =
+            ps_shared_photons(&a.o.c, def, PS_MAP_CAUSTIC) + ps_shared_photons(&a.o.c, def, PS_MAP_GLOBAL);
+        st = ps_check_run_memory("photosplat", photons, PS_PREVIEW_PHOTON_BYTES, a.o.c.width ? a.o.c.width : def->width,
+                                 a.o.c.height ? a.o.c.height : def->height, WIN_PIXEL_BYTES, &err);
+    }
+    if (st != PS_OK) {
         ps_script_destroy(a.script);
+        ps_scene_destroy(a.scene);
         return ps_cli_fail(&err);
     }
-    ps_status st = session(&a, &err);
+    a.o.cancel = ps_interrupt_install();
+    st = session(&a, &err);
     if (st == PS_OK && a.o.c.stats)
         st = write_stats(&a, &err);
     teardown_maps(&a);
@@ -1185,5 +1214,9 @@ int main(int argc, char **argv)
     ps_scene_destroy(a.scene);
     if (st == PS_OK)
         printf("photosplat: %llu frames, %llu edits\n", (unsigned long long)a.frames, (unsigned long long)a.edits);
+    if (st == PS_ERR_INTERRUPTED) { /* screenshots already taken stay; the stats are not written */
+        fprintf(stderr, "photosplat: %s\n", err.msg);
+        return ps_interrupt_exit_status();
+    }
     return st == PS_OK ? PS_EXIT_OK : ps_cli_fail(&err);
 }

@@ -4,6 +4,7 @@
 #include "core/fileio.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <stdbool.h>
 #include <stdlib.h>
@@ -17,6 +18,36 @@ struct ps_outfile {
     char *target; /* the file renamed over (path with links resolved); NULL when writing straight to a device */
     char *tmp;
 };
+
+/* A device or FIFO for writing. A FIFO without a reader would block open(2)
+ * for ever; O_NONBLOCK makes that fail at once (ENXIO), then writes block as
+ * usual. */
+static FILE *open_special(const char *path)
+{
+    int fd = open(path, O_WRONLY | O_NONBLOCK);
+    if (fd < 0)
+        return NULL;
+    int flags = fcntl(fd, F_GETFL);
+    FILE *fp = flags >= 0 && fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) == 0 ? fdopen(fd, "wb") : NULL;
+    if (!fp) {
+        int saved = errno;
+        close(fd);
+        errno = saved;
+    }
+    return fp;
+}
+
+ps_status ps_check_output_path(const char *path, ps_error *err)
+{
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
+        return PS_OK; /* a device or pipe: opened when written */
+    ps_outfile *f = ps_outfile_open(path, err);
+    if (!f)
+        return err ? err->status : PS_ERR_IO;
+    ps_outfile_abort(f);
+    return PS_OK;
+}
 
 ps_outfile *ps_outfile_open(const char *path, ps_error *err)
 {
@@ -36,7 +67,7 @@ ps_outfile *ps_outfile_open(const char *path, ps_error *err)
         /* A device, FIFO or terminal (/dev/stdout, a pipe): write straight to
          * it. Renaming a file over it would replace the device node itself. */
         f->path = strdup(path);
-        f->fp = f->path ? fopen(path, "wb") : NULL;
+        f->fp = f->path ? open_special(path) : NULL;
         if (!f->fp) {
             ps_error_set(err, PS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
             ps_outfile_abort(f);
@@ -216,10 +247,12 @@ ps_status ps_text_lines(const char *text, const char *name, size_t max_len, ps_l
     if (!buf)
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", name);
     ps_status st = PS_OK;
-    const char *at = text;
-    while (st == PS_OK && *at) {
-        const char *nl = strchr(at, '\n');
-        size_t n = nl ? (size_t)(nl - at) : strlen(at);
+    /* memchr over the known rest, not strchr: ASan's strict string checks
+     * make every strchr scan to the terminating NUL, quadratic in a long file. */
+    const char *at = text, *end = text + strlen(text);
+    while (st == PS_OK && at < end) {
+        const char *nl = memchr(at, '\n', (size_t)(end - at));
+        size_t n = nl ? (size_t)(nl - at) : (size_t)(end - at);
         (*line)++;
         if (n > max_len) {
             st = ps_error_set(err, PS_ERR_PARSE, "%s:%d: line longer than %zu characters", name, *line, max_len);

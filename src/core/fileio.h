@@ -22,6 +22,12 @@ ps_status ps_outfile_commit(ps_outfile *f, ps_error *err);
 /* Discards the temporary file and frees f (f may be NULL). */
 void ps_outfile_abort(ps_outfile *f);
 
+/* Checks, before any work, that an output file can be made at `path`: not a
+ * directory, its directory exists and takes a new file (a temporary file is
+ * created there and removed again). A device or FIFO passes unopened. The
+ * message is the one ps_outfile_open would give. */
+ps_status ps_check_output_path(const char *path, ps_error *err);
+
 /* Checks that `path` names a readable regular file (not a directory, device or
  * FIFO, which would make a reader hang or fail obscurely). */
 ps_status ps_check_input_file(const char *path, ps_error *err);

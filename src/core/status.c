@@ -45,6 +45,7 @@ const char *ps_status_name(ps_status status)
     case PS_ERR_RANGE: return "value out of range";
     case PS_ERR_LIMIT: return "too large";
     case PS_ERR_NOMEM: return "out of memory";
+    case PS_ERR_INTERRUPTED: return "interrupted";
     }
     return "unknown error";
 }

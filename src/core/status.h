@@ -13,7 +13,8 @@ typedef enum ps_status {
     PS_ERR_FORMAT, /* binary input is malformed or unsupported (PNG, PFM) */
     PS_ERR_RANGE,  /* a value is well formed but outside what it may be */
     PS_ERR_LIMIT,  /* input is valid but too large for this machine or program */
-    PS_ERR_NOMEM   /* an allocation failed */
+    PS_ERR_NOMEM,  /* an allocation failed */
+    PS_ERR_INTERRUPTED /* the caller's cancel flag was raised (a signal): work stopped early */
 } ps_status;
 
 /* Long enough for a path plus a sentence; longer messages are truncated. */

@@ -2,9 +2,11 @@
 #include "gl/gl_render.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/memory.h"
 #include "core/sampling.h"
 #include "scene/tessellate.h"
 #include "gl/gl_api.h"
@@ -37,6 +39,12 @@
 /* Blinn's (n.h)^s is about Phong's cos^e(alpha) when s = 4e; GL caps s at 128. */
 #define BLINN_PER_PHONG 4.0
 #define GL_MAX_SHININESS 128.0
+
+/* The memory plan of the lights: a shadow texel (24-bit depth, stored in
+ * 32 bits), and a sphere light's mesh triangle (half a vertex of double
+ * position and normal, three 32-bit indices). */
+#define GL_SHADOW_TEXEL_BYTES 4
+#define GL_SPHERE_TRIANGLE_BYTES (24 + 3 * 4)
 
 /* A GL light: a scene light, or one virtual point light of an area light. */
 typedef struct vlight {
@@ -280,6 +288,23 @@ static ps_status build_lights(ps_gl_renderer *r, ps_error *err)
     size_t spheres = 0;
     for (size_t l = 0; l < n; l++)
         spheres += lights[l].type == PS_LIGHT_SPHERE;
+    /* Shadow maps (a depth texture per lit cube face of every virtual light)
+     * and sphere-light meshes: thousands of lights would not fit, so they
+     * are refused here rather than failing inside the GL driver. */
+    uint64_t faces = 0;
+    for (size_t i = 0; r->opt.shadows && i < r->light_count; i++)
+        for (unsigned m = r->lights[i].faces; m; m &= m - 1)
+            faces++;
+    uint64_t texels = (uint64_t)r->shadow_size * (uint64_t)r->shadow_size;
+    uint64_t bytes = ps_memory_mul(faces, ps_memory_mul(texels, GL_SHADOW_TEXEL_BYTES)) +
+                     ps_memory_mul(spheres, ps_memory_mul(ps_sphere_triangle_count(PS_SPHERE_DEFAULT_TOLERANCE),
+                                                          GL_SPHERE_TRIANGLE_BYTES));
+    char what[128];
+    snprintf(what, sizeof what, "%zu lights (%zu GL lights, %llu shadow maps of %dx%d)", n, r->light_count,
+             (unsigned long long)faces, r->shadow_size, r->shadow_size);
+    ps_status cst = ps_memory_check(bytes, ps_scene_path(r->scene), what, err);
+    if (cst != PS_OK)
+        return cst;
     r->sphere_lights = spheres ? calloc(spheres, sizeof *r->sphere_lights) : NULL;
     if (spheres && !r->sphere_lights)
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for GL lights", ps_scene_path(r->scene));

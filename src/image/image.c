@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/fileio.h"
+#include "core/memory.h"
 
 /* IEC 61966-2-1 constants. The encode threshold 0.0031308 and the decode
  * threshold 0.04045 are the standard's; they meet at 0.0031308·12.92 =
@@ -40,7 +41,9 @@ ps_status ps_image_check_size(int64_t w, int64_t h, ps_error *err)
     if ((uint64_t)(w * h) > SIZE_MAX / (3 * sizeof(float)))
         return ps_error_set(err, PS_ERR_LIMIT, "image is %lldx%lld, too large for this machine's address space",
                             (long long)w, (long long)h);
-    return PS_OK;
+    char what[64];
+    snprintf(what, sizeof what, "image is %lldx%lld: it", (long long)w, (long long)h);
+    return ps_memory_check((uint64_t)(w * h) * PS_IMAGE_PLAN_PIXEL_BYTES, NULL, what, err);
 }
 
 ps_status ps_image_create(int w, int h, ps_image *out, ps_error *err)

@@ -25,7 +25,11 @@ typedef struct ps_image {
     float *rgb;
 } ps_image;
 
-/* PS_OK when a w x h image is within the limits below; otherwise PS_ERR_LIMIT
+/* What one pixel is planned at against the memory budget (core/memory.h):
+ * the float image, and a reader's decoded copy of up to 16-bit RGBA. */
+#define PS_IMAGE_PLAN_PIXEL_BYTES (3 * sizeof(float) + 4 * sizeof(uint16_t))
+
+/* PS_OK when a w x h image is within the limits below and the memory budget; otherwise PS_ERR_LIMIT
  * with a message without a file name ("image is WxH, ..."), which readers
  * prefix with theirs. Takes 64-bit sides so that readers can check header
  * values before narrowing them. */

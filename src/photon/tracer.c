@@ -593,12 +593,19 @@ typedef struct trace_job {
     size_t chunks;
     chunk_out *outs;
     atomic_size_t next;
+    atomic_size_t done;           /* chunks traced to the end */
+    atomic_uint_least64_t stored; /* photons the chunks hold so far */
+    uint64_t room;                /* how many more the map may take (max_stored) */
+    atomic_bool over;             /* stored would pass room: every worker stops */
 } trace_job;
 
 static void *worker(void *arg)
 {
     trace_job *job = arg;
     for (;;) {
+        /* Stop between chunks when asked to, or when the map is full. */
+        if (ps_cancelled(job->t->opt.cancel) || atomic_load(&job->over))
+            return NULL;
         size_t k = atomic_fetch_add(&job->next, 1);
         if (k >= job->chunks)
             return NULL;
@@ -608,6 +615,10 @@ static void *worker(void *arg)
             hi = job->first + job->count;
         for (uint64_t i = lo; i < hi && !job->outs[k].failed; i++)
             trace_photon(job->t, job->kind, i, &job->outs[k]);
+        uint64_t stored = atomic_fetch_add(&job->stored, job->outs[k].count) + job->outs[k].count;
+        if (job->room && stored > job->room)
+            atomic_store(&job->over, true);
+        atomic_fetch_add(&job->done, 1);
     }
 }
 
@@ -631,6 +642,15 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
     job.count = count;
     job.chunks = (size_t)((count + PS_PHOTON_CHUNK - 1) / PS_PHOTON_CHUNK);
     atomic_init(&job.next, 0);
+    atomic_init(&job.done, 0);
+    atomic_init(&job.stored, 0);
+    atomic_init(&job.over, false);
+    uint64_t max_stored = t->opt.max_stored;
+    if (max_stored && m->count >= max_stored)
+        return ps_error_set(err, PS_ERR_LIMIT,
+                            "%s: the %s photon map is full: %llu photons, the most the memory budget allows", path,
+                            ps_map_name(kind), (unsigned long long)m->count);
+    job.room = max_stored ? max_stored - m->count : 0;
     job.outs = calloc(job.chunks, sizeof *job.outs);
     if (!job.outs)
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory tracing %llu photons", path, (unsigned long long)count);
@@ -647,8 +667,15 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
 
     /* Join the chunks in index order: the array never depends on who traced what. */
     ps_status st = PS_OK;
-    size_t need = m->count;
-    for (size_t k = 0; k < job.chunks; k++) {
+    size_t need = m->count, done = atomic_load(&job.done);
+    if (atomic_load(&job.over))
+        st = ps_error_set(err, PS_ERR_LIMIT,
+                          "%s: the %s photon map would hold more than %llu photons, the most the memory budget allows",
+                          path, ps_map_name(kind), (unsigned long long)max_stored);
+    else if (done < job.chunks)
+        st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.0f %% of the %s photons",
+                          100.0 * ((double)first + (double)done * PS_PHOTON_CHUNK) / (double)total, ps_map_name(kind));
+    for (size_t k = 0; k < job.chunks && st == PS_OK; k++) {
         if (job.outs[k].failed)
             st = PS_ERR_NOMEM;
         need += job.outs[k].count;
@@ -669,9 +696,9 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
         free(job.outs[k].objects);
     }
     free(job.outs);
-    if (st != PS_OK)
+    if (st == PS_ERR_NOMEM)
         return ps_error_set(err, st, "%s: out of memory storing photons", path);
-    return PS_OK;
+    return st;
 }
 
 void ps_photon_map_write_text(FILE *f, const ps_photon_map *m)

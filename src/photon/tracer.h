@@ -20,6 +20,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "core/cancel.h"
 #include "core/status.h"
 #include "photon/photon.h"
 #include "photon/world.h"
@@ -43,7 +44,16 @@ typedef struct ps_tracer_options {
                           * Jensen's global map does (default false: the preview draws
                           * direct light itself). The reference renderer's precomputed
                           * irradiance for final gathering needs all of the light. */
+    const ps_cancel_flag *cancel; /* NULL, or a flag that stops a trace between chunks
+                                   * (PS_ERR_INTERRUPTED, the map left as it was) */
+    uint64_t max_stored;          /* 0, or the most photons a map may hold: a trace that
+                                   * would store more stops (PS_ERR_LIMIT, the map left as
+                                   * it was) before the map grows past it */
 } ps_tracer_options;
+
+/* Bytes a stored photon takes in a map: the 20-byte record and the material
+ * and object beside it. While a trace's chunks are joined they exist twice. */
+#define PS_PHOTON_MAP_BYTES (sizeof(ps_photon) + sizeof(uint16_t) + sizeof(uint32_t))
 
 /* Online cores, at least 1 and at most PS_TRACER_MAX_THREADS: the default
  * thread count. */

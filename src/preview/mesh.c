@@ -2,10 +2,12 @@
 #include "preview/mesh.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/array.h"
+#include "core/memory.h"
 #include "scene/tessellate.h"
 
 /* The default: a 64th of the scene's diagonal keeps Gouraud lighting of a
@@ -33,6 +35,39 @@ static bool reserve(builder *b, size_t vertices)
     if (need > SIZE_MAX / 3)
         return false;
     return PS_RESERVE(b->m->positions, b->cap_pos, 3 * need) && PS_RESERVE(b->m->normals, b->cap_nrm, 3 * need);
+}
+
+/* How many pieces add_triangle cuts each side of a triangle into. */
+static int split_count(const ps_vec3 p[3], double max_edge)
+{
+    double longest = fmax(ps_v3_len(ps_v3_sub(p[1], p[0])),
+                          fmax(ps_v3_len(ps_v3_sub(p[2], p[1])), ps_v3_len(ps_v3_sub(p[0], p[2]))));
+    double want = ceil(longest / max_edge);
+    return !(want >= 1.0) ? 1 : want > PS_MESH_MAX_SPLIT ? PS_MESH_MAX_SPLIT : (int)want;
+}
+
+/* The vertices the mesh will have, counted before anything is allocated
+ * (a room of huge quads or a million spheres must be refused, not built). */
+static uint64_t count_vertices(const ps_scene *s, const ps_mesh_options *o, double max_edge)
+{
+    size_t nobj, ntri, npos;
+    const ps_object *objects = ps_scene_objects(s, &nobj);
+    const ps_triangle *tris = ps_scene_triangles(s, &ntri);
+    const ps_vec3 *pos = ps_scene_positions(s, &npos);
+    uint64_t n = 0;
+    for (size_t i = 0; i < nobj; i++) {
+        const ps_object *obj = &objects[i];
+        if (obj->type == PS_OBJ_SPHERE) {
+            n += 3 * (uint64_t)ps_sphere_triangle_count(o->sphere_tolerance);
+            continue;
+        }
+        for (uint32_t t = obj->first_triangle; t < obj->first_triangle + obj->triangle_count; t++) {
+            ps_vec3 p[3] = {pos[tris[t].v[0]], pos[tris[t].v[1]], pos[tris[t].v[2]]};
+            uint64_t split = (uint64_t)split_count(p, max_edge);
+            n += 3 * split * split;
+        }
+    }
+    return n;
 }
 
 static void put(builder *b, ps_vec3 p, ps_vec3 n)
@@ -79,10 +114,7 @@ static void corner(const ps_vec3 p[3], const ps_vec3 n[3], double a, double c, p
 /* Cuts triangle (p, n) into split^2 similar triangles, same winding. */
 static bool add_triangle(builder *b, const ps_vec3 p[3], const ps_vec3 n[3], double max_edge)
 {
-    double longest = fmax(ps_v3_len(ps_v3_sub(p[1], p[0])),
-                          fmax(ps_v3_len(ps_v3_sub(p[2], p[1])), ps_v3_len(ps_v3_sub(p[0], p[2]))));
-    double want = ceil(longest / max_edge);
-    int split = !(want >= 1.0) ? 1 : want > PS_MESH_MAX_SPLIT ? PS_MESH_MAX_SPLIT : (int)want;
+    int split = split_count(p, max_edge);
     if (!reserve(b, 3 * (size_t)split * (size_t)split))
         return false;
     double inv = 1.0 / split;
@@ -134,7 +166,12 @@ ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_
     const ps_vec3 *pos = ps_scene_positions(s, &npos);
     const ps_vec3 *nrm = ps_scene_normals(s, &nnrm);
     double max_edge = o->max_edge > 0.0 ? o->max_edge : 1.0;
-    ps_status st = PS_OK;
+    uint64_t vertices = count_vertices(s, o, max_edge);
+    char what[96];
+    snprintf(what, sizeof what, "the preview mesh of %llu triangles", (unsigned long long)(vertices / 3));
+    ps_status st = ps_memory_check(ps_memory_mul(vertices, PS_MESH_PLAN_VERTEX_BYTES), ps_scene_path(s), what, err);
+    if (st != PS_OK)
+        return st;
     for (size_t i = 0; i < nobj && st == PS_OK; i++) {
         const ps_object *obj = &objects[i];
         if (obj->type == PS_OBJ_SPHERE) {

@@ -21,6 +21,10 @@
 /* Subdivision stops here whatever max_edge asks: 2 * 256^2 triangles a face. */
 #define PS_MESH_MAX_SPLIT 256
 
+/* What a vertex is planned at against the memory budget: its float position
+ * and normal, twice (the arrays grow by doubling). */
+#define PS_MESH_PLAN_VERTEX_BYTES (2 * 6 * sizeof(float))
+
 /* A run of triangles of one object and one material. */
 typedef struct ps_mesh_range {
     uint32_t object, material;
@@ -44,6 +48,8 @@ typedef struct ps_mesh_options {
  * tessellation default. */
 ps_mesh_options ps_mesh_default_options(const ps_scene *s);
 
+/* Refuses (PS_ERR_LIMIT) a mesh that would not fit in the memory budget
+ * (core/memory.h), counted before anything is allocated. */
 ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_preview_mesh *out, ps_error *err);
 void ps_preview_mesh_free(ps_preview_mesh *m); /* and zero it; accepts a zeroed one */
 

@@ -238,7 +238,7 @@ static void *cache_worker(void *arg)
     worker *wk = arg;
     render_job *job = wk->job;
     int n = job->cache_w * job->cache_h;
-    for (int i; (i = atomic_fetch_add(&job->next_record, 1)) < n;)
+    for (int i; !ps_cancelled(job->o->cancel) && (i = atomic_fetch_add(&job->next_record, 1)) < n;)
         cache_record(wk, i);
     return NULL;
 }
@@ -454,7 +454,9 @@ static ps_rgb radiance(worker *wk, ps_ray r, int depth, bool through, uint64_t k
 
 /* ---- pixels, tiles, threads ---------------------------------------------- */
 
-static void render_tile(worker *wk, int tile)
+/* Renders one tile; false when the cancel flag stopped it partway (checked
+ * every row, so that a tile of many samples still stops within moments). */
+static bool render_tile(worker *wk, int tile)
 {
     render_job *job = wk->job;
     const ps_render_options *o = job->o;
@@ -466,7 +468,9 @@ static void render_tile(worker *wk, int tile)
     while (o->spp % sx)
         sx--;
     int sy = o->spp / sx;
-    for (int y = y0; y < y1; y++)
+    for (int y = y0; y < y1; y++) {
+        if (ps_cancelled(o->cancel))
+            return false;
         for (int x = x0; x < x1; x++) {
             ps_rng rng = ps_rng_make(o->seed, PS_STREAM_PIXEL, (uint64_t)y * (uint64_t)o->width + (uint64_t)x);
             ps_rgb sum = ps_rgb_gray(0.0);
@@ -485,6 +489,8 @@ static void render_tile(worker *wk, int tile)
             dst[1] = (float)(sum.g / o->spp);
             dst[2] = (float)(sum.b / o->spp);
         }
+    }
+    return true;
 }
 
 /* Takes tiles until none are left. The calling thread's worker (`reports`)
@@ -494,10 +500,13 @@ static void *render_worker(void *arg)
     worker *wk = arg;
     render_job *job = wk->job;
     for (;;) {
+        if (ps_cancelled(job->o->cancel))
+            break; /* between tiles: every finished tile is whole */
         int t = atomic_fetch_add(&job->next_tile, 1);
         if (t >= job->tiles)
             break;
-        render_tile(wk, t);
+        if (!render_tile(wk, t))
+            break;
         int done = atomic_fetch_add(&job->done_tiles, 1) + 1;
         if (wk->reports && job->o->progress)
             job->o->progress(job->o->progress_user, (double)done / job->tiles);
@@ -584,9 +593,16 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     for (int i = 0; i < threads; i++)
         free(wk[i].scratch);
     free(job.cache);
+    int done = atomic_load(&job.done_tiles);
     if (stats) {
         stats->rays = atomic_load(&job.rays);
         stats->seconds = now() - t0;
+        stats->fraction = (double)done / job.tiles;
+    }
+    if (done < job.tiles) { /* only the cancel flag stops workers early */
+        ps_image_destroy(out);
+        return ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.0f %% of the image",
+                            100.0 * done / job.tiles);
     }
     return PS_OK;
 }

@@ -14,6 +14,7 @@
 
 #include <stdint.h>
 
+#include "core/cancel.h"
 #include "core/status.h"
 #include "image/image.h"
 #include "photon/emit.h"
@@ -75,11 +76,15 @@ typedef struct ps_render_options {
     /* Called now and then from one thread with the fraction done (may be NULL). */
     void (*progress)(void *user, double fraction);
     void *progress_user;
+    /* NULL, or a flag that stops the render between tiles: PS_ERR_INTERRUPTED,
+     * *out destroyed, stats->fraction the part finished. */
+    const ps_cancel_flag *cancel;
 } ps_render_options;
 
 typedef struct ps_render_stats {
     uint64_t rays;
     double seconds;
+    double fraction; /* of the tiles finished: 1 unless interrupted */
 } ps_render_stats;
 
 /* Renders the image into out (created here; the caller destroys it). Pixel

@@ -8,7 +8,9 @@
 
 #include "core/array.h"
 #include "core/fileio.h"
+#include "core/memory.h"
 #include "core/number.h"
+#include "scene/scene.h"
 
 /* Larger files are refused before reading: 1 GiB of OBJ text is ~20 M triangles,
  * far past what the interactive preview is for. */
@@ -69,14 +71,18 @@ static int split(char *s, char **tok, int max)
  * next line, or NULL at the end. */
 static const char *next_line(const char *at, char *dst, size_t dst_size, bool *too_long)
 {
-    const char *nl = strchr(at, '\n');
-    size_t n = nl ? (size_t)(nl - at) : strlen(at);
+    /* A plain loop, not strchr: ASan's strict string checks make each strchr
+     * scan to the end of the file, quadratic in its length. */
+    const char *e = at;
+    while (*e && *e != '\n')
+        e++;
+    size_t n = (size_t)(e - at);
     *too_long = n >= dst_size;
     if (*too_long)
         n = dst_size - 1;
     memcpy(dst, at, n);
     dst[n] = '\0';
-    return nl ? nl + 1 : (*at ? at + strlen(at) : NULL);
+    return *e ? e + 1 : (*at ? e : NULL);
 }
 
 static ps_status check_numbers(const char *path, int line, char **tok, int ntok, int min, int max,
@@ -361,6 +367,15 @@ ps_status ps_obj_load(const char *path, ps_obj_mesh *out, const ps_warn_sink *wa
         st = scan_obj(&ps, text);
     if (st == PS_OK && ps.faces == 0)
         st = ps_error_set(err, PS_ERR_PARSE, "%s: no faces: not a mesh (empty file, or not an OBJ file?)", path);
+    /* Before tinyobjloader copies it all: every face is at least a triangle. */
+    if (st == PS_OK && ps.faces > PS_SCENE_MAX_TRIANGLES)
+        st = ps_error_set(err, PS_ERR_LIMIT, "%s: %zu faces, more than the limit of %d triangles", path, ps.faces,
+                          PS_SCENE_MAX_TRIANGLES);
+    if (st == PS_OK) {
+        char what[64];
+        snprintf(what, sizeof what, "%zu faces", ps.faces);
+        st = ps_memory_check((uint64_t)ps.faces * PS_SCENE_PLAN_TRIANGLE_BYTES, path, what, err);
+    }
     if (st == PS_OK) {
         char msg[512];
         if (ps_tinyobj_parse(text, len, ps.mtl_text ? ps.mtl_text : "", ps.mtl_len, out, msg, sizeof msg) != 0)

@@ -27,6 +27,12 @@
  * power ends at 2^127 W (about 1.7e38), and three channels of more than
  * about 1e308 W no longer add up to a finite total. */
 #define PS_SCENE_MAX_LIGHT_POWER 1e30
+/* What a triangle is planned at against the memory budget (core/memory.h):
+ * the scene's soup, the OBJ reader's text and copies, the ray accelerator
+ * and the preview's mesh. Measured: 470 bytes a triangle at the peak of
+ * photosplat-snap on a 980 000-triangle OBJ (320 for photosplat-ref). So
+ * PS_SCENE_MAX_TRIANGLES fit only on a machine with about 32 GiB. */
+#define PS_SCENE_PLAN_TRIANGLE_BYTES 512
 
 typedef struct ps_camera {
     ps_vec3 eye, target, up; /* up need not be orthogonal to the view direction */

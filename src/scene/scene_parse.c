@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/fileio.h"
+#include "core/memory.h"
 #include "core/number.h"
 #include "core/transform.h"
 #include "scene/obj.h"
@@ -387,6 +388,12 @@ static ps_status reserve_geometry(parser *p, size_t positions, size_t normals, s
     if (s->triangles.count + triangles > PS_SCENE_MAX_TRIANGLES)
         return ps_error_set(p->err, PS_ERR_LIMIT, "%s:%d: the scene would have more than %d triangles", p->name,
                             p->line, PS_SCENE_MAX_TRIANGLES);
+    char who[PS_ERROR_MSG_MAX / 2], what[64];
+    snprintf(who, sizeof who, "%s:%d", p->name, p->line);
+    snprintf(what, sizeof what, "a scene of %zu triangles", s->triangles.count + triangles);
+    if (ps_memory_check((uint64_t)(s->triangles.count + triangles) * PS_SCENE_PLAN_TRIANGLE_BYTES, who, what,
+                        p->err) != PS_OK)
+        return PS_ERR_LIMIT;
     if (!PS_RESERVE(s->positions.items, s->positions.cap, s->positions.count + positions) ||
         !PS_RESERVE(s->normals.items, s->normals.cap, s->normals.count + normals) ||
         !PS_RESERVE(s->triangles.items, s->triangles.cap, s->triangles.count + triangles))

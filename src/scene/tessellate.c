@@ -19,22 +19,33 @@ void ps_trimesh_free(ps_trimesh *m)
     memset(m, 0, sizeof *m);
 }
 
+/* Longitude segments for a tolerance in (0, 0.5]. */
+static int sphere_slices(double tolerance)
+{
+    /* A chord spanning angle a lies r(1 - cos(a/2)) inside the sphere. A flat
+     * triangle's centre lies deeper than its edges' midpoints; a quad cell of
+     * angular size a x a is at most about r(1 - cos(a/sqrt2)) deep, so solve
+     * for a with the cell's half-diagonal. */
+    double a = sqrt(2.0) * acos(1.0 - tolerance);
+    double slices = ceil(2.0 * PS_PI / a);
+    return slices < MIN_SLICES ? MIN_SLICES : slices > MAX_SLICES ? MAX_SLICES : (int)slices;
+}
+
+uint32_t ps_sphere_triangle_count(double tolerance)
+{
+    if (!(tolerance > 0.0 && tolerance <= 0.5))
+        return 0;
+    int slices = sphere_slices(tolerance), stacks = (slices + 1) / 2;
+    return 2u * (uint32_t)slices * (uint32_t)(stacks - 1);
+}
+
 ps_status ps_sphere_tessellate(ps_vec3 center, double radius, double tolerance, ps_trimesh *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
     if (!(radius > 0.0) || !(tolerance > 0.0 && tolerance <= 0.5))
         return ps_error_set(err, PS_ERR_RANGE, "sphere tessellation: radius %g or tolerance %g out of range", radius,
                             tolerance);
-    /* A chord spanning angle a lies r(1 - cos(a/2)) inside the sphere. A flat
-     * triangle's centre lies deeper than its edges' midpoints; a quad cell of
-     * angular size a x a is at most about r(1 - cos(a/sqrt2)) deep, so solve
-     * for a with the cell's half-diagonal. */
-    double a = sqrt(2.0) * acos(1.0 - tolerance);
-    int slices = (int)ceil(2.0 * PS_PI / a);
-    if (slices < MIN_SLICES)
-        slices = MIN_SLICES;
-    if (slices > MAX_SLICES)
-        slices = MAX_SLICES;
+    int slices = sphere_slices(tolerance);
     int stacks = (slices + 1) / 2;
     /* Ring vertices of stacks-1 latitude rings, plus the two poles. */
     uint32_t nv = (uint32_t)(stacks - 1) * (uint32_t)slices + 2;

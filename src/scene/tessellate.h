@@ -28,6 +28,10 @@ typedef struct ps_trimesh {
  * mesh is closed and every edge is shared by exactly two triangles. */
 ps_status ps_sphere_tessellate(ps_vec3 center, double radius, double tolerance, ps_trimesh *out, ps_error *err);
 
+/* How many triangles ps_sphere_tessellate makes for this tolerance (0 when
+ * it is out of range): what a caller checks against memory first. */
+uint32_t ps_sphere_triangle_count(double tolerance);
+
 /* Frees and zeroes m (m may be zeroed already). */
 void ps_trimesh_free(ps_trimesh *m);
 
