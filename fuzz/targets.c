@@ -12,7 +12,8 @@
 #include "image/image.h"
 #include "scene/scene.h"
 
-/* Room for a temporary directory and a file name in it. */
+/* Room for a temporary directory, and for it with a file name appended. */
+#define DIR_CAP 3072
 #define PATH_CAP 4096
 /* The PNG signature and a chunk's length, type and CRC fields, in bytes. */
 #define PNG_SIG_BYTES 8
@@ -63,13 +64,13 @@ static void check_warning(void *user, const char *msg)
 /* ---- temporary files ---------------------------------------------------- */
 
 /* A fresh directory under $TMPDIR (or /tmp) for one input's files. */
-static bool make_tmpdir(char dir[PATH_CAP])
+static bool make_tmpdir(char dir[DIR_CAP])
 {
     const char *base = getenv("TMPDIR");
     if (!base || !base[0])
         base = "/tmp";
-    int n = snprintf(dir, PATH_CAP, "%s/psfuzz-XXXXXX", base);
-    return n > 0 && n < PATH_CAP && mkdtemp(dir) != NULL;
+    int n = snprintf(dir, DIR_CAP, "%s/psfuzz-XXXXXX", base);
+    return n > 0 && n < DIR_CAP && mkdtemp(dir) != NULL;
 }
 
 static bool write_file(const char *path, const void *data, size_t size)
@@ -81,10 +82,11 @@ static bool write_file(const char *path, const void *data, size_t size)
     return fclose(fp) == 0 && ok;
 }
 
-/* dir/name into out. */
-static void join(char out[PATH_CAP], const char *dir, const char *name)
+/* dir/name into out; false when it does not fit. */
+static bool join(char out[PATH_CAP], const char dir[DIR_CAP], const char *name)
 {
-    snprintf(out, PATH_CAP, "%s/%s", dir, name);
+    int n = snprintf(out, PATH_CAP, "%s/%s", dir, name);
+    return n > 0 && n < PATH_CAP;
 }
 
 /* A harness that cannot write its scratch files has nothing to test; that is
@@ -168,11 +170,12 @@ static ps_status load_scene(const char *text, const char *file, const char *name
 ps_status ps_fuzz_scene(const uint8_t *data, size_t size, const char *name, const char *base_dir, ps_error *err)
 {
     if (memchr(data, '\0', size)) {
-        char dir[PATH_CAP], path[PATH_CAP];
+        char dir[DIR_CAP], path[PATH_CAP] = "";
         if (!make_tmpdir(dir))
             return no_scratch(err);
-        join(path, dir, "fuzz.scn");
-        ps_status st = write_file(path, data, size) ? load_scene(NULL, path, NULL, NULL, path, err) : no_scratch(err);
+        ps_status st = join(path, dir, "fuzz.scn") && write_file(path, data, size)
+                           ? load_scene(NULL, path, NULL, NULL, path, err)
+                           : no_scratch(err);
         remove(path);
         rmdir(dir);
         return st;
@@ -206,14 +209,11 @@ ps_status ps_fuzz_obj(const uint8_t *data, size_t size, ps_error *err)
             break;
         }
     }
-    char dir[PATH_CAP], obj[PATH_CAP], mtl[PATH_CAP], scn[PATH_CAP];
+    char dir[DIR_CAP], obj[PATH_CAP] = "", mtl[PATH_CAP] = "", scn[PATH_CAP] = "";
     if (!make_tmpdir(dir))
         return no_scratch(err);
-    join(obj, dir, "m.obj");
-    join(mtl, dir, "m.mtl");
-    join(scn, dir, "fuzz.scn");
     ps_status st;
-    if (write_file(obj, data, obj_len) && write_file(mtl, data + mtl_at, size - mtl_at) &&
+    if (join(obj, dir, "m.obj") && join(mtl, dir, "m.mtl") && join(scn, dir, "fuzz.scn") && write_file(obj, data, obj_len) && write_file(mtl, data + mtl_at, size - mtl_at) &&
         write_file(scn, obj_scene, sizeof obj_scene - 1))
         st = load_scene(NULL, scn, NULL, NULL, dir, err); /* the scene's, OBJ's or MTL's path */
     else
@@ -281,12 +281,11 @@ typedef ps_status (*image_reader)(const char *path, ps_image *out, ps_error *err
 static ps_status read_image(const uint8_t *data, size_t size, const char *file, image_reader read, bool unit_range,
                             ps_error *err)
 {
-    char dir[PATH_CAP], path[PATH_CAP];
+    char dir[DIR_CAP], path[PATH_CAP] = "";
     if (!make_tmpdir(dir))
         return no_scratch(err);
-    join(path, dir, file);
     ps_status st;
-    if (!write_file(path, data, size)) {
+    if (!join(path, dir, file) || !write_file(path, data, size)) {
         st = no_scratch(err);
     } else {
         ps_image img = {0};
