@@ -11,6 +11,7 @@
 
 #include <dirent.h>
 #include <stdbool.h>
+#include <time.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,6 +20,14 @@
 #define MAX_FILES 256
 #define MAX_INPUT_BYTES ((size_t)1 << 20)
 #define EXPECT_TAG "# expect: "
+/* The many-names inputs: sizes at which the quadratic lookups found while
+ * fuzzing took about 45 s (scene) and 25 s (OBJ) in the release build, and a
+ * bound between those and the linear code (about 1 s and 2.5 s release, 2 s
+ * and 5 s under ASan, on an idle machine) with room for a busy one. */
+#define MANY_MATERIALS 60000
+#define MANY_REFERENCES 200000
+#define MANY_MTL_MATERIALS 40000
+#define MANY_NAMES_MAX_SECONDS 15.0
 
 typedef ps_status (*target_fn)(const uint8_t *data, size_t size, const char *path, ps_error *err);
 
@@ -171,6 +180,88 @@ static void seeds_load(void **state)
     assert_true(replay_dir("tests/data/golden", ".pfm", run_pfm, PS_OK) >= 1);
 }
 
+/* A growable text buffer for generated inputs. */
+typedef struct text_buf {
+    char *s;
+    size_t len, cap;
+} text_buf;
+
+static void append(text_buf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void append(text_buf *b, const char *fmt, ...)
+{
+    va_list ap;
+    for (;;) {
+        va_start(ap, fmt);
+        int n = vsnprintf(b->s + b->len, b->cap - b->len, fmt, ap);
+        va_end(ap);
+        assert_true(n >= 0);
+        if ((size_t)n < b->cap - b->len) {
+            b->len += (size_t)n;
+            return;
+        }
+        b->cap = b->cap ? b->cap * 2 : 1 << 16;
+        b->s = realloc(b->s, b->cap);
+        assert_non_null(b->s);
+    }
+}
+
+static double seconds_since(const struct timespec *t0)
+{
+    struct timespec t1;
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    return (double)(t1.tv_sec - t0->tv_sec) + (double)(t1.tv_nsec - t0->tv_nsec) * 1e-9;
+}
+
+/* Many materials, each referenced from many spheres: looked up by a scan of
+ * the list, this took 51 s; with the hash about one. */
+static void many_scene_materials_load_quickly(void **state)
+{
+    (void)state;
+    text_buf b = {0};
+    append(&b, "camera eye 0 0 5 target 0 0 0\nlight point position 0 3 0 power 1 1 1\n");
+    for (int i = 0; i < MANY_MATERIALS; i++)
+        append(&b, "material m%d diffuse albedo 0.5 0.5 0.5\n", i);
+    for (int i = 0; i < MANY_REFERENCES; i++)
+        append(&b, "sphere center 0 0 0 radius 1 material m%d\n", MANY_MATERIALS - 1 - i % MANY_MATERIALS);
+    struct timespec t0;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    ps_error err;
+    ps_status st = ps_fuzz_scene((const uint8_t *)b.s, b.len, "many.scn", "", &err);
+    double took = seconds_since(&t0);
+    free(b.s);
+    print_message("%d materials, %d references: %.2f s\n", MANY_MATERIALS, MANY_REFERENCES, took);
+    if (st != PS_OK)
+        fail_msg("%s", err.msg);
+    if (took > MANY_NAMES_MAX_SECONDS)
+        fail_msg("%d materials, %d references: %.1f s", MANY_MATERIALS, MANY_REFERENCES, took);
+}
+
+/* A mesh with many emissive MTL materials, one face each: the usemtl check,
+ * the Ns/Ni matching and the per-material face scan for mesh lights were
+ * each quadratic in the number of materials. */
+static void many_mtl_materials_load_quickly(void **state)
+{
+    (void)state;
+    text_buf b = {0};
+    append(&b, "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for (int i = 0; i < MANY_MTL_MATERIALS; i++)
+        append(&b, "usemtl m%d\nf 1 2 3\n", i);
+    append(&b, "%s", PS_FUZZ_MTL_SEPARATOR);
+    for (int i = 0; i < MANY_MTL_MATERIALS; i++)
+        append(&b, "newmtl m%d\nKd 0.5 0.5 0.5\nKe 1 1 1\nNs 10\n", i);
+    struct timespec t0;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    ps_error err;
+    ps_status st = ps_fuzz_obj((const uint8_t *)b.s, b.len, &err);
+    double took = seconds_since(&t0);
+    free(b.s);
+    print_message("%d MTL materials: %.2f s\n", MANY_MTL_MATERIALS, took);
+    if (st != PS_OK)
+        fail_msg("%s", err.msg);
+    if (took > MANY_NAMES_MAX_SECONDS)
+        fail_msg("%d MTL materials: %.1f s", MANY_MTL_MATERIALS, took);
+}
+
 /* What a finding's file name says it must give now. */
 static const struct {
     const char *prefix;
@@ -239,6 +330,8 @@ int main(void)
         cmocka_unit_test(good_scenes_load),
         cmocka_unit_test(bad_scenes_refused_at_their_line),
         cmocka_unit_test(seeds_load),
+        cmocka_unit_test(many_scene_materials_load_quickly),
+        cmocka_unit_test(many_mtl_materials_load_quickly),
         cmocka_unit_test(scene_findings),
         cmocka_unit_test(obj_findings),
         cmocka_unit_test(png_findings),

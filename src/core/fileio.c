@@ -218,8 +218,8 @@ ps_status ps_text_lines(const char *text, const char *name, size_t max_len, ps_l
     ps_status st = PS_OK;
     const char *at = text;
     while (st == PS_OK && *at) {
-        const char *nl = strchr(at, '\n');
-        size_t n = nl ? (size_t)(nl - at) : strlen(at);
+        size_t n = ps_line_length(at);
+        const char *nl = at[n] ? at + n : NULL;
         (*line)++;
         if (n > max_len) {
             st = ps_error_set(err, PS_ERR_PARSE, "%s:%d: line longer than %zu characters", name, *line, max_len);

@@ -8,6 +8,7 @@
 
 #include "core/array.h"
 #include "core/fileio.h"
+#include "core/namemap.h"
 #include "core/number.h"
 
 /* Larger files are refused before reading: 1 GiB of OBJ text is ~20 M triangles,
@@ -33,6 +34,10 @@ typedef struct prescan {
     size_t faces;     /* faces with >= 3 vertices */
     mtl_info *mtls;
     size_t mtl_count, mtl_cap;
+    /* name -> index in mtls, the last of a name winning as in tinyobjloader;
+     * a hash, since usemtl lines look names up (a scan made many materials
+     * quadratic: found by fuzzing). */
+    ps_namemap *mtl_names;
     char *mtl_text; /* every MTL library found, concatenated */
     size_t mtl_len, mtl_cap_bytes;
     char libs[OBJ_MAX_MTLLIBS][256]; /* names already loaded */
@@ -69,14 +74,13 @@ static int split(char *s, char **tok, int max)
  * next line, or NULL at the end. */
 static const char *next_line(const char *at, char *dst, size_t dst_size, bool *too_long)
 {
-    const char *nl = strchr(at, '\n');
-    size_t n = nl ? (size_t)(nl - at) : strlen(at);
+    size_t len = ps_line_length(at), n = len;
     *too_long = n >= dst_size;
     if (*too_long)
         n = dst_size - 1;
     memcpy(dst, at, n);
     dst[n] = '\0';
-    return nl ? nl + 1 : (*at ? at + strlen(at) : NULL);
+    return at[len] ? at + len + 1 : (*at ? at + len : NULL);
 }
 
 static ps_status check_numbers(const char *path, int line, char **tok, int ntok, int min, int max,
@@ -181,9 +185,12 @@ static ps_status scan_mtl_text(prescan *ps, const char *mpath, const char *text)
                 return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: newmtl without a name", mpath, line);
             if (!PS_RESERVE(ps->mtls, ps->mtl_cap, ps->mtl_count + 1))
                 return ps_error_set(ps->err, PS_ERR_NOMEM, "%s: out of memory", mpath);
-            mtl_info *m = &ps->mtls[ps->mtl_count++];
+            mtl_info *m = &ps->mtls[ps->mtl_count];
             memset(m, 0, sizeof *m);
             snprintf(m->name, sizeof m->name, "%s", tok[1]);
+            if (!ps_namemap_put(ps->mtl_names, m->name, (int64_t)ps->mtl_count, true))
+                return ps_error_set(ps->err, PS_ERR_NOMEM, "%s: out of memory", mpath);
+            ps->mtl_count++;
         } else if (!strcmp(k, "Kd") || !strcmp(k, "Ks") || !strcmp(k, "Ke") || !strcmp(k, "Ka") || !strcmp(k, "Tf")) {
             if (ntok > 1 && (!strcmp(tok[1], "spectral") || !strcmp(tok[1], "xyz")))
                 return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: '%s %s' colours are not supported, use r g b", mpath,
@@ -315,10 +322,7 @@ static ps_status scan_obj(prescan *ps, const char *text)
         } else if (!strcmp(k, "mtllib")) {
             st = load_mtllib(ps, line, tok, ntok);
         } else if (!strcmp(k, "usemtl")) {
-            bool found = false;
-            for (size_t i = 0; ntok > 1 && i < ps->mtl_count; i++)
-                found |= strcmp(ps->mtls[i].name, tok[1]) == 0;
-            if (!found)
+            if (ntok < 2 || ps_namemap_find(ps->mtl_names, tok[1]) < 0)
                 ps_warn(ps->warn, "%s:%d: usemtl '%s' is not defined in any material library; default material",
                         ps->path, line, ntok > 1 ? tok[1] : "");
         }
@@ -355,7 +359,9 @@ ps_status ps_obj_load(const char *path, ps_obj_mesh *out, const ps_warn_sink *wa
     ps.path = path;
     ps.warn = warn;
     ps.err = err;
-    if (memchr(text, '\0', len))
+    if (!(ps.mtl_names = ps_namemap_create()))
+        st = ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
+    if (st == PS_OK && memchr(text, '\0', len))
         st = ps_error_set(err, PS_ERR_PARSE, "%s: binary data, not an OBJ file", path);
     if (st == PS_OK)
         st = scan_obj(&ps, text);
@@ -381,16 +387,16 @@ ps_status ps_obj_load(const char *path, ps_obj_mesh *out, const ps_warn_sink *wa
     if (st == PS_OK && out->triangle_count == 0)
         st = ps_error_set(err, PS_ERR_PARSE, "%s: no triangles", path);
     for (size_t i = 0; st == PS_OK && i < out->material_count; i++) {
-        for (size_t j = 0; j < ps.mtl_count; j++) {
-            if (strcmp(ps.mtls[j].name, out->materials[i].name) == 0) {
-                out->materials[i].has_ns = ps.mtls[j].has_ns;
-                out->materials[i].has_ni = ps.mtls[j].has_ni;
-            }
+        int64_t j = ps_namemap_find(ps.mtl_names, out->materials[i].name);
+        if (j >= 0) {
+            out->materials[i].has_ns = ps.mtls[j].has_ns;
+            out->materials[i].has_ni = ps.mtls[j].has_ni;
         }
     }
     if (st != PS_OK)
         ps_obj_free(out);
     free(ps.mtls);
+    ps_namemap_destroy(ps.mtl_names);
     free(ps.mtl_text);
     free(text);
     return st;
