@@ -153,7 +153,8 @@ static ps_status load_scene(const char *text, const char *file, const char *name
     ps_scene_load_options opts = {{check_warning, NULL}};
     ps_scene *s = NULL;
     ps_error_clear(err);
-    ps_status st = file ? ps_scene_load(file, &opts, &s, err) : ps_scene_load_text(text, name, base_dir, &opts, &s, err);
+    ps_status st = file ? ps_scene_load(file, &opts, &s, err)
+                        : ps_scene_load_text(text, name, base_dir, &opts, &s, err);
     if (st == PS_OK) {
         if (!s)
             broken("PS_OK without a scene");
@@ -213,7 +214,8 @@ ps_status ps_fuzz_obj(const uint8_t *data, size_t size, ps_error *err)
     if (!make_tmpdir(dir))
         return no_scratch(err);
     ps_status st;
-    if (join(obj, dir, "m.obj") && join(mtl, dir, "m.mtl") && join(scn, dir, "fuzz.scn") && write_file(obj, data, obj_len) && write_file(mtl, data + mtl_at, size - mtl_at) &&
+    if (join(obj, dir, "m.obj") && join(mtl, dir, "m.mtl") && join(scn, dir, "fuzz.scn") &&
+        write_file(obj, data, obj_len) && write_file(mtl, data + mtl_at, size - mtl_at) &&
         write_file(scn, obj_scene, sizeof obj_scene - 1))
         st = load_scene(NULL, scn, NULL, NULL, dir, err); /* the scene's, OBJ's or MTL's path */
     else

@@ -15,7 +15,8 @@ FUZZ_TARGETS := $(patsubst fuzz/%.c,build/fuzz/bin/%,$(wildcard fuzz/fuzz_*.c))
 
 build/fuzz/obj/%.o: src/%.c
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(CSTD) $(WARN) $(FUZZ_OPT) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Isrc $(PKG_CFLAGS) -MMD -MP -c $< -o $@
+	$(FUZZ_CC) $(CSTD) $(WARN) $(FUZZ_OPT) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Isrc $(PKG_CFLAGS) \
+	    -MMD -MP -c $< -o $@
 build/fuzz/obj/%.o: src/%.cpp
 	@mkdir -p $(@D)
 	$(FUZZ_CXX) -std=c++11 $(CXXWARN) $(FUZZ_OPT) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Isrc $(PKG_CFLAGS) -MMD -MP -c $< -o $@
@@ -38,7 +39,8 @@ build/fuzz/bin/fuzz_%: build/fuzz/harness/fuzz_%.o build/fuzz/harness/targets.o 
 define fuzz-replay-rule
 build/$(1)/tests/test_fuzz_replay: tests/test_fuzz_replay.c fuzz/targets.c fuzz/fuzz_targets.h tests/test.h $$(LIB_$(1))
 	@mkdir -p $$(@D)
-	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc -Itests -Ifuzz $$(PKG_CFLAGS) $$(TEST_CFLAGS) tests/test_fuzz_replay.c fuzz/targets.c -o $$@ $$(LDOPT_$(1)) $$(LIB_$(1)) $$(TEST_LIBS) $$(LIBS)
+	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc -Itests -Ifuzz $$(PKG_CFLAGS) $$(TEST_CFLAGS) \
+	    tests/test_fuzz_replay.c fuzz/targets.c -o $$@ $$(LDOPT_$(1)) $$(LIB_$(1)) $$(TEST_LIBS) $$(LIBS)
 endef
 $(foreach v,release asan,$(eval $(call fuzz-replay-rule,$(v))))
 

@@ -4,6 +4,7 @@
 #
 #   FUZZ_SECONDS=60         seconds per target
 #   FUZZ_TARGETS_RUN="scene obj png pfm"   which targets, in order
+#   FUZZ_ARGS=""            more libFuzzer flags (e.g. -only_ascii=1)
 #
 # Prints one line per target (executions, findings) and exits 1 when any
 # target found a crash, leak, timeout or out-of-memory input; those inputs are
@@ -13,6 +14,7 @@ cd "$(dirname "$0")/.."
 
 FUZZ_SECONDS=${FUZZ_SECONDS:-60}
 FUZZ_TARGETS_RUN=${FUZZ_TARGETS_RUN:-"scene obj png pfm"}
+FUZZ_ARGS=${FUZZ_ARGS:-}
 JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 # Per input: 10 s is a hang (the readers take milliseconds); 2 GiB of memory
 # is far beyond what any input up to max_len may legitimately cost.
@@ -80,7 +82,7 @@ found_any=0
 summary=()
 for t in $FUZZ_TARGETS_RUN; do
     bin=build/fuzz/bin/fuzz_$t
-    [ -x "$bin" ] || { echo "fuzz: no target '$t' (have: scene obj png pfm)" >&2; exit 2; }
+    [ -x "$bin" ] || { echo "fuzz: no target '$t' (have: $(ls build/fuzz/bin | sed 's/^fuzz_//' | xargs))" >&2; exit 2; }
     seeds=build/fuzz/seeds/$t corpus=build/fuzz/corpus/$t findings=build/fuzz/findings/$t
     tmp=build/fuzz/tmp/$t log=build/fuzz/logs/$t.log
     rm -rf "$seeds" "$tmp"
@@ -94,7 +96,7 @@ for t in $FUZZ_TARGETS_RUN; do
     rc=0
     TMPDIR=$PWD/$tmp ASAN_OPTIONS="detect_leaks=1:abort_on_error=0" \
         "$bin" -max_total_time="$FUZZ_SECONDS" -max_len="$(max_len_of "$t")" -rss_limit_mb=$RSS_LIMIT_MB \
-        -timeout=$TIMEOUT_S -print_final_stats=1 -artifact_prefix="$findings/" ${dict:+-dict=$dict} \
+        -timeout=$TIMEOUT_S -print_final_stats=1 -artifact_prefix="$findings/" ${dict:+-dict=$dict} $FUZZ_ARGS \
         "$corpus" "$seeds" >"$log" 2>&1 || rc=$?
     rm -rf "$tmp"
     execs=$(grep -Eo 'stat::number_of_executed_units: [0-9]+' "$log" | grep -Eo '[0-9]+$' | tail -1)
