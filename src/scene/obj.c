@@ -1,6 +1,7 @@
 /* obj.c: OBJ/MTL pre-scan (strict checks with line numbers), then tinyobjloader. */
 #include "scene/obj.h"
 
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +20,11 @@
 #define OBJ_MAX_FACE_VERTICES 255
 #define OBJ_MAX_TOKENS 300
 #define OBJ_MAX_MTLLIBS 16
+/* Largest magnitude of any OBJ or MTL number. tinyobjloader reads some
+ * finite values near 1e300 as infinite (a fuzzed "vn 0 1e300 1" became a
+ * non-finite normal), and products of larger coordinates (areas, emitted
+ * power) overflow; 1e30 m is far beyond any scene yet keeps those finite. */
+#define OBJ_MAX_MAGNITUDE 1e30
 
 /* Per MTL material: what tinyobjloader cannot tell us (whether Ns/Ni were given). */
 typedef struct mtl_info {
@@ -98,6 +104,9 @@ static ps_status check_numbers(const char *path, int line, char **tok, int ntok,
         if (!ps_parse_double(tok[k], &v))
             return ps_error_set(err, PS_ERR_PARSE, "%s:%d: '%s': '%s' is not a finite number", path, line, tok[0],
                                 tok[k]);
+        if (fabs(v) > OBJ_MAX_MAGNITUDE)
+            return ps_error_set(err, PS_ERR_RANGE, "%s:%d: '%s': '%s' is out of range (magnitude above %g)", path,
+                                line, tok[0], tok[k], OBJ_MAX_MAGNITUDE);
     }
     return PS_OK;
 }
@@ -384,6 +393,12 @@ ps_status ps_obj_load(const char *path, ps_obj_mesh *out, const ps_warn_sink *wa
         if (st == PS_OK && (m < -1 || (m >= 0 && (size_t)m >= out->material_count)))
             st = ps_error_set(err, PS_ERR_RANGE, "%s: triangle %zu has a material out of range", path, t);
     }
+    for (size_t i = 0; st == PS_OK && i < out->position_count * 3; i++)
+        if (!isfinite(out->positions[i]))
+            st = ps_error_set(err, PS_ERR_RANGE, "%s: vertex %zu is not finite as read", path, i / 3 + 1);
+    for (size_t i = 0; st == PS_OK && i < out->normal_count * 3; i++)
+        if (!isfinite(out->normals[i]))
+            st = ps_error_set(err, PS_ERR_RANGE, "%s: normal %zu is not finite as read", path, i / 3 + 1);
     if (st == PS_OK && out->triangle_count == 0)
         st = ps_error_set(err, PS_ERR_PARSE, "%s: no triangles", path);
     for (size_t i = 0; st == PS_OK && i < out->material_count; i++) {
