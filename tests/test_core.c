@@ -1,5 +1,5 @@
 /* test_core.c: vectors, boxes, transforms, strict numbers, atomic output, the
- * memory budget and the interrupt flag. */
+ * memory budget, the interrupt flag and the name map. */
 #include "test.h"
 
 #include <stdlib.h>
@@ -12,6 +12,7 @@
 #include "app/interrupt.h"
 #include "core/fileio.h"
 #include "core/memory.h"
+#include "core/namemap.h"
 #include "core/number.h"
 #include "core/rng.h"
 #include "core/transform.h"
@@ -232,6 +233,44 @@ static void read_file_limits(void **state)
     assert_non_null(strstr(err.msg, "not a regular file"));
 }
 
+/* The name map keeps the first or the last index of a name as asked, and
+ * survives growing well past its initial size. */
+static void name_map(void **state)
+{
+    (void)state;
+    ps_namemap *m = ps_namemap_create();
+    assert_non_null(m);
+    assert_int_equal(ps_namemap_find(m, "a"), -1);
+    char name[32];
+    for (int i = 0; i < 5000; i++) {
+        snprintf(name, sizeof name, "n%d", i);
+        assert_true(ps_namemap_put(m, name, i, false));
+    }
+    for (int i = 0; i < 5000; i += 7) {
+        snprintf(name, sizeof name, "n%d", i);
+        assert_int_equal(ps_namemap_find(m, name), i);
+    }
+    assert_true(ps_namemap_put(m, "n3", 99, false));
+    assert_int_equal(ps_namemap_find(m, "n3"), 3);
+    assert_true(ps_namemap_put(m, "n3", 99, true));
+    assert_int_equal(ps_namemap_find(m, "n3"), 99);
+    assert_int_equal(ps_namemap_find(m, "n5000"), -1);
+    assert_int_equal(ps_namemap_find(m, ""), -1);
+    assert_true(ps_namemap_put(m, "", 7, false));
+    assert_int_equal(ps_namemap_find(m, ""), 7);
+    ps_namemap_destroy(m);
+    ps_namemap_destroy(NULL);
+}
+
+static void line_lengths(void **state)
+{
+    (void)state;
+    assert_int_equal(ps_line_length(""), 0);
+    assert_int_equal(ps_line_length("abc"), 3);
+    assert_int_equal(ps_line_length("ab\ncd"), 2);
+    assert_int_equal(ps_line_length("\n"), 0);
+}
+
 static void error_messages_are_one_line(void **state)
 {
     (void)state;
@@ -355,6 +394,8 @@ int main(void)
         cmocka_unit_test(strict_numbers),
         cmocka_unit_test(atomic_output),
         cmocka_unit_test(read_file_limits),
+        cmocka_unit_test(name_map),
+        cmocka_unit_test(line_lengths),
         cmocka_unit_test(error_messages_are_one_line),
         cmocka_unit_test(memory_budget),
         cmocka_unit_test(output_checks),

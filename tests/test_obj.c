@@ -89,6 +89,9 @@ static void malformed_files(void **state)
                  "nan.obj:2: 'v': 'nan' is not a finite number");
     expect_error(write_text("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 1e999 0\nf 1 2 3\n"), PS_ERR_PARSE,
                  "inf.obj:3: 'v': '1e999' is not a finite number");
+    /* Found by fuzzing: tinyobjloader read this as infinite; magnitudes above 1e30 are refused. */
+    expect_error(write_text("huge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 1e300 1\nf 1//1 2//1 3//1\n"), PS_ERR_RANGE,
+                 "huge.obj:4: 'vn': '1e300' is out of range");
     expect_error(write_text("infn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 -inf 1\nf 1//1 2//1 3//1\n"), PS_ERR_PARSE,
                  "infn.obj:4: 'vn'");
     expect_error(write_text("short.obj", "v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), PS_ERR_PARSE,

@@ -247,12 +247,10 @@ ps_status ps_text_lines(const char *text, const char *name, size_t max_len, ps_l
     if (!buf)
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", name);
     ps_status st = PS_OK;
-    /* memchr over the known rest, not strchr: ASan's strict string checks
-     * make every strchr scan to the terminating NUL, quadratic in a long file. */
-    const char *at = text, *end = text + strlen(text);
-    while (st == PS_OK && at < end) {
-        const char *nl = memchr(at, '\n', (size_t)(end - at));
-        size_t n = nl ? (size_t)(nl - at) : (size_t)(end - at);
+    const char *at = text;
+    while (st == PS_OK && *at) {
+        size_t n = ps_line_length(at);
+        const char *nl = at[n] ? at + n : NULL;
         (*line)++;
         if (n > max_len) {
             st = ps_error_set(err, PS_ERR_PARSE, "%s:%d: line longer than %zu characters", name, *line, max_len);

@@ -43,6 +43,18 @@ ps_status ps_read_file(const char *path, size_t max_bytes, char **out, size_t *o
  * there is none: text readers refuse binary input by naming where it starts. */
 int ps_text_nul_line(const char *text, size_t len);
 
+/* The characters before the next '\n' or the text's end. A plain loop rather
+ * than strchr: under ASan's strict_string_checks (as `make test` runs it)
+ * strchr measures all the remaining text, so reading a long file line by
+ * line became quadratic (found while fuzzing, docs/fuzzing.md). */
+static inline size_t ps_line_length(const char *at)
+{
+    size_t n = 0;
+    while (at[n] && at[n] != '\n')
+        n++;
+    return n;
+}
+
 /* Calls fn once for each line of the NUL-terminated text, with its number
  * (from 1, also kept in *line) and its characters copied without the newline
  * into a NUL-terminated buffer: the shape every text reader here shares. A

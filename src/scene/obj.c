@@ -1,6 +1,7 @@
 /* obj.c: OBJ/MTL pre-scan (strict checks with line numbers), then tinyobjloader. */
 #include "scene/obj.h"
 
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,6 +10,7 @@
 #include "core/array.h"
 #include "core/fileio.h"
 #include "core/memory.h"
+#include "core/namemap.h"
 #include "core/number.h"
 #include "scene/scene.h"
 
@@ -20,6 +22,11 @@
 #define OBJ_MAX_FACE_VERTICES 255
 #define OBJ_MAX_TOKENS 300
 #define OBJ_MAX_MTLLIBS 16
+/* Largest magnitude of any OBJ or MTL number. tinyobjloader reads some
+ * finite values near 1e300 as infinite (a fuzzed "vn 0 1e300 1" became a
+ * non-finite normal), and products of larger coordinates (areas, emitted
+ * power) overflow; 1e30 m is far beyond any scene yet keeps those finite. */
+#define OBJ_MAX_MAGNITUDE 1e30
 
 /* Per MTL material: what tinyobjloader cannot tell us (whether Ns/Ni were given). */
 typedef struct mtl_info {
@@ -35,6 +42,10 @@ typedef struct prescan {
     size_t faces;     /* faces with >= 3 vertices */
     mtl_info *mtls;
     size_t mtl_count, mtl_cap;
+    /* name -> index in mtls, the last of a name winning as in tinyobjloader;
+     * a hash, since usemtl lines look names up (a scan made many materials
+     * quadratic: found by fuzzing). */
+    ps_namemap *mtl_names;
     char *mtl_text; /* every MTL library found, concatenated */
     size_t mtl_len, mtl_cap_bytes;
     char libs[OBJ_MAX_MTLLIBS][256]; /* names already loaded */
@@ -71,18 +82,13 @@ static int split(char *s, char **tok, int max)
  * next line, or NULL at the end. */
 static const char *next_line(const char *at, char *dst, size_t dst_size, bool *too_long)
 {
-    /* A plain loop, not strchr: ASan's strict string checks make each strchr
-     * scan to the end of the file, quadratic in its length. */
-    const char *e = at;
-    while (*e && *e != '\n')
-        e++;
-    size_t n = (size_t)(e - at);
+    size_t len = ps_line_length(at), n = len;
     *too_long = n >= dst_size;
     if (*too_long)
         n = dst_size - 1;
     memcpy(dst, at, n);
     dst[n] = '\0';
-    return *e ? e + 1 : (*at ? e : NULL);
+    return at[len] ? at + len + 1 : (*at ? at + len : NULL);
 }
 
 static ps_status check_numbers(const char *path, int line, char **tok, int ntok, int min, int max,
@@ -100,6 +106,9 @@ static ps_status check_numbers(const char *path, int line, char **tok, int ntok,
         if (!ps_parse_double(tok[k], &v))
             return ps_error_set(err, PS_ERR_PARSE, "%s:%d: '%s': '%s' is not a finite number", path, line, tok[0],
                                 tok[k]);
+        if (fabs(v) > OBJ_MAX_MAGNITUDE)
+            return ps_error_set(err, PS_ERR_RANGE, "%s:%d: '%s': '%s' is out of range (magnitude above %g)", path,
+                                line, tok[0], tok[k], OBJ_MAX_MAGNITUDE);
     }
     return PS_OK;
 }
@@ -187,9 +196,12 @@ static ps_status scan_mtl_text(prescan *ps, const char *mpath, const char *text)
                 return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: newmtl without a name", mpath, line);
             if (!PS_RESERVE(ps->mtls, ps->mtl_cap, ps->mtl_count + 1))
                 return ps_error_set(ps->err, PS_ERR_NOMEM, "%s: out of memory", mpath);
-            mtl_info *m = &ps->mtls[ps->mtl_count++];
+            mtl_info *m = &ps->mtls[ps->mtl_count];
             memset(m, 0, sizeof *m);
             snprintf(m->name, sizeof m->name, "%s", tok[1]);
+            if (!ps_namemap_put(ps->mtl_names, m->name, (int64_t)ps->mtl_count, true))
+                return ps_error_set(ps->err, PS_ERR_NOMEM, "%s: out of memory", mpath);
+            ps->mtl_count++;
         } else if (!strcmp(k, "Kd") || !strcmp(k, "Ks") || !strcmp(k, "Ke") || !strcmp(k, "Ka") || !strcmp(k, "Tf")) {
             if (ntok > 1 && (!strcmp(tok[1], "spectral") || !strcmp(tok[1], "xyz")))
                 return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: '%s %s' colours are not supported, use r g b", mpath,
@@ -321,10 +333,7 @@ static ps_status scan_obj(prescan *ps, const char *text)
         } else if (!strcmp(k, "mtllib")) {
             st = load_mtllib(ps, line, tok, ntok);
         } else if (!strcmp(k, "usemtl")) {
-            bool found = false;
-            for (size_t i = 0; ntok > 1 && i < ps->mtl_count; i++)
-                found |= strcmp(ps->mtls[i].name, tok[1]) == 0;
-            if (!found)
+            if (ntok < 2 || ps_namemap_find(ps->mtl_names, tok[1]) < 0)
                 ps_warn(ps->warn, "%s:%d: usemtl '%s' is not defined in any material library; default material",
                         ps->path, line, ntok > 1 ? tok[1] : "");
         }
@@ -361,7 +370,9 @@ ps_status ps_obj_load(const char *path, ps_obj_mesh *out, const ps_warn_sink *wa
     ps.path = path;
     ps.warn = warn;
     ps.err = err;
-    if (memchr(text, '\0', len))
+    if (!(ps.mtl_names = ps_namemap_create()))
+        st = ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
+    if (st == PS_OK && memchr(text, '\0', len))
         st = ps_error_set(err, PS_ERR_PARSE, "%s: binary data, not an OBJ file", path);
     if (st == PS_OK)
         st = scan_obj(&ps, text);
@@ -393,19 +404,25 @@ ps_status ps_obj_load(const char *path, ps_obj_mesh *out, const ps_warn_sink *wa
         if (st == PS_OK && (m < -1 || (m >= 0 && (size_t)m >= out->material_count)))
             st = ps_error_set(err, PS_ERR_RANGE, "%s: triangle %zu has a material out of range", path, t);
     }
+    for (size_t i = 0; st == PS_OK && i < out->position_count * 3; i++)
+        if (!isfinite(out->positions[i]))
+            st = ps_error_set(err, PS_ERR_RANGE, "%s: vertex %zu is not finite as read", path, i / 3 + 1);
+    for (size_t i = 0; st == PS_OK && i < out->normal_count * 3; i++)
+        if (!isfinite(out->normals[i]))
+            st = ps_error_set(err, PS_ERR_RANGE, "%s: normal %zu is not finite as read", path, i / 3 + 1);
     if (st == PS_OK && out->triangle_count == 0)
         st = ps_error_set(err, PS_ERR_PARSE, "%s: no triangles", path);
     for (size_t i = 0; st == PS_OK && i < out->material_count; i++) {
-        for (size_t j = 0; j < ps.mtl_count; j++) {
-            if (strcmp(ps.mtls[j].name, out->materials[i].name) == 0) {
-                out->materials[i].has_ns = ps.mtls[j].has_ns;
-                out->materials[i].has_ni = ps.mtls[j].has_ni;
-            }
+        int64_t j = ps_namemap_find(ps.mtl_names, out->materials[i].name);
+        if (j >= 0) {
+            out->materials[i].has_ns = ps.mtls[j].has_ns;
+            out->materials[i].has_ni = ps.mtls[j].has_ni;
         }
     }
     if (st != PS_OK)
         ps_obj_free(out);
     free(ps.mtls);
+    ps_namemap_destroy(ps.mtl_names);
     free(ps.mtl_text);
     free(text);
     return st;

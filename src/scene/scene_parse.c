@@ -7,6 +7,7 @@
 
 #include "core/fileio.h"
 #include "core/memory.h"
+#include "core/namemap.h"
 #include "core/number.h"
 #include "core/transform.h"
 #include "scene/obj.h"
@@ -46,6 +47,7 @@ typedef struct parser {
     int ntok, pos;
     bool has_camera, has_image, has_photons, has_radius;
     int64_t default_material; /* index, or -1 until first needed */
+    ps_namemap *material_names; /* name -> index in s->materials; the first of a name wins */
 } parser;
 
 /* ---- tokens ---------------------------------------------------------------- */
@@ -226,12 +228,11 @@ static bool valid_name(const char *n)
     return true;
 }
 
-static int64_t find_material(const ps_scene *s, const char *name)
+/* A hash lookup: scanning the list made a file with many materials and
+ * many references to them take minutes (found by fuzzing). */
+static int64_t find_material(const parser *p, const char *name)
 {
-    for (size_t i = 0; i < s->materials.count; i++)
-        if (strcmp(s->materials.items[i].name, name) == 0)
-            return (int64_t)i;
-    return -1;
+    return ps_namemap_find(p->material_names, name);
 }
 
 static ps_material *add_material(parser *p, const char *name)
@@ -246,6 +247,11 @@ static ps_material *add_material(parser *p, const char *name)
         return NULL;
     }
     snprintf(m->name, sizeof m->name, "%s", name);
+    if (!ps_namemap_put(p->material_names, m->name, (int64_t)(p->s->materials.count - 1), false)) {
+        p->s->materials.count--;
+        ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        return NULL;
+    }
     m->transmittance = ps_rgb_gray(1.0);
     m->reflectance = ps_rgb_gray(1.0);
     return m;
@@ -274,7 +280,7 @@ static ps_status parse_material(parser *p)
         return ps_error_set(p->err, PS_ERR_PARSE,
                             "%s:%d: material name '%s' must be 1-%d letters, digits, '_', '-' or '.'", p->name,
                             p->line, name, PS_NAME_MAX - 1);
-    if (find_material(p->s, name) >= 0)
+    if (find_material(p, name) >= 0)
         return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: material '%s' is already defined", p->name, p->line, name);
     const char *type = next_word(p, "type (diffuse, glossy, mirror or dielectric)");
     if (!type)
@@ -353,7 +359,7 @@ static ps_status parse_material(parser *p)
 /* The material named by a `material NAME` key, or the default. */
 static ps_status resolve_material(parser *p, const key_vals *kv, uint32_t *out)
 {
-    int64_t m = kv->present ? find_material(p->s, kv->word) : default_material(p);
+    int64_t m = kv->present ? find_material(p, kv->word) : default_material(p);
     if (m < 0 && kv->present)
         return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: material '%s' is not defined (define it above)",
                             p->name, p->line, p->tok[0], kv->word);
@@ -551,41 +557,85 @@ static ps_status add_mesh_geometry(parser *p, const ps_obj_mesh *om, const ps_xf
 /* One PS_LIGHT_MESH per emissive material of the mesh: its faces, their area.
  * mats/nmats: the scene materials of the mesh's faces, UINT32_MAX for unused
  * slots (see parse_mesh). */
+/* An emitting face of the mesh being added: what add_mesh_lights groups. */
+typedef struct emit_face {
+    uint32_t material, triangle;
+} emit_face;
+
+static int by_material_then_triangle(const void *a, const void *b)
+{
+    const emit_face *x = a, *y = b;
+    if (x->material != y->material)
+        return x->material < y->material ? -1 : 1;
+    return x->triangle < y->triangle ? -1 : x->triangle > y->triangle;
+}
+
+/* One PS_LIGHT_MESH per distinct emissive material of the mesh, in OBJ
+ * material order, its emitters in triangle order. The faces are sorted by
+ * material once: scanning every face per material, and every earlier slot
+ * per slot, made meshes with many materials quadratic (found by fuzzing). */
 static ps_status add_mesh_lights(parser *p, const ps_object *o, uint32_t object, const uint32_t *mats, size_t nmats)
 {
     ps_scene *s = p->s;
-    for (size_t k = 0; k < nmats; k++) {
+    emit_face *faces = NULL;
+    size_t nfaces = 0, cap = 0;
+    for (uint32_t t = o->first_triangle; t < o->first_triangle + o->triangle_count; t++) {
+        uint32_t m = s->triangles.items[t].material;
+        /* A zero-area face emits nothing and could not be sampled. */
+        if (ps_rgb_is_black(s->materials.items[m].emission) || !(ps_scene_triangle_area(s, t) > 0.0))
+            continue;
+        if (!PS_RESERVE(faces, cap, nfaces + 1)) {
+            free(faces);
+            return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        }
+        faces[nfaces++] = (emit_face){m, t};
+    }
+    if (nfaces == 0)
+        return PS_OK;
+    qsort(faces, nfaces, sizeof *faces, by_material_then_triangle);
+    bool *done = calloc(s->materials.count, sizeof *done); /* a light was made for this material */
+    if (!done) {
+        free(faces);
+        return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+    }
+    ps_status st = PS_OK;
+    for (size_t k = 0; st == PS_OK && k < nmats; k++) {
         uint32_t m = mats[k];
-        if (m == UINT32_MAX)
+        if (m == UINT32_MAX || done[m])
             continue;
-        const ps_material *mat = &s->materials.items[m];
-        bool repeat = false;
-        for (size_t j = 0; j < k; j++)
-            repeat |= mats[j] == m;
-        if (repeat || ps_rgb_is_black(mat->emission))
+        done[m] = true;
+        /* The first face of material m: a lower bound in the sorted faces. */
+        size_t lo = 0, hi = nfaces;
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (faces[mid].material < m)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        if (lo == nfaces || faces[lo].material != m)
             continue;
+        if (s->lights.count >= PS_SCENE_MAX_LIGHTS) {
+            st = ps_error_set(p->err, PS_ERR_LIMIT, "%s:%d: more than %d lights", p->name, p->line,
+                              PS_SCENE_MAX_LIGHTS);
+            break;
+        }
         size_t first = s->emitters.count;
         double area = 0.0;
-        for (uint32_t t = o->first_triangle; t < o->first_triangle + o->triangle_count; t++) {
-            if (s->triangles.items[t].material != m)
-                continue;
-            double a = ps_scene_triangle_area(s, t);
-            if (!(a > 0.0))
-                continue; /* a zero-area face emits nothing and could not be sampled */
+        for (size_t i = lo; st == PS_OK && i < nfaces && faces[i].material == m; i++) {
             uint32_t *e = PS_VEC_PUSH(s->emitters);
             if (!e)
-                return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
-            *e = t;
-            area += a;
+                st = ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+            else
+                *e = faces[i].triangle;
+            area += ps_scene_triangle_area(s, faces[i].triangle);
         }
-        if (s->emitters.count == first)
-            continue;
-        if (s->lights.count >= PS_SCENE_MAX_LIGHTS)
-            return ps_error_set(p->err, PS_ERR_LIMIT, "%s:%d: more than %d lights", p->name, p->line,
-                                PS_SCENE_MAX_LIGHTS);
-        ps_light *l = PS_VEC_PUSH(s->lights);
-        if (!l)
-            return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        ps_light *l = st == PS_OK ? PS_VEC_PUSH(s->lights) : NULL;
+        if (st == PS_OK && !l)
+            st = ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        if (st != PS_OK)
+            break;
+        const ps_material *mat = &s->materials.items[m];
         l->type = PS_LIGHT_MESH;
         l->line = p->line;
         l->first_emitter = (uint32_t)first;
@@ -601,7 +651,9 @@ static ps_status add_mesh_lights(parser *p, const ps_object *o, uint32_t object,
                                 p->name, p->line, ps_rgb_max(l->power), PS_SCENE_MAX_LIGHT_POWER);
         l->position = ps_aabb_center(o->bounds);
     }
-    return PS_OK;
+    free(done);
+    free(faces);
+    return st;
 }
 
 static ps_status parse_mesh(parser *p)
@@ -657,7 +709,7 @@ static ps_status parse_mesh(parser *p)
         xf = ps_xform_compose(step, xf);
     }
     int64_t override_mat = -1;
-    if (override && (override_mat = find_material(p->s, override)) < 0)
+    if (override && (override_mat = find_material(p, override)) < 0)
         return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: mesh: material '%s' is not defined (define it above)",
                             p->name, p->line, override);
 
@@ -1014,9 +1066,11 @@ static ps_status load_text(const char *text, size_t len, const char *name, const
     parser p;
     memset(&p, 0, sizeof p);
     p.s = ps_scene_alloc();
+    p.material_names = ps_namemap_create();
     size_t nlen = strlen(name);
-    if (!p.s || !(p.s->path = malloc(nlen + 1))) {
+    if (!p.s || !p.material_names || !(p.s->path = malloc(nlen + 1))) {
         ps_scene_destroy(p.s);
+        ps_namemap_destroy(p.material_names);
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", name);
     }
     memcpy(p.s->path, name, nlen + 1);
@@ -1030,6 +1084,7 @@ static ps_status load_text(const char *text, size_t len, const char *name, const
     int bin = ps_text_nul_line(text, len);
     ps_status st = bin ? ps_error_set(err, PS_ERR_PARSE, "%s:%d: binary data (a NUL byte), not a scene file", name, bin)
                        : parse_text(&p, text, len);
+    ps_namemap_destroy(p.material_names);
     if (st != PS_OK) {
         ps_scene_destroy(p.s);
         return st;

@@ -1,0 +1,11 @@
+/* fuzz_obj.c: libFuzzer entry point for the obj target (body in targets.c). */
+#include "fuzz_targets.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    ps_error err;
+    (void)ps_fuzz_obj(data, size, &err);
+    return 0;
+}
