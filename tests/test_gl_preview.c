@@ -108,6 +108,53 @@ static ps_image reference(preview *p, ps_component c, const ps_kdtree *caustic, 
     return img;
 }
 
+/* A spot straight down at height 1 over the plane, half-angle 25 degrees:
+ * inside the cone rho / pi * I h / (h^2 + r^2)^(3/2) with I = power / (2 pi
+ * (1 - cos 25)), outside exactly 0, and the edge where the cone meets the
+ * plane to within a pixel (the cone texture), not a mesh edge (GL's
+ * per-vertex cutoff, which lit or darkened whole mesh triangles there). */
+static void spot_cone_on_plane(void **state)
+{
+    (void)state;
+    const char *text = "camera eye 0 3 0.01 target 0 0 0 up 0 0 -1 fov 50\n"
+                       "material floor diffuse albedo 0.5 0.5 0.5\n"
+                       "quad corner -2 0 2 edge1 4 0 0 edge2 0 0 -4 material floor\n"
+                       "light spot position 0.1 1 -0.1 direction 0 -1 0 angle 25 power 100 100 100\n";
+    preview p;
+    preview_make(&p, text, 128, 128, PS_KERNEL_BOX);
+    const double exposure = 0.25, cutoff = tan(25.0 * PS_PI / 180.0);
+    ps_gl_begin_frame(p.gl, &p.cam, exposure, true);
+    ps_image img = read_back(&p);
+    double intensity = 100.0 / (2.0 * PS_PI * (1.0 - cos(25.0 * PS_PI / 180.0))), worst = 0, brightest_out = 0;
+    /* A pixel's footprint on the floor: 2 * 3 tan(25 deg) / 128 wide; the
+     * edge may fall anywhere in the pixels it crosses. */
+    const double pixel = 2.0 * 3.0 * tan(25.0 * PS_PI / 180.0) / 128.0;
+    int inside = 0, outside = 0;
+    for (int y = 0; y < p.h; y++)
+        for (int x = 0; x < p.w; x++) {
+            ps_vec3 q;
+            if (!floor_point(&p.cam, x + 0.5, y + 0.5, &q))
+                continue;
+            double r = hypot(q.x - 0.1, q.z + 0.1);
+            double got = ps_image_at(&img, x, y)[1] / exposure;
+            if (r < cutoff - pixel) {
+                double expect = floor_radiance(0.5, intensity, 1.0, 0.1, -0.1, q);
+                worst = fmax(worst, fabs(got - expect) / expect);
+                inside++;
+            } else if (r > cutoff + pixel) {
+                brightest_out = fmax(brightest_out, got);
+                outside++;
+            }
+        }
+    printf("spot cone: %d pixels inside, worst %.3f %% off; %d outside, brightest %g\n", inside, 100 * worst, outside,
+           brightest_out);
+    assert_true(inside > 500 && outside > 500);
+    assert_true(worst < 0.02);
+    assert_true(brightest_out == 0.0);
+    ps_image_destroy(&img);
+    preview_free(&p);
+}
+
 /* A point light at height 1 over a diffuse plane: GL lights in physical units
  * give rho / pi * I h / (h^2 + x^2)^(3/2) at every pixel centre (within 2 %:
  * Gouraud interpolation over the fine mesh), and the reference renderer's
@@ -384,6 +431,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(direct_layer_on_plane),
+        cmocka_unit_test(spot_cone_on_plane),
         cmocka_unit_test(shadow_of_a_square),
         cmocka_unit_test(caustic_layer_mirror_quad),
         cmocka_unit_test(stencil_clips_haze),

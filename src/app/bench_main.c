@@ -860,7 +860,7 @@ static ps_status write_plots(const bench_state *b, const char *script, ps_error 
         return err->status;
     FILE *fp = ps_outfile_stream(out);
     fprintf(fp, "# Made by %s: gnuplot %s\nset datafile separator whitespace\n"
-                "set logscale xy\nset grid\nset key bottom left font ',8'\n"
+                "set logscale xy\nset grid\nset key top right font ',7' samplen 2 spacing 0.9\n"
                 "set xlabel 'seconds'\nset ylabel 'relMSE'\n",
             PROG, script);
     /* Main curves solid and strong; comparisons thin and dashed. */
