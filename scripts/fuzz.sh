@@ -22,32 +22,7 @@ TIMEOUT_S=10
 RSS_LIMIT_MB=2048
 
 # ---- packages: the project's, then clang and its libFuzzer runtime ----------
-scripts/install-deps.sh
-missing=()
-command -v clang >/dev/null 2>&1 || missing+=(clang)
-command -v clang++ >/dev/null 2>&1 || missing+=(clang)
-# The runtime (libclang_rt.fuzzer) is in libclang-rt-14-dev on Debian 12.
-if command -v clang >/dev/null 2>&1; then
-    rt=$(clang -print-file-name=libclang_rt.fuzzer-x86_64.a 2>/dev/null || true)
-    [ -n "$rt" ] && [ -e "$rt" ] || missing+=(libclang-rt-14-dev)
-fi
-if [ ${#missing[@]} -gt 0 ]; then
-    echo "fuzz: installing ${missing[*]}" >&2
-    SUDO=()
-    if [ "$(id -u)" -ne 0 ]; then
-        if command -v sudo >/dev/null 2>&1; then
-            SUDO=(sudo)
-        else
-            echo "fuzz: need root or sudo to install: ${missing[*]} (or install them and rerun)" >&2
-            exit 2
-        fi
-    fi
-    export DEBIAN_FRONTEND=noninteractive
-    if ! "${SUDO[@]}" apt-get install -y --no-install-recommends "${missing[@]}" >/dev/null 2>&1; then
-        "${SUDO[@]}" apt-get update -qq
-        "${SUDO[@]}" apt-get install -y --no-install-recommends "${missing[@]}"
-    fi
-fi
+scripts/install-deps.sh --fuzz
 
 make --no-print-directory -j"$JOBS" build-fuzz
 

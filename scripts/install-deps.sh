@@ -3,7 +3,8 @@
 # what is already there (checked with pkg-config or the command itself).
 # Called by `make test` and `make run`; needs root or sudo only when something
 # is missing. With --bench, also what `make bench` needs (gnuplot for the
-# photosplat-bench plots).
+# photosplat-bench plots); with --fuzz, what `make fuzz` needs (clang and
+# its libFuzzer runtime).
 set -euo pipefail
 
 missing=()
@@ -30,9 +31,22 @@ need_cmd xauth xauth
 [ -e "$(gcc -print-file-name=libasan.so 2>/dev/null)" ] && gcc -print-file-name=libasan.so | grep -q / || missing+=(libasan8)
 [ -e "$(gcc -print-file-name=libubsan.so 2>/dev/null)" ] && gcc -print-file-name=libubsan.so | grep -q / || missing+=(libubsan1)
 
-if [ "${1:-}" = --bench ]; then
+case "${1:-}" in
+--bench)
     need_cmd gnuplot gnuplot-nox
-fi
+    ;;
+--fuzz)
+    # clang and its libFuzzer runtime (libclang_rt.fuzzer, in libclang-rt-14-dev).
+    need_cmd clang clang
+    need_cmd clang++ clang
+    if command -v clang >/dev/null 2>&1; then
+        rt=$(clang -print-file-name=libclang_rt.fuzzer-x86_64.a 2>/dev/null || true)
+        [ -n "$rt" ] && [ -e "$rt" ] || missing+=(libclang-rt-14-dev)
+    else
+        missing+=(libclang-rt-14-dev)
+    fi
+    ;;
+esac
 
 if [ ${#missing[@]} -eq 0 ]; then
     exit 0

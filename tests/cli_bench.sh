@@ -109,5 +109,7 @@ sed -i 's/power 100 100 100/power 90 90 90/' "$cli_tmp/tiny.scn"
 expect_success "bench: changed scene" "$bench" --quick --size 24x24 --budgets 0.05 --scenes "$cli_tmp/tiny.scn:0.5" \
     --out "$cli_tmp/b" --bin "$bin" --threads 1
 expect_match "bench: a changed scene renders anew" "$cli_out" 'reference direct'
+# ... and the old references make way for the new: one file a component.
+[ "$(ls "$cli_tmp/b/cache" | grep -c '^tiny-direct-[0-9a-f]*\.pfm$')" = 1 ] && ok || bad "stale references kept: $(ls "$cli_tmp/b/cache")"
 
 cli_summary

@@ -4,6 +4,7 @@
  * capped maps (photon i depends only on scene, seed and i), so that memory is
  * bounded for any scene and the picture stays a correct estimate. */
 #include "test.h"
+#include "rig.h"
 
 #include <string.h>
 #include <time.h>
@@ -20,34 +21,16 @@
 #define GLOBAL_CAP 10000
 #define STORE_LIMIT 25000
 
-typedef struct rig {
-    ps_scene *scene;
-    ps_world *world;
-    ps_tracer *tracer;
-} rig;
-
-static rig rig_make(void)
+static rig feed_rig(void)
 {
-    rig r;
-    memset(&r, 0, sizeof r);
+    ps_scene *scene;
     ps_error err;
-    if (ps_scene_load(SCENE, NULL, &r.scene, &err) != PS_OK)
+    if (ps_scene_load(SCENE, NULL, &scene, &err) != PS_OK)
         fail_msg("scene: %s", err.msg);
-    if (ps_world_create(r.scene, NULL, &r.world, &err) != PS_OK)
-        fail_msg("world: %s", err.msg);
     ps_tracer_options o = ps_tracer_default_options();
     o.seed = 3;
     o.threads = 2;
-    if (ps_tracer_create(r.world, &o, &r.tracer, &err) != PS_OK)
-        fail_msg("tracer: %s", err.msg);
-    return r;
-}
-
-static void rig_free(rig *r)
-{
-    ps_tracer_destroy(r->tracer);
-    ps_world_destroy(r->world);
-    ps_scene_destroy(r->scene);
+    return rig_of_scene(scene, NULL, &o);
 }
 
 /* A feed of both maps run to its end on this thread, with store limit `limit`. */
@@ -75,7 +58,7 @@ static size_t stored(const ps_feed *f)
 static void ends_at_the_caps(void **state)
 {
     (void)state;
-    rig r = rig_make();
+    rig r = feed_rig();
     ps_feed *f = run_feed(&r, 0);
     assert_true(ps_feed_ended(f));
     assert_false(ps_feed_store_limited(f));
@@ -101,7 +84,7 @@ static void ends_at_the_caps(void **state)
 static void ends_at_the_store_limit(void **state)
 {
     (void)state;
-    rig r = rig_make();
+    rig r = feed_rig();
     ps_feed *full = run_feed(&r, 0);
     ps_feed *f = run_feed(&r, STORE_LIMIT);
     assert_true(ps_feed_ended(f));
@@ -132,7 +115,7 @@ static void ends_at_the_store_limit(void **state)
 static void background_thread_stops(void **state)
 {
     (void)state;
-    rig r = rig_make();
+    rig r = feed_rig();
     const uint64_t caps[PS_MAP_COUNT] = {CAUSTIC_CAP, GLOBAL_CAP};
     const bool active[PS_MAP_COUNT] = {true, true};
     ps_feed *f = NULL;

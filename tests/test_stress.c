@@ -10,6 +10,7 @@
  * Photon counts are multiplied by PS_STRESS_FACTOR (environment, default 1):
  * `make stress` runs this file again with a larger factor (docs/stress.md). */
 #include "test.h"
+#include "rig.h"
 
 #include <float.h>
 #include <stdlib.h>
@@ -60,42 +61,10 @@ static double mc_tol(uint64_t n, double sigmas) { return sigmas / sqrt((double)n
 
 /* ---- rigs ------------------------------------------------------------------- */
 
-typedef struct rig {
-    ps_scene *scene;
-    ps_world *world;
-    ps_tracer *tracer;
-} rig;
-
-static rig rig_make(const char *text, const char *base_dir, const ps_tracer_options *opt, ps_accel_kind kind)
-{
-    rig r;
-    memset(&r, 0, sizeof r);
-    ps_error err;
-    if (ps_scene_load_text(text, "inline.scn", base_dir, NULL, &r.scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_accel_options aopt = {0};
-    aopt.kind = kind;
-    if (ps_world_create(r.scene, &aopt, &r.world, &err) != PS_OK)
-        fail_msg("world: %s", err.msg);
-    if (ps_tracer_create(r.world, opt, &r.tracer, &err) != PS_OK)
-        fail_msg("tracer: %s", err.msg);
-    return r;
-}
-
-static void rig_free(rig *r)
-{
-    ps_tracer_destroy(r->tracer);
-    ps_world_destroy(r->world);
-    ps_scene_destroy(r->scene);
-}
-
+/* rig_trace, and every photon asked for was emitted. */
 static ps_photon_map trace(rig *r, ps_map_kind kind, uint64_t n)
 {
-    ps_photon_map m;
-    ps_photon_map_init(&m, kind);
-    ps_error err;
-    if (ps_tracer_trace(r->tracer, kind, 0, n, n, &m, &err) != PS_OK)
-        fail_msg("trace: %s", err.msg);
+    ps_photon_map m = rig_trace(r, kind, n);
     assert_int_equal(m.counters.emitted, n);
     return m;
 }

@@ -2,6 +2,7 @@
  * closed box, the caustic of a mirror quad, overlapping caustic cones, no
  * leaks, per-index determinism, scale invariance and the skip rules. */
 #include "test.h"
+#include "rig.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -10,45 +11,6 @@
 #include "photon/tracer.h"
 #include "photon/world.h"
 #include "scene/scene.h"
-
-typedef struct rig {
-    ps_scene *scene;
-    ps_world *world;
-    ps_tracer *tracer;
-} rig;
-
-static rig rig_make(const char *text, const char *base_dir, const ps_tracer_options *opt, ps_accel_kind kind)
-{
-    rig r;
-    memset(&r, 0, sizeof r);
-    ps_error err;
-    if (ps_scene_load_text(text, "inline.scn", base_dir, NULL, &r.scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_accel_options aopt = {0};
-    aopt.kind = kind;
-    if (ps_world_create(r.scene, &aopt, &r.world, &err) != PS_OK)
-        fail_msg("world: %s", err.msg);
-    if (ps_tracer_create(r.world, opt, &r.tracer, &err) != PS_OK)
-        fail_msg("tracer: %s", err.msg);
-    return r;
-}
-
-static void rig_free(rig *r)
-{
-    ps_tracer_destroy(r->tracer);
-    ps_world_destroy(r->world);
-    ps_scene_destroy(r->scene);
-}
-
-static ps_photon_map trace(rig *r, ps_map_kind kind, uint64_t n)
-{
-    ps_photon_map m;
-    ps_photon_map_init(&m, kind);
-    ps_error err;
-    if (ps_tracer_trace(r->tracer, kind, 0, n, n, &m, &err) != PS_OK)
-        fail_msg("trace: %s", err.msg);
-    return m;
-}
 
 static ps_tracer_options options(int threads)
 {
@@ -91,7 +53,7 @@ static void furnace_box(void **state)
         rig r = rig_make(text, "", &o, PS_ACCEL_AUTO);
         /* Russian roulette's noise: about 0.3 % (one sigma) at this count. */
         uint64_t n = 500000;
-        ps_photon_map m = trace(&r, PS_MAP_GLOBAL, n);
+        ps_photon_map m = rig_trace(&r, PS_MAP_GLOBAL, n);
         ps_rgb flux = ps_photon_map_power(&m);
         double f = rhos[k] / (1.0 - rhos[k]);
         printf("furnace rho %.1f: stored flux %.4f %.4f %.4f W, expected %.4f %.4f %.4f W\n", rhos[k], flux.r, flux.g,
@@ -155,7 +117,7 @@ static void mirror_caustic(void **state)
     (void)state;
     ps_tracer_options o = options(0);
     rig r = rig_make(mirror_scene, "", &o, PS_ACCEL_AUTO);
-    ps_photon_map m = trace(&r, PS_MAP_CAUSTIC, 200000);
+    ps_photon_map m = rig_trace(&r, PS_MAP_CAUSTIC, 200000);
     /* All that reaches the mirror lands on the floor: P Omega / (4 pi), with
      * the solid angle of a 1 x 1 square at distance 1: 4 asin(a b / sqrt((a^2+d^2)(b^2+d^2))). */
     double omega = 4.0 * asin(0.25 / 1.25);
@@ -206,7 +168,7 @@ static double caustic_flux(bool cones, bool first_hit, uint64_t n)
     o.caustic_cones = cones;
     o.first_hit_test = first_hit;
     rig r = rig_make(overlap_scene, "", &o, PS_ACCEL_AUTO);
-    ps_photon_map m = trace(&r, PS_MAP_CAUSTIC, n);
+    ps_photon_map m = rig_trace(&r, PS_MAP_CAUSTIC, n);
     double f = ps_photon_map_power(&m).g;
     ps_photon_map_free(&m);
     rig_free(&r);
@@ -279,7 +241,7 @@ static void no_leaks(void **state)
                        "light point position 0.5 -0.5 0.5 power 10 10 10\n";
     ps_tracer_options o = options(0);
     rig r = rig_make(text, dir, &o, PS_ACCEL_OCTREE);
-    ps_photon_map m = trace(&r, PS_MAP_GLOBAL, 1000000);
+    ps_photon_map m = rig_trace(&r, PS_MAP_GLOBAL, 1000000);
     assert_int_equal(m.counters.emitted, 1000000);
     assert_int_equal(m.counters.escaped, 0);
     assert_true(m.counters.rays > 3000000); /* albedo 0.7: about 1/(1-0.7) rays a photon */
@@ -326,7 +288,7 @@ static void determinism(void **state)
         ps_tracer_options o = options(threads[t]);
         rig r = rig_file(default_scene_path, &o);
         for (int k = 0; k < PS_MAP_COUNT; k++) {
-            ps_photon_map m = trace(&r, (ps_map_kind)k, n);
+            ps_photon_map m = rig_trace(&r, (ps_map_kind)k, n);
             assert_true(m.count > 1000);
             if (t == 0) {
                 ref[k] = m;
@@ -350,7 +312,7 @@ static void determinism(void **state)
     ps_tracer_options o = options(2);
     o.seed = 8;
     rig r = rig_file(default_scene_path, &o);
-    ps_photon_map other = trace(&r, PS_MAP_CAUSTIC, n);
+    ps_photon_map other = rig_trace(&r, PS_MAP_CAUSTIC, n);
     assert_false(maps_equal(&other, &ref[PS_MAP_CAUSTIC]));
     ps_photon_map_free(&other);
     rig_free(&r);
@@ -389,7 +351,7 @@ static void scale_invariance(void **state)
         ps_tracer_options o = options(0);
         rig r = rig_make(text, "", &o, PS_ACCEL_OCTREE);
         for (int m = 0; m < PS_MAP_COUNT; m++)
-            maps[k][m] = trace(&r, (ps_map_kind)m, 40000);
+            maps[k][m] = rig_trace(&r, (ps_map_kind)m, 40000);
         rig_free(&r);
     }
     for (int k = 1; k < 3; k++)
@@ -434,7 +396,7 @@ static void skips(void **state)
     const ps_skip *sk = ps_tracer_skips(r.tracer, &n);
     assert_int_equal(n, 1);
     assert_non_null(strstr(sk[0].reason, "spot light 0 (line 5): no specular object inside its emission"));
-    ps_photon_map m = trace(&r, PS_MAP_CAUSTIC, 1000);
+    ps_photon_map m = rig_trace(&r, PS_MAP_CAUSTIC, 1000);
     assert_int_equal(m.count, 0);
     assert_int_equal(m.counters.rays, 0);
     rig_free(&r);
@@ -481,7 +443,7 @@ static void photon_materials(void **state)
     rig r = rig_make(text, "", &o, PS_ACCEL_AUTO);
     int seen[3] = {0, 0, 0};
     for (int k = 0; k < PS_MAP_COUNT; k++) {
-        ps_photon_map m = trace(&r, (ps_map_kind)k, 20000);
+        ps_photon_map m = rig_trace(&r, (ps_map_kind)k, 20000);
         assert_true(m.count > 1000);
         for (size_t i = 0; i < m.count; i++) {
             const float *p = m.photons[i].pos;

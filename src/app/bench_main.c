@@ -461,6 +461,29 @@ static const char *stem(const char *path, char *buf, size_t size)
 
 /* ---- references -------------------------------------------------------------- */
 
+/* Removes the cache's older references of this scene and component (NAME-
+ * COMPONENT-KEY.pfm with another key): a new one replaces them. */
+static void remove_stale(const char *cache, const char *name, const char *component)
+{
+    char prefix[512];
+    snprintf(prefix, sizeof prefix, "%s-%s-", name, component);
+    size_t plen = strlen(prefix);
+    DIR *d = opendir(cache);
+    if (!d)
+        return;
+    for (struct dirent *e; (e = readdir(d)) != NULL;) {
+        size_t len = strlen(e->d_name);
+        /* NAME-COMPONENT- then 16 hex digits and .pfm */
+        if (len == plen + 16 + 4 && strncmp(e->d_name, prefix, plen) == 0 && strcmp(e->d_name + len - 4, ".pfm") == 0 &&
+            strspn(e->d_name + plen, "0123456789abcdef") == 16) {
+            char path[2 * PATH_MAX];
+            snprintf(path, sizeof path, "%s/%s", cache, e->d_name);
+            remove(path);
+        }
+    }
+    closedir(d);
+}
+
 static ps_status scene_photons(const char *scene, int64_t counts[2], ps_error *err)
 {
     ps_scene *s;
@@ -531,6 +554,7 @@ static ps_status reference(bench_state *b, int si, char paths[BENCH_LAYERS][PATH
         snprintf(out, sizeof out, "%s/%s-%s-%016llx.pfm", o->cache, name, components[c], (unsigned long long)key);
         if (!file_exists(out)) {
             all_cached = false;
+            remove_stale(o->cache, name, components[c]);
             printf("  reference %s: %s ...\n", components[c], out);
             fflush(stdout);
             args[n++] = "--hdr";
