@@ -2,7 +2,7 @@
 set datafile separator whitespace
 set logscale xy
 set grid
-set key bottom left font ',8'
+set key top right font ',7' samplen 2 spacing 0.9
 set xlabel 'seconds'
 set ylabel 'relMSE'
 set style line 1 lw 2 dt 1 pt 1
