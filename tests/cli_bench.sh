@@ -100,6 +100,15 @@ if command -v gnuplot >/dev/null 2>&1; then
     [ "$(head -c 8 "$cli_tmp/b/bench.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a ] && ok || bad "no bench.png"
 fi
 [ ! -e "$cli_tmp/b/cache/work/cp.csv" ] && ok || bad "scratch files left behind"
+# --replot: the same tables again from the CSV, running nothing.
+cp "$cli_tmp/b/bench.csv" "$cli_tmp/b.csv"
+expect_success "bench: replot" "$bench" --replot --quick --size 24x24 --budgets 0.05,0.3 --scenes "$cli_tmp/tiny.scn:0.5" \
+    --out "$cli_tmp/b" --bin "$bin"
+cmp -s "$cli_tmp/b/bench.csv" "$cli_tmp/b.csv" && ok || bad "bench: --replot changed the CSV"
+grep -q '^Remade by `photosplat-bench --replot`' "$cli_tmp/b/bench.md" && grep -q '^| triangles float fixed | [0-9.]* @ ' "$cli_tmp/b/bench.md" &&
+    ok || bad "bench: --replot did not remake bench.md"
+expect_usage_error "bench: replot, other budgets" "$bench" --replot --quick --size 24x24 --budgets 0.05 \
+    --scenes "$cli_tmp/tiny.scn:0.5" --out "$cli_tmp/b" --bin "$bin"
 # Again: the references come from the cache; a changed scene renders anew.
 expect_success "bench: cached" "$bench" --quick --size 24x24 --budgets 0.05 --scenes "$cli_tmp/tiny.scn:0.5" \
     --out "$cli_tmp/b" --bin "$bin" --threads 1

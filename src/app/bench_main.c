@@ -59,6 +59,8 @@ static const char usage[] =
     "  --budgets LIST     checkpoint seconds (default 0.05,0.1,0.2,0.5,1,2,5,10)\n"
     "  --quick            the four main configurations only, budgets up to 2 s\n"
     "  --threads N        tracing and rendering threads (default: all cores)\n"
+    "  --replot           run nothing: remake bench.md and the plots from OUT/bench.csv\n"
+    "                     (the scenes and budgets must be the run's)\n"
     "  --help             this text\n"
     "\n"
     "Exit status 0 on success, 2 on bad options or a failed run (one line on stderr).\n";
@@ -138,7 +140,7 @@ typedef struct bench_options {
     double budgets[BENCH_MAX_BUDGETS];
     int budget_count;
     int width, height;
-    bool quick, help;
+    bool quick, help, replot;
     int64_t threads;
     char *scene_text; /* --scenes, split in place: the paths point into it */
 } bench_options;
@@ -238,6 +240,8 @@ static ps_status parse_args(int argc, char **argv, bench_options *o, ps_error *e
             return PS_OK;
         } else if (ps_cli_is(&cli, "--quick")) {
             o->quick = true;
+        } else if (ps_cli_is(&cli, "--replot")) {
+            o->replot = true;
         } else if (ps_cli_is(&cli, "--out")) {
             st = ps_cli_string(&cli, &o->out, err);
         } else if (ps_cli_is(&cli, "--cache")) {
@@ -797,21 +801,29 @@ static ps_status write_markdown(const bench_state *b, const char *path, double t
     strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", gmtime(&now));
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     fprintf(fp, "# Run time against error (photosplat-bench)\n\n");
-    fprintf(fp, "Made by `%s` on %s, %ld cores, %dx%d images, in %.0f s. Error: relMSE against the converged "
+    if (o->replot)
+        fprintf(fp, "Remade by `%s --replot` on %s from bench.csv (%dx%d images); the run's own date, length and "
+                    "reference times are not in the CSV. ",
+                PROG, date, o->width, o->height);
+    else
+        fprintf(fp, "Made by `%s` on %s, %ld cores, %dx%d images, in %.0f s. ", PROG, date, cores, o->width,
+                o->height, total);
+    fprintf(fp, "Error: relMSE against the converged "
                 "reference (photosplat-ref, per component), both images clamped to the display's white "
                 "(1/exposure). Seconds: photosplat-snap's clock from start to the checkpoint's frame, "
                 "including loading, tracing and drawing. `whole` is the picture against the reference's direct, "
                 "caustic and indirect terms (what the preview draws); `caustic`, `global` and `direct` each layer "
                 "alone against the caustic, indirect and direct terms; `full` the picture against the whole "
                 "reference, where mirrors and glass also show what they reflect and refract, which the preview "
-                "draws black: its floor is the price of that.\n\n",
-            PROG, date, cores, o->width, o->height, total);
+                "draws black: its floor is the price of that.\n\n");
     for (int si = 0; si < o->scene_count; si++) {
         char name[256];
         fprintf(fp, "## %s (exposure %g)\n\n", stem(o->scenes[si].path, name, sizeof name), o->scenes[si].exposure);
-        fprintf(fp, "Reference: %s, %.0f s.\n\n", b->ref_cached[si] ? "from the cache" : "rendered",
-                b->ref_seconds[si]);
-        fprintf(fp, "Whole-image relMSE at each checkpoint (requested seconds):\n\n| configuration |");
+        if (!o->replot)
+            fprintf(fp, "Reference: %s, %.0f s.\n\n", b->ref_cached[si] ? "from the cache" : "rendered",
+                    b->ref_seconds[si]);
+        fprintf(fp, "Whole-image relMSE at each checkpoint, headed by the seconds asked for; each cell says when "
+                    "the frame it shows was done (a frame of millions of splats takes seconds):\n\n| configuration |");
         for (int i = 0; i < o->budget_count; i++)
             fprintf(fp, " %g s |", o->budgets[i]);
         double last = o->budgets[o->budget_count - 1];
@@ -830,7 +842,7 @@ static ps_status write_markdown(const bench_state *b, const char *path, double t
             for (int i = 0; i < o->budget_count; i++) {
                 r = find_row(b, si, c, i);
                 if (r)
-                    fprintf(fp, " %.4f |", r->relmse[0]);
+                    fprintf(fp, " %.4f @ %.1f s |", r->relmse[0], r->seconds);
                 else
                     fprintf(fp, " |");
             }
@@ -957,6 +969,61 @@ static ps_status write_results(bench_state *b, double total, ps_error *err)
     return run_checked(args, NULL, 0, err);
 }
 
+/* bench.csv back into rows (write_csv's columns), for --replot. */
+static ps_status read_csv(bench_state *b, const char *path, ps_error *err)
+{
+    const bench_options *o = b->o;
+    char *text;
+    size_t len;
+    ps_status st = ps_read_file(path, 1u << 28, &text, &len, err);
+    if (st != PS_OK)
+        return st;
+    int line = 1;
+    for (char *save = NULL, *row = strtok_r(text, "\n", &save); row && st == PS_OK; row = strtok_r(NULL, "\n", &save)) {
+        if (line++ == 1)
+            continue; /* the header */
+        char scene[256], splat[32], buffer[32], precision[32], schedule[32];
+        bench_row r;
+        memset(&r, 0, sizeof r);
+        unsigned long long ce, ge;
+        int used = 0;
+        if (sscanf(row, "%255[^,],%31[^,],%31[^,],%31[^,],%31[^,],%d,%lf,%lf,%llu,%llu,%lf,%lf%n", scene, splat, buffer,
+                   precision, schedule, &r.checkpoint, &r.requested, &r.seconds, &ce, &ge, &r.radius[0], &r.radius[1],
+                   &used) != 12) {
+            st = ps_error_set(err, PS_ERR_PARSE, "%s:%d: not a bench.csv row", path, line - 1);
+            break;
+        }
+        r.emitted[0] = ce;
+        r.emitted[1] = ge;
+        const char *p = row + used;
+        for (int l = 0; l < BENCH_LAYERS && st == PS_OK; l++) {
+            int n = 0;
+            if (sscanf(p, ",%lf,%lf%n", &r.rmse[l], &r.relmse[l], &n) != 2)
+                st = ps_error_set(err, PS_ERR_PARSE, "%s:%d: missing errors", path, line - 1);
+            p += n;
+        }
+        r.scene = r.config = -1;
+        for (int si = 0; si < o->scene_count; si++) {
+            char name[256];
+            if (strcmp(stem(o->scenes[si].path, name, sizeof name), scene) == 0)
+                r.scene = si;
+        }
+        for (size_t c = 0; c < BENCH_CONFIGS; c++) {
+            const bench_config *k = &configs[c];
+            if (!strcmp(k->splat, splat) && !strcmp(strcmp(k->depth, "float") == 0 ? "float" : "8-bit", buffer) &&
+                !strcmp(k->precision, precision) && !strcmp(k->schedule, schedule))
+                r.config = (int)c;
+        }
+        if (st == PS_OK && (r.scene < 0 || r.config < 0 || r.checkpoint < 0 || r.checkpoint >= o->budget_count))
+            st = ps_error_set(err, PS_ERR_PARSE, "%s:%d: a scene, configuration or checkpoint this run does not have",
+                              path, line - 1);
+        if (st == PS_OK)
+            st = add_row(b, &r, err);
+    }
+    free(text);
+    return st;
+}
+
 /* ---- main --------------------------------------------------------------------- */
 
 static ps_status run(bench_state *b, ps_error *err)
@@ -1041,7 +1108,15 @@ int main(int argc, char **argv)
         b.self_dir[n] = '\0';
         *strrchr(b.self_dir, '/') = '\0';
     }
-    st = run(&b, &err);
+    if (o.replot) {
+        char path[PATH_MAX + 16];
+        snprintf(path, sizeof path, "%s/bench.csv", o.out);
+        st = read_csv(&b, path, &err);
+        if (st == PS_OK)
+            st = write_results(&b, 0.0, &err);
+    } else {
+        st = run(&b, &err);
+    }
     free(b.rows);
     free(o.scene_text);
     if (st != PS_OK)
