@@ -645,10 +645,12 @@ static ps_status add_mesh_lights(parser *p, const ps_object *o, uint32_t object,
         l->radiance = mat->emission;
         /* A one-sided Lambertian emitter of radiance L emits pi * L per unit area. */
         l->power = ps_rgb_scale(mat->emission, PS_PI * area);
-        if (!(ps_rgb_max(l->power) <= PS_SCENE_MAX_LIGHT_POWER))
-            return ps_error_set(p->err, PS_ERR_RANGE,
-                                "%s:%d: mesh: its emitting faces' power %g W is above the %g W a light may have",
-                                p->name, p->line, ps_rgb_max(l->power), PS_SCENE_MAX_LIGHT_POWER);
+        if (!(ps_rgb_max(l->power) <= PS_SCENE_MAX_LIGHT_POWER)) {
+            st = ps_error_set(p->err, PS_ERR_RANGE,
+                              "%s:%d: mesh: its emitting faces' power %g W is above the %g W a light may have",
+                              p->name, p->line, ps_rgb_max(l->power), PS_SCENE_MAX_LIGHT_POWER);
+            break; /* through the frees below */
+        }
         l->position = ps_aabb_center(o->bounds);
     }
     free(done);
