@@ -429,11 +429,11 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
             draw_frame(&s);
         first_frame = ps_now_seconds() - t_start;
     } else if (st == PS_OK) {
-        /* Progressive: trace in the background, refresh every tau. Time
-         * spent writing checkpoints is taken off the clock (the tracer is
-         * held meanwhile), so they measure the preview, not the bench. */
-        /* As the window: the first round traced here, so that the first
-         * frame already shows photons (the rest come in the background). */
+        /* Progressive: trace in the background, refresh every tau. As in
+         * the window, the first round is traced here, so that the first
+         * frame already shows photons. Time spent writing checkpoints is
+         * taken off the clock (the tracer is held between batches
+         * meanwhile), so they measure the preview, not the bench. */
         st = ps_feed_prime(feed, err);
         if (st == PS_OK)
             st = ps_feed_start(feed, err);
@@ -465,10 +465,16 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
             if (first_frame < 0.0)
                 first_frame = now - t_start;
             if (cp < o->checkpoint_count && now - t_start - excluded >= o->checkpoints[cp]) {
+                /* This frame is the first done at or after every checkpoint
+                 * time it passed: each of them shows it. */
                 ps_feed_pause(feed, true);
-                st = write_checkpoint(&s, cp, now - t_start - excluded, &rows[cp], err);
+                double at = now - t_start - excluded;
+                for (int first = cp; st == PS_OK && cp < o->checkpoint_count && at >= o->checkpoints[cp]; cp++) {
+                    if (cp > first)
+                        draw_frame(&s); /* the layers of the last one overwrote it */
+                    st = write_checkpoint(&s, cp, at, &rows[cp], err);
+                }
                 ps_feed_pause(feed, false);
-                cp++;
                 double spent = ps_now_seconds() - now;
                 excluded += spent;
                 next += spent;
