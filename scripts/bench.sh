@@ -9,57 +9,38 @@ cd "$(dirname "$0")/.."
 
 status=0
 found=0
+# step NAME CMD...: one more benchmark, timed; a failure is reported and
+# remembered, the others still run.
+step() {
+    local name=$1 start=$SECONDS
+    shift
+    echo "== $name"
+    if ! "$@"; then
+        echo "== $name: FAILED" >&2
+        status=1
+    fi
+    echo "== $name: $((SECONDS - start)) s"
+    echo
+}
 for b in build/release/bench/bench_*; do
     [ -x "$b" ] || continue
     case "$b" in *.d) continue ;; esac
     found=1
-    echo "== $(basename "$b")"
-    start=$SECONDS
-    if ! "$b"; then
-        echo "== $(basename "$b"): FAILED" >&2
-        status=1
-    fi
-    echo "== $(basename "$b"): $((SECONDS - start)) s"
-    echo
+    step "$(basename "$b")" "$b"
 done
 # photosplat-ref against POV-Ray on the default scene. It takes about ten
 # minutes until its references are cached (bench/results/cache), a few after;
 # PS_BENCH_REF=0 skips it.
-if [ "${PS_BENCH_REF:-1}" != 0 ]; then
-    echo "== bench-ref"
-    start=$SECONDS
-    if ! scripts/bench-ref.sh; then
-        echo "== bench-ref: FAILED" >&2
-        status=1
-    fi
-    echo "== bench-ref: $((SECONDS - start)) s"
-    echo
-fi
+[ "${PS_BENCH_REF:-1}" != 0 ] && step bench-ref scripts/bench-ref.sh
 # The preview's error against time on the four bench scenes (photosplat-bench):
-# bench/results/bench.{csv,md,png}. About 25 minutes on 2 cores with its
-# references cached, 10 more without; PS_BENCH_QUICK=1 runs its --quick
-# subset, PS_BENCH_PREVIEW=0 skips it.
-if [ "${PS_BENCH_PREVIEW:-1}" != 0 ]; then
-    echo "== photosplat-bench"
-    start=$SECONDS
-    quick=()
-    [ "${PS_BENCH_QUICK:-0}" != 0 ] && quick=(--quick)
-    if ! bin/photosplat-bench "${quick[@]}"; then
-        echo "== photosplat-bench: FAILED" >&2
-        status=1
-    fi
-    echo "== photosplat-bench: $((SECONDS - start)) s"
-    echo
-fi
+# bench/results/bench.{csv,md,png}. 22 minutes on 2 cores with its references
+# rendered (4 of those minutes); PS_BENCH_QUICK=1 runs its --quick subset,
+# PS_BENCH_PREVIEW=0 skips it.
+quick=()
+[ "${PS_BENCH_QUICK:-0}" != 0 ] && quick=(--quick)
+[ "${PS_BENCH_PREVIEW:-1}" != 0 ] && step photosplat-bench bin/photosplat-bench "${quick[@]}"
 # The window's frames per second and edit latency, under Xvfb.
-echo "== bench-window"
-start=$SECONDS
-if ! scripts/bench-window.sh; then
-    echo "== bench-window: FAILED" >&2
-    status=1
-fi
-echo "== bench-window: $((SECONDS - start)) s"
-echo
+step bench-window scripts/bench-window.sh
 if [ "$found" -eq 0 ]; then
     echo "bench: no programs under build/release/bench (run make bench)" >&2
     exit 2

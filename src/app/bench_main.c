@@ -73,6 +73,8 @@ enum {
      * included, which the preview does not draw. */
     BENCH_LAYERS = 5,
     BENCH_PLOTTED_LAYERS = 4,
+    /* A child's exit status when it could not be started (the shell's). */
+    BENCH_EXEC_FAILED = 127,
     BENCH_COMPONENTS = 4,
     /* A scene and the meshes it names are hashed whole up to this size. */
     BENCH_MAX_HASHED = 1 << 30,
@@ -165,27 +167,6 @@ typedef struct bench_state {
 
 /* ---- options ----------------------------------------------------------------- */
 
-static ps_status parse_list(const char *text, const char *what, double lo, double hi, double *out, int max, int *count,
-                            ps_error *err)
-{
-    *count = 0;
-    for (const char *p = text;;) {
-        char *end;
-        double v = strtod(p, &end);
-        if (end == p || !(v >= lo && v <= hi) || (*end != ',' && *end != '\0'))
-            return ps_error_set(err, PS_ERR_PARSE, "%s: %s: '%s' is not a comma list of numbers in [%g, %g]", PROG,
-                                what, text, lo, hi);
-        if (*count == max)
-            return ps_error_set(err, PS_ERR_PARSE, "%s: %s: more than %d values", PROG, what, max);
-        if (*count > 0 && v <= out[*count - 1])
-            return ps_error_set(err, PS_ERR_PARSE, "%s: %s: values must ascend ('%s')", PROG, what, text);
-        out[(*count)++] = v;
-        if (*end == '\0')
-            return PS_OK;
-        p = end + 1;
-    }
-}
-
 /* "a.scn:0.3,b.scn": the text is the program's argument and outlives us, but
  * is split in place, so it is copied first. */
 static ps_status parse_scenes(const char *text, bench_options *o, ps_error *err)
@@ -257,9 +238,7 @@ static ps_status parse_args(int argc, char **argv, bench_options *o, ps_error *e
             if (st == PS_OK)
                 st = parse_scenes(text, o, err);
         } else if (ps_cli_is(&cli, "--budgets")) {
-            st = ps_cli_string(&cli, &text, err);
-            if (st == PS_OK)
-                st = parse_list(text, "--budgets", 1e-3, 1e5, o->budgets, BENCH_MAX_BUDGETS, &o->budget_count, err);
+            st = ps_cli_ascending(&cli, 1e-3, 1e5, o->budgets, BENCH_MAX_BUDGETS, &o->budget_count, err);
             budgets_given = true;
         } else if (ps_cli_positional(&cli)) {
             return ps_error_set(err, PS_ERR_PARSE, "%s: unexpected argument '%s' (see --help)", PROG, ps_cli_arg(&cli));
@@ -293,8 +272,8 @@ static int run_program(char *const argv[], char *out, size_t size)
         dup2(fd[1], STDOUT_FILENO);
         close(fd[0]);
         close(fd[1]);
-        execv(argv[0], argv);
-        _exit(127);
+        execvp(argv[0], argv); /* a path, or a program on PATH (gnuplot) */
+        _exit(BENCH_EXEC_FAILED);
     }
     close(fd[1]);
     size_t used = 0;
@@ -960,13 +939,13 @@ static ps_status write_results(bench_state *b, double total, ps_error *err)
         st = write_plots(b, path, err);
     if (st != PS_OK)
         return st;
-    char gnuplot[] = "/usr/bin/gnuplot";
-    if (access(gnuplot, X_OK) != 0) {
+    char *args[] = {"gnuplot", path, NULL};
+    int rc = run_program(args, NULL, 0);
+    if (rc == BENCH_EXEC_FAILED) {
         printf("gnuplot is not installed (Debian: gnuplot-nox): plots not drawn; %s is ready for it\n", path);
         return PS_OK;
     }
-    char *args[] = {gnuplot, path, NULL};
-    return run_checked(args, NULL, 0, err);
+    return rc == 0 ? PS_OK : ps_error_set(err, PS_ERR_IO, "%s: gnuplot %s failed (exit status %d)", PROG, path, rc);
 }
 
 /* bench.csv back into rows (write_csv's columns), for --replot. */

@@ -175,3 +175,28 @@ int ps_cli_fail(const ps_error *err)
      * does not fit in memory) is status 2, as the contract says. */
     return PS_EXIT_USAGE;
 }
+
+ps_status ps_cli_ascending(ps_cli *cli, double lo, double hi, double *out, int max, int *count, ps_error *err)
+{
+    int n;
+    const char *opt, *s;
+    ps_status st = fetch(cli, &n, &opt, &s, err);
+    if (st != PS_OK)
+        return st;
+    *count = 0;
+    for (const char *p = s;;) {
+        char *end;
+        double v = strtod(p, &end);
+        if (end == p || !(v >= lo && v <= hi) || (*end != ',' && *end != '\0'))
+            return ps_error_set(err, PS_ERR_PARSE, "%s: option %.*s: '%s' is not a comma list of numbers in [%g, %g]",
+                                cli->prog, n, opt, s, lo, hi);
+        if (*count == max)
+            return ps_error_set(err, PS_ERR_PARSE, "%s: option %.*s: more than %d values", cli->prog, n, opt, max);
+        if (*count > 0 && v <= out[*count - 1])
+            return ps_error_set(err, PS_ERR_PARSE, "%s: option %.*s: values must ascend ('%s')", cli->prog, n, opt, s);
+        out[(*count)++] = v;
+        if (*end == '\0')
+            return PS_OK;
+        p = end + 1;
+    }
+}

@@ -42,6 +42,9 @@ ps_status ps_cli_int(ps_cli *cli, int64_t lo, int64_t hi, int64_t *out, ps_error
 ps_status ps_cli_choice(ps_cli *cli, const char *const *choices, int *out, ps_error *err);
 /* WxH with each side in [1, max_side]. */
 ps_status ps_cli_size(ps_cli *cli, int max_side, int *w, int *h, ps_error *err);
+/* A comma list of 1..max strictly ascending numbers in [lo, hi] ("0.1,0.5,2"),
+ * into out[0..*count). */
+ps_status ps_cli_ascending(ps_cli *cli, double lo, double hi, double *out, int max, int *count, ps_error *err);
 
 /* Sets err for the current argument being unknown. */
 ps_status ps_cli_unknown(const ps_cli *cli, ps_error *err);

@@ -86,29 +86,6 @@ typedef struct snap_options {
  * is OSMesa's 24-bit depth + 8-bit stencil, the float read-back and the image. */
 #define SNAP_PIXEL_BYTES (4 + 2 * 3 * sizeof(float))
 
-/* "0.1,0.5,2": ascending times within --time's range. */
-static ps_status parse_checkpoints(const char *text, snap_options *o, ps_error *err)
-{
-    const char *p = text;
-    o->checkpoint_count = 0;
-    for (;;) {
-        char *end;
-        double t = strtod(p, &end);
-        if (end == p || !(t >= 1e-3 && t <= 1e6) || (*end != ',' && *end != '\0'))
-            return ps_error_set(err, PS_ERR_PARSE,
-                                "photosplat-snap: --checkpoints: '%s' is not a comma list of seconds in [0.001, 1e6]", text);
-        if (o->checkpoint_count == SNAP_MAX_CHECKPOINTS)
-            return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --checkpoints: more than %d times",
-                                SNAP_MAX_CHECKPOINTS);
-        if (o->checkpoint_count > 0 && t <= o->checkpoints[o->checkpoint_count - 1])
-            return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --checkpoints: times must ascend ('%s')", text);
-        o->checkpoints[o->checkpoint_count++] = t;
-        if (*end == '\0')
-            return PS_OK;
-        p = end + 1;
-    }
-}
-
 static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, ps_error *err)
 {
     ps_cli cli = ps_cli_begin("photosplat-snap", argc, argv);
@@ -131,10 +108,7 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
         } else if (ps_cli_is(&cli, "--checkpoint-prefix")) {
             st = ps_cli_string(&cli, &o->checkpoint_prefix, err);
         } else if (ps_cli_is(&cli, "--checkpoints")) {
-            const char *text;
-            st = ps_cli_string(&cli, &text, err);
-            if (st == PS_OK)
-                st = parse_checkpoints(text, o, err);
+            st = ps_cli_ascending(&cli, 1e-3, 1e6, o->checkpoints, SNAP_MAX_CHECKPOINTS, &o->checkpoint_count, err);
         } else {
             return ps_cli_unknown(&cli, err);
         }
@@ -237,17 +211,21 @@ static void draw_frame(snap_run *s)
     s->splat_seconds += ps_now_seconds() - t0;
 }
 
-/* The colour buffer as linear radiance: it holds radiance times exposure. */
-static ps_status read_radiance(snap_run *s, ps_image *img, ps_error *err)
+/* The colour buffer holds radiance times exposure: back to radiance. */
+static void to_radiance(const snap_run *s, ps_image *img)
 {
-    ps_status st = ps_gl_read(s->gl, img, err);
-    if (st != PS_OK)
-        return st;
     float inv = s->o->c.exposure > 0.0 ? (float)(1.0 / s->o->c.exposure) : 0.0f;
     size_t n = 3 * (size_t)img->width * (size_t)img->height;
     for (size_t i = 0; i < n; i++)
         img->rgb[i] *= inv;
-    return PS_OK;
+}
+
+static ps_status read_radiance(snap_run *s, ps_image *img, ps_error *err)
+{
+    ps_status st = ps_gl_read(s->gl, img, err);
+    if (st == PS_OK)
+        to_radiance(s, img);
+    return st;
 }
 
 static ps_status write_radiance(snap_run *s, const char *path, ps_error *err)
@@ -292,10 +270,7 @@ static ps_status write_outputs(snap_run *s, ps_error *err)
     if (o->c.out_png)
         st = ps_png_write(&img, o->c.out_png, 1.0f, err);
     if (st == PS_OK && o->c.out_hdr) {
-        float inv = o->c.exposure > 0.0 ? (float)(1.0 / o->c.exposure) : 0.0f;
-        size_t n = 3 * (size_t)img.width * (size_t)img.height;
-        for (size_t i = 0; i < n; i++)
-            img.rgb[i] *= inv;
+        to_radiance(s, &img);
         st = ps_pfm_write(&img, o->c.out_hdr, err);
     }
     ps_image_destroy(&img);
