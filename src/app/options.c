@@ -111,13 +111,6 @@ ps_status ps_check_run_memory(const char *prog, uint64_t photons, uint64_t photo
     return ps_memory_check(total, prog, what, err);
 }
 
-double ps_now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 void ps_preview_options_init(ps_preview_options *o, bool float_depth)
 {
     memset(o, 0, sizeof *o);

@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "app/cli.h"
+#include "core/clock.h"
 #include "core/status.h"
 #include "photon/tracer.h"
 
@@ -91,8 +92,5 @@ uint64_t ps_photon_cap(int maps, uint64_t bytes_each);
  * not fit in the memory budget, before anything is allocated. */
 ps_status ps_check_run_memory(const char *prog, uint64_t photons, uint64_t photon_bytes, int width, int height,
                               uint64_t pixel_bytes, ps_error *err);
-
-/* Seconds on a monotonic clock. */
-double ps_now_seconds(void);
 
 #endif

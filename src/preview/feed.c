@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "core/array.h"
+#include "core/clock.h"
 
 struct ps_feed {
     ps_tracer *tracer;
@@ -28,13 +29,6 @@ struct ps_feed {
     ps_error err;
     double seconds;
 };
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const bool active[PS_MAP_COUNT],
                          ps_feed **out, ps_error *err)
@@ -111,7 +105,7 @@ static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
 static void *feed_main(void *arg)
 {
     ps_feed *f = arg;
-    double t0 = now();
+    double t0 = ps_now_seconds();
     ps_status st = f->status;
     ps_error err = f->err;
     bool more = st == PS_OK && !f->ended;
@@ -129,21 +123,21 @@ static void *feed_main(void *arg)
     f->status = st;
     f->err = err;
     f->ended = true;
-    f->seconds += now() - t0;
+    f->seconds += ps_now_seconds() - t0;
     pthread_mutex_unlock(&f->lock);
     return NULL;
 }
 
 ps_status ps_feed_prime(ps_feed *f, ps_error *err)
 {
-    double t0 = now();
+    double t0 = ps_now_seconds();
     ps_status st = PS_OK;
     ps_error_clear(&f->err);
     bool more = round_once(f, &st, &f->err);
     pthread_mutex_lock(&f->lock);
     f->status = st;
     f->ended = !more;
-    f->seconds += now() - t0;
+    f->seconds += ps_now_seconds() - t0;
     pthread_mutex_unlock(&f->lock);
     if (st != PS_OK && err)
         *err = f->err;
