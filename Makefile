@@ -39,7 +39,9 @@ LDOPT_asan := -fsanitize=address,undefined
 # notes). GL_PROGS lists the OSMesa programs, GL tests are tests/test_gl*.c.
 LIB_C := $(filter-out src/app/%_main.c src/gl/%,$(wildcard src/*/*.c))
 LIB_CXX := $(wildcard src/*/*.cpp)
-GL_C := $(wildcard src/gl/*.c)
+# src/gl/platform_*.c are the context backends (platform.h): each program
+# links one, platform_osmesa with OSMesa, platform_glfw with GLFW and libGL.
+GL_C := $(filter-out src/gl/platform_%.c,$(wildcard src/gl/*.c))
 MAINS := $(wildcard src/app/*_main.c)
 # window_main.c is the preview window, bin/photosplat; every other NAME_main.c
 # is bin/photosplat-NAME.
@@ -77,12 +79,15 @@ $$(GLLIB_$(1)): $$(GLOBJ_$(1))
 build/$(1)/obj/gl/%.o: src/gl/%.c
 	@mkdir -p $$(@D)
 	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc $$(OSMESA_CFLAGS) -MMD -MP -c $$< -o $$@
-build/$(1)/bin/photosplat-snap: build/$(1)/obj/app/snap_main.o $$(GLLIB_$(1)) $$(LIB_$(1))
+build/$(1)/bin/photosplat-snap: build/$(1)/obj/app/snap_main.o build/$(1)/obj/gl/platform_osmesa.o $$(GLLIB_$(1)) $$(LIB_$(1))
 	@mkdir -p $$(@D)
 	$$(CC) $$(LDOPT_$(1)) $$^ -o $$@ $$(OSMESA_LIBS) $$(LIBS)
-build/$(1)/bin/photosplat: build/$(1)/obj/app/window_main.o $$(GLLIB_$(1)) $$(LIB_$(1))
+build/$(1)/bin/photosplat: build/$(1)/obj/app/window_main.o build/$(1)/obj/gl/platform_glfw.o $$(GLLIB_$(1)) $$(LIB_$(1))
 	@mkdir -p $$(@D)
 	$$(CC) $$(LDOPT_$(1)) $$^ -o $$@ $$(WINDOW_LIBS) $$(LIBS)
+build/$(1)/obj/gl/platform_glfw.o: src/gl/platform_glfw.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc $$(PKG_CFLAGS) $$(WINDOW_CFLAGS) -MMD -MP -c $$< -o $$@
 build/$(1)/obj/app/window_main.o: src/app/window_main.c
 	@mkdir -p $$(@D)
 	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc $$(PKG_CFLAGS) $$(WINDOW_CFLAGS) -MMD -MP -c $$< -o $$@
@@ -98,7 +103,7 @@ build/$(1)/bin/photosplat-%: build/$(1)/obj/app/%_main.o $$(LIB_$(1))
 build/$(1)/tests/%: tests/%.c $$(LIB_$(1))
 	@mkdir -p $$(@D)
 	$$(CC) $$(CSTD) $$(WARN) $$(OPT_$(1)) -Isrc -Itests $$(TEST_CFLAGS) -MMD -MP $$< -o $$@ $$(LDOPT_$(1)) $$(LIB_$(1)) $$(TEST_LIBS) $$(LIBS)
--include $$(OBJ_$(1):.o=.d) $$(GLOBJ_$(1):.o=.d) $$(patsubst src/%.c,build/$(1)/obj/%.d,$$(MAINS)) $$(patsubst %,build/$(1)/tests/%.d,$$(TESTS))
+-include $$(OBJ_$(1):.o=.d) $$(GLOBJ_$(1):.o=.d) build/$(1)/obj/gl/platform_osmesa.d build/$(1)/obj/gl/platform_glfw.d $$(patsubst src/%.c,build/$(1)/obj/%.d,$$(MAINS)) $$(patsubst %,build/$(1)/tests/%.d,$$(TESTS))
 endef
 $(eval $(call variant-rules,release))
 $(eval $(call variant-rules,asan))

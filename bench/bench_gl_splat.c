@@ -29,6 +29,7 @@
  * llvmpipe rasterises on every core while the build runs on one. */
 #include <GL/osmesa.h>
 #include <stdio.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -68,7 +69,8 @@ typedef struct bench_gl {
     OSMesaContext ctx;
     ps_world *world;
     ps_tracer *tracer;
-    ps_preview_mesh mesh;
+    ps_preview_mesh mesh, coarse;
+    ps_preview_lights lights;
     ps_kernel_texture kernel;
     ps_gl_renderer *gl;
     ps_camera_frame cam;
@@ -208,7 +210,14 @@ static int first_picture_run(bench_gl *g, double t[STAGE_COUNT], double warm[3],
         goto done;
     STAGE();
     ps_gl_options gopt = {true, false, 0};
-    if (ps_gl_renderer_create(g->scene, &g->mesh, &g->kernel, &gopt, &g->gl, err) != PS_OK)
+    mopt.max_edge = HUGE_VAL;
+    if (ps_preview_mesh_build(g->scene, &mopt, &g->coarse, err) != PS_OK)
+        goto done;
+    if (ps_preview_lights_build(g->scene, &g->coarse, PS_GL_SHADOW_SIZE, &g->lights, err) != PS_OK)
+        goto done;
+    size_t nmat;
+    ps_gl_scene gs = {&g->mesh, &g->coarse, ps_scene_materials(g->scene, &nmat), &g->lights, ps_scene_bounds(g->scene)};
+    if (ps_gl_renderer_create(&gs, &g->kernel, &gopt, &g->gl, err) != PS_OK)
         goto done;
     glFinish();
     STAGE();
@@ -479,6 +488,8 @@ static void bench_gl_free(bench_gl *g)
     ps_gl_renderer_destroy(g->gl);
     ps_kernel_texture_free(&g->kernel);
     ps_preview_mesh_free(&g->mesh);
+    ps_preview_mesh_free(&g->coarse);
+    ps_preview_lights_free(&g->lights);
     ps_tracer_destroy(g->tracer);
     ps_world_destroy(g->world);
     if (g->ctx)

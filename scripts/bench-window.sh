@@ -26,16 +26,17 @@ orbit_lines() { # an orbit step every 0.05 s for 4 s, then quit
     echo "4.6 quit"
 }
 
-echo "| photons (caustic + global) | view | fps | frames | emitted by the end |"
-echo "| ---: | --- | ---: | ---: | ---: |"
+echo "| photons (caustic + global) | view | fps | frames | emitted by the end | composite ms |"
+echo "| ---: | --- | ---: | ---: | ---: | ---: |"
 for n in 100000 1000000; do
     run still-$n $n "4.5 quit"
     mapfile -t lines < <(orbit_lines)
     run orbit-$n $n "${lines[@]}"
     for view in still orbit; do
         f=$tmp/$view-$n.json
-        printf '| %d + %d | %s | %.1f | %s | %s |\n' $n $((n / 4)) "$view" "$(stat_of fps "$f")" "$(stat_of frames "$f")" \
-            "$(($(stat_of emitted_caustic "$f") + $(stat_of emitted_global "$f")))"
+        printf '| %d + %d | %s | %.1f | %s | %s | %.2f |\n' $n $((n / 4)) "$view" "$(stat_of fps "$f")" "$(stat_of frames "$f")" \
+            "$(($(stat_of emitted_caustic "$f") + $(stat_of emitted_global "$f")))" \
+            "$(awk -v s="$(stat_of composite_seconds_mean "$f")" 'BEGIN { print 1000 * s }')"
     done
 done
 echo

@@ -7,6 +7,7 @@
 #include "analytic.h"
 
 #include <GL/osmesa.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -25,7 +26,8 @@ typedef struct preview {
     ps_scene *scene;
     ps_world *world;
     ps_tracer *tracer;
-    ps_preview_mesh mesh;
+    ps_preview_mesh mesh, coarse;
+    ps_preview_lights lights;
     ps_kernel_texture kernel;
     OSMesaContext ctx;
     float *buffer;
@@ -48,6 +50,8 @@ static void preview_make(preview *out, const char *text, int w, int h, ps_kernel
     assert_int_equal(ps_tracer_create(p.world, &o, &p.tracer, &err), PS_OK);
     ps_mesh_options mo = ps_mesh_default_options(p.scene);
     assert_int_equal(ps_preview_mesh_build(p.scene, &mo, &p.mesh, &err), PS_OK);
+    mo.max_edge = HUGE_VAL;
+    assert_int_equal(ps_preview_mesh_build(p.scene, &mo, &p.coarse, &err), PS_OK);
     assert_int_equal(ps_kernel_texture_make(kernel, PS_KERNEL_TEXTURE_SIZE, &p.kernel, &err), PS_OK);
     p.w = w;
     p.h = h;
@@ -57,7 +61,10 @@ static void preview_make(preview *out, const char *text, int w, int h, ps_kernel
     assert_true(OSMesaMakeCurrent(p.ctx, p.buffer, GL_FLOAT, w, h));
     ps_gl_options go = {true, true, 0};
     *pp = p;
-    assert_int_equal(ps_gl_renderer_create(pp->scene, &pp->mesh, &pp->kernel, &go, &pp->gl, &err), PS_OK);
+    assert_int_equal(ps_preview_lights_build(pp->scene, &pp->coarse, PS_GL_SHADOW_SIZE, &pp->lights, &err), PS_OK);
+    size_t nmat;
+    ps_gl_scene gs = {&pp->mesh, &pp->coarse, ps_scene_materials(pp->scene, &nmat), &pp->lights, ps_scene_bounds(pp->scene)};
+    assert_int_equal(ps_gl_renderer_create(&gs, &pp->kernel, &go, &pp->gl, &err), PS_OK);
     pp->cam = ps_camera_frame_make(ps_scene_camera(pp->scene), w, h);
 }
 
@@ -68,6 +75,8 @@ static void preview_free(preview *p)
     free(p->buffer);
     ps_kernel_texture_free(&p->kernel);
     ps_preview_mesh_free(&p->mesh);
+    ps_preview_mesh_free(&p->coarse);
+    ps_preview_lights_free(&p->lights);
     ps_tracer_destroy(p->tracer);
     ps_world_destroy(p->world);
     ps_scene_destroy(p->scene);

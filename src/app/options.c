@@ -127,12 +127,31 @@ void ps_preview_options_init(ps_preview_options *o, bool float_depth)
     o->radius_alpha = PS_RADIUS_ALPHA_DEFAULT;
 }
 
-double ps_preview_radius(const ps_preview_options *o, double r0, const ps_scene_defaults *d, ps_map_kind k,
-                         uint64_t cap, uint64_t emitted)
+ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_preview_options *o, const ps_scene *s)
 {
-    int64_t scene_n = k == PS_MAP_CAUSTIC ? d->caustic_photons : d->global_photons;
-    uint64_t n0 = scene_n > 0 ? (uint64_t)scene_n : cap;
-    return ps_splat_radius_at((ps_radius_schedule)o->radius_schedule, r0, n0, emitted, o->radius_alpha);
+    const ps_scene_defaults *d = ps_scene_get_defaults(s);
+    ps_session_settings set = ps_session_default_settings(s);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        set.caps[k] = ps_shared_photons(c, d, (ps_map_kind)k);
+        set.radius[k] = ps_shared_radius(c, d, (ps_map_kind)k);
+    }
+    set.seed = (uint64_t)c->seed;
+    set.threads = (int)c->threads;
+    set.max_map_photons = ps_photon_cap(PS_PREVIEW_MAPS, PS_PREVIEW_PHOTON_BYTES);
+    set.layers = o->layers;
+    set.splat = (ps_splat_mode)o->splat;
+    set.kernel = (ps_kernel)o->kernel;
+    set.point_size = o->point_size;
+    set.float_buffer = o->color_depth != 0;
+    set.precision = (ps_precision)o->precision;
+    set.counter_threshold = o->counter_threshold;
+    set.stencil_clip = o->stencil_clip != 0;
+    set.radius_schedule = (ps_radius_schedule)o->radius_schedule;
+    set.radius_alpha = o->radius_alpha;
+    set.exposure = c->exposure;
+    set.tau = o->tau;
+    set.shadow_size = o->shadows ? PS_SHADOW_SIZE_DEFAULT : 0;
+    return set;
 }
 
 ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_error *err)

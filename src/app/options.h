@@ -10,6 +10,7 @@
 #include "core/clock.h"
 #include "core/status.h"
 #include "photon/tracer.h"
+#include "preview/session.h"
 
 typedef struct ps_shared_options {
     const char *scene, *out_png, *out_hdr, *stats, *dump;
@@ -32,8 +33,8 @@ bool ps_shared_option(ps_cli *cli, const char *prog, ps_shared_options *o, ps_st
 uint64_t ps_shared_photons(const ps_shared_options *o, const ps_scene_defaults *d, ps_map_kind k);
 double ps_shared_radius(const ps_shared_options *o, const ps_scene_defaults *d, ps_map_kind k);
 
-/* The preview's options, shared by photosplat-snap and the window. */
-enum { PS_LAYER_DIRECT = 1, PS_LAYER_CAUSTIC = 2, PS_LAYER_GLOBAL = 4, PS_LAYER_ALL = 7 };
+/* The preview's options, shared by photosplat-snap and the window (layers:
+ * PS_LAYER_* of preview/session.h). */
 
 typedef struct ps_preview_options {
     double tau;               /* seconds between refreshes (0.1) */
@@ -54,11 +55,11 @@ typedef struct ps_preview_options {
 void ps_preview_options_init(ps_preview_options *o, bool float_depth);
 /* Like ps_shared_option, for the preview's options. */
 bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_status *st, ps_error *err);
-/* Map k's splat radius after `emitted` photons: r0 under the schedule, its
- * reference count the scene's photon count for the map (what r0 was chosen
- * for), else `cap`. */
-double ps_preview_radius(const ps_preview_options *o, double r0, const ps_scene_defaults *d, ps_map_kind k,
-                         uint64_t cap, uint64_t emitted);
+/* The session settings these options and the shared ones make for scene s
+ * (its photon counts and radii unless the options give them): the memory
+ * cap of each map planned as the preview's, exposure as given. The program
+ * sets what only it knows (threads, incremental, shadow size, cancel). */
+ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_preview_options *o, const ps_scene *s);
 /* "direct,caustic,global" (any non-empty subset) to PS_LAYER_* bits. */
 ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_error *err);
 

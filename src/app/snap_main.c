@@ -1,7 +1,7 @@
-/* snap_main.c: photosplat-snap, the preview headless: OSMesa (never libGL),
- * the photon tracer feeding splats to src/gl, one snapshot written as PNG
- * and/or PFM. The same frame the window shows, for tests and benchmarks. */
-#include <GL/osmesa.h>
+/* snap_main.c: photosplat-snap, the preview headless: a preview session
+ * (src/preview/session.h) drawn by src/gl into an OSMesa buffer (never
+ * libGL, src/gl/platform_osmesa.c), one snapshot written as PNG and/or PFM.
+ * The same frame the window shows, for tests and benchmarks. */
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,13 +14,9 @@
 #include "app/stats.h"
 #include "core/fileio.h"
 #include "gl/gl_render.h"
-#include "photon/tracer.h"
-#include "photon/world.h"
-#include "preview/feed.h"
-#include "preview/mesh.h"
-#include "preview/splat.h"
+#include "gl/platform.h"
+#include "preview/session.h"
 #include "scene/scene.h"
-
 
 
 static const char usage[] =
@@ -131,84 +127,29 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
 
 typedef struct snap_run {
     const snap_options *o;
-    const ps_scene *scene;
-    ps_camera_frame cam;
+    ps_session *session;
     ps_gl_renderer *gl;
-    ps_kernel_texture kernel;
-    ps_splat_batch batch[PS_MAP_COUNT];
-    const ps_scene_defaults *def;
-    double radius0[PS_MAP_COUNT]; /* as given: the scene's or the options' */
-    double radius[PS_MAP_COUNT];  /* this frame's, under the radius schedule */
-    uint64_t emitted[PS_MAP_COUNT]; /* the photons this frame shows were emitted of */
+    ps_platform *platform;
+    ps_camera_frame cam;
+    ps_session_frame frame; /* the last refresh's */
     uint64_t frames;
-    double splat_seconds;
-    /* The counter, for the last refresh. */
-    double lost_fraction;
-    uint64_t splats;
+    double draw_seconds;
 } snap_run;
 
-/* Builds the splats of every shown map from the photons that have arrived
- * (call under the feed's lock: the arrays must not move while read). CPU
- * only, so the lock is held briefly; drawing comes after, unlocked. */
-static ps_status build_splats(snap_run *s, const ps_feed *f, ps_error *err)
+/* One refresh: the session's splats of everything that has arrived, drawn
+ * over the scene into the colour buffer. */
+static ps_status refresh(snap_run *s, ps_error *err)
 {
-    const snap_options *o = s->o;
+    ps_status st = ps_session_refresh(s->session, &s->cam, &s->frame, err);
+    if (st != PS_OK)
+        return st;
     double t0 = ps_now_seconds();
-    size_t nmat;
-    const ps_material *materials = ps_scene_materials(s->scene, &nmat);
-    double wanted = 0.0, lost = 0.0;
-    s->splats = 0;
-    for (int k = 0; k < PS_MAP_COUNT; k++) {
-        const ps_photon_map *m = &ps_feed_maps(f)[k];
-        ps_splat_batch *b = &s->batch[k];
-        unsigned layer = k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL;
-        ps_splat_batch_clear(b);
-        /* Each frame is built whole, so its round-off carry starts afresh:
-         * the same photons give the same picture. */
-        b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
-        b->wanted = b->lost = 0.0;
-        s->emitted[k] = 0;
-        if (!(o->p.layers & layer) || m->count == 0 || m->counters.emitted == 0)
-            continue;
-        ps_splat_params p;
-        memset(&p, 0, sizeof p);
-        p.mode = (ps_splat_mode)o->p.splat;
-        s->emitted[k] = m->counters.emitted;
-        s->radius[k] = ps_preview_radius(&o->p, s->radius0[k], s->def, (ps_map_kind)k, ps_feed_cap(f, (ps_map_kind)k),
-                                         m->counters.emitted);
-        p.radius = s->radius[k];
-        p.kernel_mean = s->kernel.mean;
-        p.kernel_extent = s->kernel.extent;
-        /* Powers are normalised for the cap N; n have been emitted so far. */
-        p.scale = o->c.exposure * (double)ps_feed_cap(f, (ps_map_kind)k) / (double)m->counters.emitted;
-        p.point_size = o->p.point_size;
-        p.precision = (ps_precision)o->p.precision;
-        p.levels = o->p.color_depth == 0 ? 255 : 0;
-        p.materials = materials;
-        p.objects = o->p.stencil_clip ? m->objects : NULL;
-        p.cam = s->cam;
-        ps_status st = ps_splat_build(m->photons, m->materials, m->count, &p, b, err);
-        if (st != PS_OK)
-            return st;
-        wanted += b->wanted;
-        lost += b->lost;
-        s->splats += b->splats;
-    }
-    s->lost_fraction = wanted > 0.0 ? lost / wanted : 0.0;
-    s->splat_seconds += ps_now_seconds() - t0;
-    return PS_OK;
-}
-
-/* Draws the frame: the scene (direct layer or black), then the splats. */
-static void draw_frame(snap_run *s)
-{
-    const snap_options *o = s->o;
-    double t0 = ps_now_seconds();
-    ps_gl_begin_frame(s->gl, &s->cam, o->c.exposure, (o->p.layers & PS_LAYER_DIRECT) != 0);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_gl_draw_splats(s->gl, &s->batch[k], (ps_splat_mode)o->p.splat, s->radius[k], o->p.point_size);
+    ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+    double spent = ps_now_seconds() - t0;
+    s->draw_seconds += spent;
     s->frames++;
-    s->splat_seconds += ps_now_seconds() - t0;
+    ps_session_drawn(s->session, spent);
+    return PS_OK;
 }
 
 /* The colour buffer holds radiance times exposure: back to radiance. */
@@ -220,39 +161,34 @@ static void to_radiance(const snap_run *s, ps_image *img)
         img->rgb[i] *= inv;
 }
 
-static ps_status read_radiance(snap_run *s, ps_image *img, ps_error *err)
-{
-    ps_status st = ps_gl_read(s->gl, img, err);
-    if (st == PS_OK)
-        to_radiance(s, img);
-    return st;
-}
-
 static ps_status write_radiance(snap_run *s, const char *path, ps_error *err)
 {
     ps_image img;
-    ps_status st = read_radiance(s, &img, err);
-    if (st == PS_OK)
+    ps_status st = ps_platform_read(s->platform, &img, err);
+    if (st == PS_OK) {
+        to_radiance(s, &img);
         st = ps_pfm_write(&img, path, err);
+    }
     ps_image_destroy(&img);
     return st;
 }
 
-/* Each layer alone, as the frame's splats draw it, to PREFIX-NAME.pfm. Leaves
- * the colour buffer holding the last layer: draw the frame again after. */
+/* Each layer alone, as the last refresh's splats draw it, to
+ * PREFIX-NAME.pfm. Leaves the colour buffer holding the last layer: draw the
+ * frame again after. */
 static ps_status write_layers(snap_run *s, const char *prefix, ps_error *err)
 {
     static const char *const names[PS_MAP_COUNT] = {"caustic", "global"};
-    const snap_options *o = s->o;
+    const ps_session_frame *f = &s->frame;
     char path[PATH_MAX];
     ps_status st = PS_OK;
     for (int layer = -1; layer < PS_MAP_COUNT && st == PS_OK; layer++) {
         /* layer -1: the direct light alone, no splats. */
         if (snprintf(path, sizeof path, "%s-%s.pfm", prefix, layer < 0 ? "direct" : names[layer]) >= (int)sizeof path)
             return ps_error_set(err, PS_ERR_IO, "%s: path too long", prefix);
-        ps_gl_begin_frame(s->gl, &s->cam, o->c.exposure, layer < 0 && (o->p.layers & PS_LAYER_DIRECT));
+        ps_gl_begin_frame(s->gl, &s->cam, f->direct_exposure, layer < 0 && f->direct);
         if (layer >= 0)
-            ps_gl_draw_splats(s->gl, &s->batch[layer], (ps_splat_mode)o->p.splat, s->radius[layer], o->p.point_size);
+            ps_gl_draw_splats(s->gl, f->map[layer].batch, f->splat, f->map[layer].radius, f->point_size);
         st = write_radiance(s, path, err);
     }
     return st;
@@ -262,7 +198,7 @@ static ps_status write_outputs(snap_run *s, ps_error *err)
 {
     const snap_options *o = s->o;
     ps_image img;
-    ps_status st = ps_gl_read(s->gl, &img, err);
+    ps_status st = ps_platform_read(s->platform, &img, err);
     if (st != PS_OK)
         return st;
     /* The buffer holds radiance times exposure: the PNG takes it as it is,
@@ -301,10 +237,10 @@ static ps_status write_checkpoint(snap_run *s, int i, double seconds, snap_check
         st = write_layers(s, path, err);
     row->requested = o->checkpoints[i];
     row->seconds = seconds;
-    row->lost_fraction = s->lost_fraction;
+    row->lost_fraction = s->frame.round_off;
     for (int k = 0; k < PS_MAP_COUNT; k++) {
-        row->radius[k] = s->radius[k];
-        row->emitted[k] = s->emitted[k];
+        row->radius[k] = ps_session_radius(s->session, (ps_map_kind)k);
+        row->emitted[k] = s->frame.emitted[k];
     }
     return st;
 }
@@ -327,165 +263,175 @@ static ps_status write_checkpoint_csv(const snap_options *o, const snap_checkpoi
     return ps_outfile_commit(out, err);
 }
 
-/* The photons, the frames, the files. */
-static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext ctx, void *buffer, ps_error *err)
+static void sleep_until(double until)
 {
-    const ps_scene_defaults *def = ps_scene_get_defaults(scene);
-    int width = o->c.width ? o->c.width : def->width, height = o->c.height ? o->c.height : def->height;
-    GLenum type = o->p.color_depth == 0 ? GL_UNSIGNED_BYTE : GL_FLOAT;
-    if (!OSMesaMakeCurrent(ctx, buffer, type, width, height))
-        return ps_error_set(err, PS_ERR_LIMIT, "photosplat-snap: OSMesa cannot draw a %dx%d %s buffer", width, height,
-                            o->p.color_depth == 0 ? "8-bit" : "float");
+    double t = ps_now_seconds();
+    if (t >= until)
+        return;
+    struct timespec ts = {(time_t)(until - t), (long)((until - t - (double)(time_t)(until - t)) * 1e9)};
+    nanosleep(&ts, NULL);
+}
+
+/* Progressive: trace in the background, refresh every tau. As in the window,
+ * the first round is traced before the first frame, so that it already shows
+ * photons. Time spent writing checkpoints is taken off the clock (the tracer
+ * is held meanwhile), so they measure the preview, not the bench. */
+static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_error *err)
+{
+    const snap_options *o = s->o;
+    snap_checkpoint_row rows[SNAP_MAX_CHECKPOINTS];
+    ps_status st = ps_session_start(s->session, false, err);
+    double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
+    int cp = 0;
+    while (st == PS_OK) {
+        if (ps_cancelled(o->cancel)) {
+            st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.1f s of %.1f s",
+                              ps_now_seconds() - t_start, o->time);
+            break;
+        }
+        double until = next < end ? next : end;
+        if (cp < o->checkpoint_count && t_start + excluded + o->checkpoints[cp] < until)
+            until = t_start + excluded + o->checkpoints[cp];
+        sleep_until(until);
+        ps_session_counts counts;
+        ps_session_get_counts(s->session, &counts);
+        st = refresh(s, err);
+        if (st != PS_OK)
+            break;
+        double now = ps_now_seconds();
+        if (*first_frame < 0.0)
+            *first_frame = now - t_start;
+        if (cp < o->checkpoint_count && now - t_start - excluded >= o->checkpoints[cp]) {
+            /* This frame is the first done at or after every checkpoint time
+             * it passed: each of them shows it. */
+            ps_session_hold(s->session, true);
+            double at = now - t_start - excluded;
+            for (int first = cp; st == PS_OK && cp < o->checkpoint_count && at >= o->checkpoints[cp]; cp++) {
+                if (cp > first) /* the layers of the last one overwrote it */
+                    ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+                st = write_checkpoint(s, cp, at, &rows[cp], err);
+            }
+            ps_session_hold(s->session, false);
+            double spent = ps_now_seconds() - now;
+            excluded += spent;
+            next += spent;
+            end += spent;
+            if (st != PS_OK)
+                break;
+        }
+        if (ps_session_counter_stopped(s->session, NULL))
+            break;
+        next += o->p.tau;
+        if (counts.ended || ps_now_seconds() >= end)
+            break;
+    }
+    ps_status stop = ps_session_stop(s->session, st == PS_OK ? err : NULL);
+    if (st == PS_OK)
+        st = stop;
+    /* The snapshot: everything that arrived, drawn once more. */
+    if (st == PS_OK)
+        st = refresh(s, err);
+    /* Checkpoints after the end (every cap reached, or the counter stopped
+     * the tracer) show the final picture, at the time it was done. */
+    double done = ps_now_seconds() - t_start - excluded;
+    for (; st == PS_OK && cp < o->checkpoint_count; cp++) {
+        st = write_checkpoint(s, cp, done, &rows[cp], err);
+        if (st == PS_OK)
+            ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+    }
+    if (st == PS_OK && o->checkpoint_count > 0)
+        st = write_checkpoint_csv(o, rows, o->checkpoint_count, err);
+    return st;
+}
+
+static ps_status write_stats_and_report(snap_run *s, int width, int height, double t_start, double first_frame,
+                                        ps_error *err)
+{
+    const snap_options *o = s->o;
+    ps_session_counts counts;
+    ps_session_get_counts(s->session, &counts);
+    uint64_t counter_at = 0;
+    bool counter_stopped = ps_session_counter_stopped(s->session, &counter_at);
+    const ps_tracer *tracer = ps_session_tracer(s->session);
+    ps_run_stats rs;
+    memset(&rs, 0, sizeof rs);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        rs.emitted[k] = counts.map[k].emitted;
+        rs.stored[k] = counts.map[k].stored;
+        rs.rays += counts.map[k].rays;
+    }
+    rs.trace_seconds = counts.trace_seconds;
+    rs.splat_seconds = counts.splat_seconds + s->draw_seconds;
+    rs.frames = s->frames;
+    rs.skips = ps_tracer_skips(tracer, &rs.skip_count);
+    ps_gl_stats gs = ps_gl_get_stats(s->gl);
+    ps_stats_add(&rs, "threads", ps_tracer_threads(tracer));
+    ps_stats_add(&rs, "seed", (double)o->c.seed);
+    ps_stats_add(&rs, "width", width);
+    ps_stats_add(&rs, "height", height);
+    ps_stats_add(&rs, "seconds", ps_now_seconds() - t_start);
+    ps_stats_add(&rs, "first_frame_seconds", first_frame);
+    ps_stats_add(&rs, "splats", (double)s->frame.splats);
+    ps_stats_add(&rs, "kernel_mean", ps_session_kernel(s->session)->mean);
+    ps_stats_add(&rs, "caustic_radius", ps_session_radius(s->session, PS_MAP_CAUSTIC));
+    ps_stats_add(&rs, "global_radius", ps_session_radius(s->session, PS_MAP_GLOBAL));
+    ps_stats_add(&rs, "gl_lights", gs.virtual_lights);
+    ps_stats_add(&rs, "shadow_maps", gs.shadow_maps);
+    ps_stats_add(&rs, "round_off_fraction", s->frame.round_off);
+    ps_stats_add(&rs, "counter_stopped", counter_stopped ? 1.0 : 0.0);
+    ps_stats_add(&rs, "counter_stopped_at_photons", (double)counter_at);
+    ps_stats_add(&rs, "counter_threshold", o->p.counter_threshold);
+    ps_stats_add(&rs, "radius_progressive", o->p.radius_schedule == PS_RADIUS_PROGRESSIVE ? 1.0 : 0.0);
+    if (o->c.stats) {
+        ps_status st = ps_stats_write(o->c.stats, &rs, err);
+        if (st != PS_OK)
+            return st;
+    }
+    printf("caustic: %llu emitted, %llu stored; global: %llu emitted, %llu stored; %llu frames; %s splats, %s\n",
+           (unsigned long long)rs.emitted[0], (unsigned long long)rs.stored[0], (unsigned long long)rs.emitted[1],
+           (unsigned long long)rs.stored[1], (unsigned long long)s->frames,
+           ps_splat_mode_name((ps_splat_mode)o->p.splat), o->p.color_depth == 0 ? "8-bit" : "float buffer");
+    if (counter_stopped)
+        printf("error counter: stopped shooting at %llu photons: %.1f %% of a refresh's splat energy rounded "
+               "away in the 8-bit buffer (threshold %.1f %%)\n",
+               (unsigned long long)counter_at, 100.0 * s->frame.round_off, 100.0 * o->p.counter_threshold);
+    for (size_t k = 0; k < rs.skip_count; k++)
+        printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
+    if (o->c.out_png)
+        printf("wrote %s\n", o->c.out_png);
+    if (o->c.out_hdr)
+        printf("wrote %s\n", o->c.out_hdr);
+    return PS_OK;
+}
+
+/* The photons, the frames, the files. */
+static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platform, ps_error *err)
+{
+    int width, height;
+    ps_platform_size(platform, &width, &height);
     snap_run s;
     memset(&s, 0, sizeof s);
     s.o = o;
-    s.scene = scene;
+    s.platform = platform;
     s.cam = ps_camera_frame_make(ps_scene_camera(scene), width, height);
-    s.def = def;
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        s.radius[k] = s.radius0[k] = ps_shared_radius(&o->c, def, (ps_map_kind)k);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_splat_batch_init(&s.batch[k]);
-
-    ps_world *world = NULL;
-    ps_tracer *tracer = NULL;
-    ps_feed *feed = NULL;
-    ps_preview_mesh mesh;
-    memset(&mesh, 0, sizeof mesh);
-    ps_status st = ps_world_create(scene, NULL, &world, err);
-    ps_tracer_options topt = ps_tracer_default_options();
-    topt.seed = (uint64_t)o->c.seed;
-    topt.threads = (int)o->c.threads;
-    topt.cancel = o->cancel;
-    topt.max_stored = ps_photon_cap(PS_PREVIEW_MAPS, PS_PREVIEW_PHOTON_BYTES);
-    if (st == PS_OK)
-        st = ps_tracer_create(world, &topt, &tracer, err);
-    ps_mesh_options mopt = ps_mesh_default_options(scene);
-    if (st == PS_OK)
-        st = ps_preview_mesh_build(scene, &mopt, &mesh, err);
-    if (st == PS_OK)
-        st = ps_kernel_texture_make((ps_kernel)o->p.kernel, PS_KERNEL_TEXTURE_SIZE, &s.kernel, err);
+    ps_session_settings set = ps_preview_settings(&o->c, &o->p, scene);
+    set.skip_hidden = true; /* a layer left out is not traced */
+    set.cancel = o->cancel;
+    ps_status st = ps_session_create(scene, &set, &s.session, err);
     ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0};
-    if (st == PS_OK)
-        st = ps_gl_renderer_create(scene, &mesh, &s.kernel, &gopt, &s.gl, err);
-
-    /* Which maps to trace: a layer that is off, or 0 photons, is skipped. */
-    uint64_t want[PS_MAP_COUNT] = {ps_shared_photons(&o->c, def, PS_MAP_CAUSTIC), ps_shared_photons(&o->c, def, PS_MAP_GLOBAL)};
-    bool active[PS_MAP_COUNT] = {false, false};
-    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
-        unsigned layer = k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL;
-        const char *name = ps_map_name((ps_map_kind)k);
-        if (!ps_tracer_map_enabled(tracer, (ps_map_kind)k))
-            continue;
-        if (!(o->p.layers & layer))
-            st = ps_tracer_note_skip(tracer, name, "layer not shown (--layers)");
-        else if (want[k] == 0)
-            st = ps_tracer_note_skip(tracer, name, "0 photons requested");
-        else
-            active[k] = true;
-        if (st != PS_OK)
-            ps_error_set(err, st, "photosplat-snap: out of memory");
+    if (st == PS_OK) {
+        ps_gl_scene gs = ps_gl_scene_of(s.session);
+        st = ps_gl_renderer_create(&gs, ps_session_kernel(s.session), &gopt, &s.gl, err);
     }
-    if (st == PS_OK && !(o->p.layers & PS_LAYER_DIRECT))
-        st = ps_tracer_note_skip(tracer, "direct", "layer not shown (--layers)");
-    if (st == PS_OK)
-        st = ps_feed_create(tracer, want, active, &feed, err);
-
-    snap_checkpoint_row rows[SNAP_MAX_CHECKPOINTS];
     double t_start = ps_now_seconds(), first_frame = -1.0;
-    bool counter_stopped = false;
-    uint64_t counter_at = 0;
     if (st == PS_OK && o->time <= 0.0) {
         /* A fixed photon count: trace everything, then draw once. */
-        st = ps_feed_run(feed, err);
+        st = ps_session_trace_all(s.session, err);
         if (st == PS_OK)
-            st = build_splats(&s, feed, err);
-        if (st == PS_OK)
-            draw_frame(&s);
+            st = refresh(&s, err);
         first_frame = ps_now_seconds() - t_start;
     } else if (st == PS_OK) {
-        /* Progressive: trace in the background, refresh every tau. As in
-         * the window, the first round is traced here, so that the first
-         * frame already shows photons. Time spent writing checkpoints is
-         * taken off the clock (the tracer is held between batches
-         * meanwhile), so they measure the preview, not the bench. */
-        st = ps_feed_prime(feed, err);
-        if (st == PS_OK)
-            st = ps_feed_start(feed, err);
-        double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
-        int cp = 0;
-        while (st == PS_OK) {
-            if (ps_cancelled(o->cancel)) {
-                st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.1f s of %.1f s",
-                                  ps_now_seconds() - t_start, o->time);
-                break;
-            }
-            double t = ps_now_seconds();
-            double until = next < end ? next : end;
-            if (cp < o->checkpoint_count && t_start + excluded + o->checkpoints[cp] < until)
-                until = t_start + excluded + o->checkpoints[cp];
-            if (t < until) {
-                struct timespec ts = {(time_t)(until - t), (long)((until - t - (double)(time_t)(until - t)) * 1e9)};
-                nanosleep(&ts, NULL);
-            }
-            ps_feed_lock(feed);
-            bool ended = ps_feed_ended(feed);
-            st = build_splats(&s, feed, err);
-            uint64_t emitted = ps_feed_maps(feed)[0].counters.emitted + ps_feed_maps(feed)[1].counters.emitted;
-            ps_feed_unlock(feed);
-            if (st != PS_OK)
-                break;
-            draw_frame(&s);
-            double now = ps_now_seconds();
-            if (first_frame < 0.0)
-                first_frame = now - t_start;
-            if (cp < o->checkpoint_count && now - t_start - excluded >= o->checkpoints[cp]) {
-                /* This frame is the first done at or after every checkpoint
-                 * time it passed: each of them shows it. */
-                ps_feed_pause(feed, true);
-                double at = now - t_start - excluded;
-                for (int first = cp; st == PS_OK && cp < o->checkpoint_count && at >= o->checkpoints[cp]; cp++) {
-                    if (cp > first)
-                        draw_frame(&s); /* the layers of the last one overwrote it */
-                    st = write_checkpoint(&s, cp, at, &rows[cp], err);
-                }
-                ps_feed_pause(feed, false);
-                double spent = ps_now_seconds() - now;
-                excluded += spent;
-                next += spent;
-                end += spent;
-                if (st != PS_OK)
-                    break;
-            }
-            /* Thesis 5.1: once a refresh loses this much to round-off, more
-             * photons only add noise; stop shooting. */
-            if (o->p.precision == PS_PRECISION_COUNTER && o->p.color_depth == 0 && s.lost_fraction > o->p.counter_threshold) {
-                counter_stopped = true;
-                counter_at = emitted;
-                break;
-            }
-            next += o->p.tau;
-            if (ended || ps_now_seconds() >= end)
-                break;
-        }
-        ps_feed_stop(feed);
-        if (st == PS_OK)
-            st = ps_feed_status(feed, err);
-        /* The snapshot: everything that arrived, drawn once more. */
-        if (st == PS_OK)
-            st = build_splats(&s, feed, err);
-        if (st == PS_OK)
-            draw_frame(&s);
-        /* Checkpoints after the end (every cap reached, or the counter
-         * stopped the tracer) show the final picture, at the time it was done. */
-        double done = ps_now_seconds() - t_start - excluded;
-        for (; st == PS_OK && cp < o->checkpoint_count; cp++) {
-            st = write_checkpoint(&s, cp, done, &rows[cp], err);
-            if (st == PS_OK)
-                draw_frame(&s);
-        }
-        if (st == PS_OK && o->checkpoint_count > 0)
-            st = write_checkpoint_csv(o, rows, o->checkpoint_count, err);
+        st = refine(&s, t_start, &first_frame, err);
     }
     if (st == PS_OK && ps_cancelled(o->cancel) && o->time > 0.0)
         st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.1f s of %.1f s", ps_now_seconds() - t_start,
@@ -495,66 +441,11 @@ static ps_status run(const snap_options *o, const ps_scene *scene, OSMesaContext
     if (st == PS_OK && (o->c.out_png || o->c.out_hdr || o->hdr_layers))
         st = write_outputs(&s, err);
     if (st == PS_OK && o->c.dump)
-        st = ps_write_photon_dump(o->c.dump, ps_feed_maps(feed), err);
-
-    ps_run_stats rs;
-    memset(&rs, 0, sizeof rs);
-    if (st == PS_OK) {
-        for (int k = 0; k < PS_MAP_COUNT; k++) {
-            const ps_photon_map *m = &ps_feed_maps(feed)[k];
-            rs.emitted[k] = m->counters.emitted;
-            rs.stored[k] = m->counters.stored;
-            rs.rays += m->counters.rays;
-        }
-        rs.trace_seconds = ps_feed_seconds(feed);
-        rs.splat_seconds = s.splat_seconds;
-        rs.frames = s.frames;
-        rs.skips = ps_tracer_skips(tracer, &rs.skip_count);
-        ps_gl_stats gs = ps_gl_get_stats(s.gl);
-        ps_stats_add(&rs, "threads", ps_tracer_threads(tracer));
-        ps_stats_add(&rs, "seed", (double)o->c.seed);
-        ps_stats_add(&rs, "width", width);
-        ps_stats_add(&rs, "height", height);
-        ps_stats_add(&rs, "seconds", ps_now_seconds() - t_start);
-        ps_stats_add(&rs, "first_frame_seconds", first_frame);
-        ps_stats_add(&rs, "splats", (double)s.splats);
-        ps_stats_add(&rs, "kernel_mean", s.kernel.mean);
-        ps_stats_add(&rs, "caustic_radius", s.radius[PS_MAP_CAUSTIC]);
-        ps_stats_add(&rs, "global_radius", s.radius[PS_MAP_GLOBAL]);
-        ps_stats_add(&rs, "gl_lights", gs.virtual_lights);
-        ps_stats_add(&rs, "shadow_maps", gs.shadow_maps);
-        ps_stats_add(&rs, "round_off_fraction", s.lost_fraction);
-        ps_stats_add(&rs, "counter_stopped", counter_stopped ? 1.0 : 0.0);
-        ps_stats_add(&rs, "counter_stopped_at_photons", (double)counter_at);
-        ps_stats_add(&rs, "counter_threshold", o->p.counter_threshold);
-        ps_stats_add(&rs, "radius_progressive", o->p.radius_schedule == PS_RADIUS_PROGRESSIVE ? 1.0 : 0.0);
-        if (o->c.stats)
-            st = ps_stats_write(o->c.stats, &rs, err);
-    }
-    if (st == PS_OK) {
-        printf("caustic: %llu emitted, %llu stored; global: %llu emitted, %llu stored; %llu frames; %s splats, %s\n",
-               (unsigned long long)rs.emitted[0], (unsigned long long)rs.stored[0], (unsigned long long)rs.emitted[1],
-               (unsigned long long)rs.stored[1], (unsigned long long)s.frames,
-               ps_splat_mode_name((ps_splat_mode)o->p.splat), o->p.color_depth == 0 ? "8-bit" : "float buffer");
-        if (counter_stopped)
-            printf("error counter: stopped shooting at %llu photons: %.1f %% of a refresh's splat energy rounded "
-                   "away in the 8-bit buffer (threshold %.1f %%)\n",
-                   (unsigned long long)counter_at, 100.0 * s.lost_fraction, 100.0 * o->p.counter_threshold);
-        for (size_t k = 0; k < rs.skip_count; k++)
-            printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
-        if (o->c.out_png)
-            printf("wrote %s\n", o->c.out_png);
-        if (o->c.out_hdr)
-            printf("wrote %s\n", o->c.out_hdr);
-    }
+        st = ps_write_photon_dump(o->c.dump, ps_session_maps(s.session), err);
+    if (st == PS_OK)
+        st = write_stats_and_report(&s, width, height, t_start, first_frame, err);
     ps_gl_renderer_destroy(s.gl);
-    ps_kernel_texture_free(&s.kernel);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_splat_batch_free(&s.batch[k]);
-    ps_preview_mesh_free(&mesh);
-    ps_feed_destroy(feed);
-    ps_tracer_destroy(tracer);
-    ps_world_destroy(world);
+    ps_session_destroy(s.session);
     return st;
 }
 
@@ -606,21 +497,17 @@ int main(int argc, char **argv)
         ps_scene_destroy(scene);
         return ps_cli_fail(&err);
     }
-    /* RGBA, 24-bit depth, 8-bit stencil, no accumulation buffer (platform
-     * notes: it wraps above 1.0 and is no place for photon sums). */
-    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    size_t bytes = (size_t)width * (size_t)height * 4 * (o.p.color_depth == 0 ? 1 : sizeof(float));
-    void *buffer = ctx ? malloc(bytes) : NULL;
-    ps_status st;
-    if (!ctx)
-        st = ps_error_set(&err, PS_ERR_IO, "photosplat-snap: OSMesa could not create a context");
-    else if (!buffer)
-        st = ps_error_set(&err, PS_ERR_NOMEM, "photosplat-snap: out of memory for a %dx%d buffer", width, height);
-    else
-        st = run(&o, scene, ctx, buffer, &err);
-    if (ctx)
-        OSMesaDestroyContext(ctx);
-    free(buffer);
+    ps_platform_config pc = {width, height, o.p.color_depth != 0, NULL};
+    ps_platform *platform = NULL;
+    ps_status st = ps_platform_open(&pc, &platform, &err);
+    if (st != PS_OK) {
+        char why[PS_ERROR_MSG_MAX];
+        snprintf(why, sizeof why, "%s", err.msg);
+        ps_error_set(&err, st, "photosplat-snap: %s", why);
+    } else {
+        st = run(&o, scene, platform, &err);
+    }
+    ps_platform_close(platform);
     ps_scene_destroy(scene);
     if (st == PS_ERR_INTERRUPTED)
         return ps_interrupt_fail("photosplat-snap", &err);

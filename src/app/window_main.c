@@ -1,9 +1,9 @@
-/* window_main.c: photosplat, the lighting designer's preview window (GLFW +
- * libGL, never OSMesa). It shows the scene at once and refines it while
- * photons arrive: tracing threads shoot continuously, and every tau the
- * picture takes in what has arrived (thesis 4.1.4). Moving the camera keeps
- * every photon; moving a light or an object restarts the maps. */
-#include "gl/gl_api.h"
+/* window_main.c: photosplat, the lighting designer's preview window. A
+ * preview session (src/preview/session.h: tracing threads shoot
+ * continuously, and every tau the picture takes in what has arrived, thesis
+ * 4.1.4) drawn by src/gl into a GLFW window (src/gl/platform_glfw.c, libGL,
+ * never OSMesa); this file is the options, the input and the loop. Moving the
+ * camera keeps every photon; moving a light or an object restarts the maps. */
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
@@ -15,27 +15,24 @@
 
 #include "app/cli.h"
 #include "app/interrupt.h"
-#include "core/fileio.h"
 #include "app/options.h"
 #include "app/stats.h"
+#include "core/fileio.h"
 #include "gl/gl_font.h"
 #include "gl/gl_render.h"
+#include "gl/platform.h"
 #include "image/image.h"
-#include "photon/tracer.h"
-#include "photon/world.h"
-#include "preview/feed.h"
-#include "preview/mesh.h"
 #include "preview/script.h"
-#include "preview/splat.h"
+#include "preview/session.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
 
 /* Shadow maps are remade after every light move: half the snapshot's side,
  * a quarter of the fill, for a refresh soon after the move. */
 #define WIN_SHADOW_SIZE 512
-/* The memory plan (ps_check_run_memory): a pixel is the 8-bit picture, its
- * float copy, the float splat layers and the window's own colour and depth. */
-#define WIN_PIXEL_BYTES (3 + 3 * sizeof(float) + 3 * 3 * sizeof(float) + 4 + 4)
+/* The memory plan (ps_check_run_memory): a pixel is the float splat layers,
+ * the linear and the shown composite, and the window's own colour and depth. */
+#define WIN_PIXEL_BYTES (3 * 4 * sizeof(float) + 4 * sizeof(float) + 4 + 4 + 4)
 /* Camera controls, as in Blender: degrees of orbit per pixel dragged, the
  * dolly factor per wheel notch, pan in units of the target distance per pixel. */
 #define ORBIT_DEG_PER_PIXEL 0.4
@@ -52,13 +49,8 @@
 #define KEY_ANGLE_STEP 2.0
 /* The frame-rate figure is smoothed over about this many frames. */
 #define FPS_SMOOTHING 0.2
-/* A refresh draws at most as many new splats a map as fit in this share of
- * tau at the rate the last refreshes drew them, so that a refresh comes every
- * tau however fast photons arrive (llvmpipe draws a few hundred thousand
- * large splats a second); never fewer than the first bound. */
-#define SPLAT_TIME_SHARE 0.5
-#define SPLAT_BUDGET_MIN 2048
-#define SPLAT_BUDGET_START 16384
+/* A message (an error, a saved screenshot) shows in the overlay this long. */
+#define MESSAGE_SECONDS 4.0
 /* --max-photons: the maps store at most this many photons together by
  * default (26 bytes each: 0.8 GiB, 1.6 GiB of capacity at worst), whatever
  * the scene's albedo makes of the caps (preview/feed.h). */
@@ -136,33 +128,16 @@ typedef struct win_options {
 typedef struct app {
     win_options o;
     ps_scene *scene;
-    ps_world *world;
-    ps_tracer *tracer;
-    ps_feed *feed;
-    ps_preview_mesh mesh;
-    ps_kernel_texture kernel;
+    ps_session *session;
+    ps_platform *platform;
+    GLFWwindow *win;
     ps_gl_renderer *gl;
     ps_gl_layers *layers;
-    ps_splat_batch batch[PS_MAP_COUNT];
-    GLFWwindow *win;
     int width, height;
     ps_camera camera;
-    /* Runtime settings. */
-    ps_splat_mode splat;
-    ps_kernel kernel_kind;
-    ps_precision precision;
-    unsigned shown;
-    double radius[PS_MAP_COUNT], tau, exposure;
-    /* The radius the newest splats were built with: radius[] under the
-     * radius schedule (--radius-schedule), for the photons emitted so far. */
-    double splat_radius[PS_MAP_COUNT];
-    bool paused, overlay, help;
-    /* What the frames need redone. */
-    bool view_dirty, scene_dirty, geometry_dirty;
-    size_t drawn[PS_MAP_COUNT];     /* photons already in the float layers */
-    uint64_t emitted[PS_MAP_COUNT]; /* ... and the emitted count they came from */
-    uint64_t cap[PS_MAP_COUNT];
-    double budget; /* new splats a map per refresh (float layers) */
+    ps_session_frame frame; /* the last refresh's */
+    bool overlay, help;
+    bool redraw; /* the camera or a setting changed: refresh now, not at the next tau */
     /* Selection and dragging. */
     int sel_kind;
     size_t sel_index;
@@ -172,15 +147,12 @@ typedef struct app {
     bool drag_vertical;
     /* Timing and figures. */
     double start_time, t_first_frame, first_frame_seconds, last_refresh, fps, frame_seconds;
-    uint64_t frames, edits;
+    uint64_t frames;
     double edit_time, edit_latency_max, edit_latency_sum;
     uint64_t edit_latency_count;
     bool awaiting_edit_frame;
-    double lost_fraction;
-    bool counter_stopped;
-    uint64_t counter_at;
-    uint8_t *pixels; /* the displayed picture, 8-bit sRGB, GL's row order */
-    ps_image picture;
+    double show_sum; /* the composite shown, all refreshes */
+    uint64_t show_count;
     /* The script. */
     ps_script *script;
     size_t script_next;
@@ -189,12 +161,16 @@ typedef struct app {
     bool script_waiting;
     double wait_time, script_delay;
     bool quit;
-    bool release_feed; /* the feed is held until the next refresh is done */
     char shot_path[64]; /* a screenshot asked for with P, taken after the next refresh */
-    ps_status status;
-    ps_error err;
     char message[PS_ERROR_MSG_MAX + 64]; /* the last action's one-line report, shown in the overlay */
+    double message_time;
 } app;
+
+static void say(app *a, const char *text)
+{
+    snprintf(a->message, sizeof a->message, "%s", text);
+    a->message_time = ps_now_seconds();
+}
 
 /* ---- options ---------------------------------------------------------------- */
 
@@ -204,7 +180,7 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
     ps_cli cli = ps_cli_begin("photosplat", argc, argv);
     memset(o, 0, sizeof *o);
     ps_shared_options_init(&o->c);
-    /* Float layers: they take in only new photons each refresh (see gl_render.h). */
+    /* Float layers: they take in only new photons each refresh (session.h). */
     ps_preview_options_init(&o->p, true);
     o->overlay = 1;
     o->max_photons = WIN_MAX_PHOTONS_DEFAULT;
@@ -236,226 +212,94 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
     return st;
 }
 
-/* ---- building and restarting the photon maps ----------------------------------- */
+/* ---- the session and what draws it ------------------------------------------------ */
 
-static void teardown_maps(app *a)
-{
-    ps_feed_destroy(a->feed);
-    a->feed = NULL;
-    ps_tracer_destroy(a->tracer);
-    a->tracer = NULL;
-}
+static ps_camera_frame camera_frame(const app *a) { return ps_camera_frame_make(&a->camera, a->width, a->height); }
 
-/* (Re)builds what depends on the scene: the accelerator and GL mesh when
- * geometry moved, the tracer (its caustic cones follow lights and objects),
- * the GL lights and shadow maps, and a new photon feed from photon 0. */
-static ps_status rebuild(app *a, bool geometry, ps_error *err)
+/* The session, its GL renderer and layers. */
+static ps_status open_session(app *a, ps_error *err)
 {
-    teardown_maps(a);
-    ps_status st = PS_OK;
-    if (geometry || !a->world) {
-        ps_gl_renderer_destroy(a->gl);
-        a->gl = NULL;
-        ps_world_destroy(a->world);
-        a->world = NULL;
-        ps_preview_mesh_free(&a->mesh);
-        st = ps_world_create(a->scene, NULL, &a->world, err);
-        ps_mesh_options mo = ps_mesh_default_options(a->scene);
-        if (st == PS_OK)
-            st = ps_preview_mesh_build(a->scene, &mo, &a->mesh, err);
-        ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE};
-        if (st == PS_OK)
-            st = ps_gl_renderer_create(a->scene, &a->mesh, &a->kernel, &go, &a->gl, err);
-    } else {
-        ps_gl_renderer_lights_changed(a->gl);
-    }
-    ps_tracer_options to = ps_tracer_default_options();
-    to.seed = (uint64_t)a->o.c.seed;
+    ps_session_settings set = ps_preview_settings(&a->o.c, &a->o.p, a->scene);
     /* One core is left to drawing (llvmpipe draws on the CPU too): with every
      * core tracing, the picture after a light move took four times as long. */
-    to.threads = a->o.c.threads > 0 ? (int)a->o.c.threads : (ps_online_cores() > 1 ? ps_online_cores() - 1 : 1);
-    to.cancel = a->o.cancel;
-    to.max_stored = ps_photon_cap(PS_PREVIEW_MAPS, PS_PREVIEW_PHOTON_BYTES);
+    set.threads = a->o.c.threads > 0 ? (int)a->o.c.threads : (ps_online_cores() > 1 ? ps_online_cores() - 1 : 1);
+    set.cancel = a->o.cancel;
+    set.max_stored = (size_t)a->o.max_photons;
+    set.incremental = true;
+    set.shadow_size = a->o.p.shadows ? WIN_SHADOW_SIZE : 0;
+    ps_status st = ps_session_create(a->scene, &set, &a->session, err);
+    ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE};
+    if (st == PS_OK) {
+        ps_gl_scene gs = ps_gl_scene_of(a->session);
+        st = ps_gl_renderer_create(&gs, ps_session_kernel(a->session), &go, &a->gl, err);
+    }
     if (st == PS_OK)
-        st = ps_tracer_create(a->world, &to, &a->tracer, err);
-    bool active[PS_MAP_COUNT];
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        active[k] = st == PS_OK && ps_tracer_map_enabled(a->tracer, (ps_map_kind)k);
+        st = ps_gl_layers_create(a->width, a->height, set.float_buffer, &a->layers, err);
     /* The first batch is traced here, and the thread starts held until the
      * first refresh has drawn it: that refresh (shadow maps, direct light,
      * those splats) then has every core, and the caustic shows at once. */
     if (st == PS_OK)
-        st = ps_feed_create(a->tracer, a->cap, active, &a->feed, err);
-    if (st == PS_OK)
-        ps_feed_set_store_limit(a->feed, (size_t)a->o.max_photons);
-    if (st == PS_OK)
-        st = ps_feed_prime(a->feed, err);
+        st = ps_session_start(a->session, true, err);
+    return st;
+}
+
+/* Edits made since the last refresh: the session restarts the maps, and the
+ * renderer follows its new meshes and lights. */
+static ps_status apply_edits(app *a, ps_error *err)
+{
+    ps_session_changes ch;
+    ps_status st = ps_session_update(a->session, &ch, err);
     if (st == PS_OK) {
-        ps_feed_pause(a->feed, true);
-        st = ps_feed_start(a->feed, err);
-        a->release_feed = true;
+        ps_gl_scene gs = ps_gl_scene_of(a->session);
+        st = ps_gl_renderer_set_scene(a->gl, &gs, err);
     }
-    a->counter_stopped = false;
-    a->view_dirty = true;
     return st;
-}
-
-/* ---- the frame -------------------------------------------------------------------- */
-
-static ps_camera_frame camera_frame(const app *a) { return ps_camera_frame_make(&a->camera, a->width, a->height); }
-
-static bool float_layers(const app *a) { return a->o.p.color_depth == 1; }
-
-/* How far into map k this refresh draws: with float layers, whole batches
- * beyond what is drawn, at most the budget (but at least one batch); with
- * 8-bit layers everything. *emitted: the photons emitted for that prefix,
- * which its splats are scaled by. Under the feed's lock. */
-static size_t prefix(const app *a, int k, uint64_t *emitted)
-{
-    size_t n;
-    const ps_feed_mark *m = ps_feed_marks(a->feed, (ps_map_kind)k, &n);
-    size_t end = a->drawn[k];
-    *emitted = a->emitted[k];
-    for (size_t i = 0; i < n; i++) {
-        if (m[i].stored < a->drawn[k] || m[i].emitted < *emitted)
-            continue;
-        bool over = float_layers(a) && (double)(m[i].stored - a->drawn[k]) > a->budget;
-        if (over && end > a->drawn[k])
-            break;
-        end = m[i].stored;
-        *emitted = m[i].emitted;
-        if (over)
-            break;
-    }
-    return end;
-}
-
-/* Builds splats of the photons that have arrived (under the feed's lock):
- * with float layers only those not drawn yet, at their stored power; with
- * 8-bit layers all of them, scaled for display (thesis 5.1). */
-static ps_status build_splats(app *a, size_t first[PS_MAP_COUNT], ps_error *err)
-{
-    size_t nmat;
-    const ps_material *materials = ps_scene_materials(a->scene, &nmat);
-    ps_camera_frame cam = camera_frame(a);
-    double wanted = 0.0, lost = 0.0;
-    ps_feed_lock(a->feed);
-    const ps_photon_map *maps = ps_feed_maps(a->feed);
-    ps_status st = PS_OK;
-    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
-        ps_splat_batch *b = &a->batch[k];
-        ps_splat_batch_clear(b);
-        b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
-        b->wanted = b->lost = 0.0;
-        const ps_photon_map *m = &maps[k];
-        unsigned layer = k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL;
-        uint64_t emitted;
-        size_t end = prefix(a, k, &emitted);
-        first[k] = float_layers(a) ? a->drawn[k] : 0;
-        a->emitted[k] = emitted;
-        if (!(a->shown & layer) || end <= first[k] || emitted == 0) {
-            first[k] = end;
-            continue;
-        }
-        ps_splat_params p;
-        memset(&p, 0, sizeof p);
-        p.mode = a->splat;
-        a->splat_radius[k] = ps_preview_radius(&a->o.p, a->radius[k], ps_scene_get_defaults(a->scene), (ps_map_kind)k,
-                                               a->cap[k], emitted);
-        p.radius = a->splat_radius[k];
-        p.kernel_mean = a->kernel.mean;
-        p.kernel_extent = a->kernel.extent;
-        p.scale = float_layers(a) ? 1.0 : a->exposure * (double)a->cap[k] / (double)emitted;
-        p.point_size = a->o.p.point_size;
-        p.precision = a->precision;
-        p.levels = float_layers(a) ? 0 : 255;
-        p.materials = materials;
-        p.objects = a->o.p.stencil_clip ? m->objects + first[k] : NULL;
-        p.cam = cam;
-        st = ps_splat_build(m->photons + first[k], m->materials + first[k], end - first[k], &p, b, err);
-        wanted += b->wanted;
-        lost += b->lost;
-        first[k] = end;
-    }
-    ps_feed_unlock(a->feed);
-    a->lost_fraction = wanted > 0.0 ? lost / wanted : 0.0;
-    return st;
-}
-
-/* The picture as the window shows it: layers composited, encoded like a
- * snapshot (exposure, sRGB, 8 bits), drawn with glDrawPixels. */
-static ps_status compose(app *a, ps_error *err)
-{
-    double gain[PS_MAP_COUNT];
-    for (int k = 0; k < PS_MAP_COUNT; k++) {
-        unsigned layer = k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL;
-        gain[k] = !(a->shown & layer) || a->emitted[k] == 0 ? 0.0
-                  : float_layers(a)                         ? a->exposure * (double)a->cap[k] / (double)a->emitted[k]
-                                                            : 1.0;
-    }
-    ps_image_destroy(&a->picture);
-    ps_status st = ps_gl_layers_composite(a->layers, float_layers(a) ? a->exposure : 1.0, gain, &a->picture, err);
-    if (st != PS_OK)
-        return st;
-    for (int y = 0; y < a->height; y++) {
-        const float *src = ps_image_at(&a->picture, 0, a->height - 1 - y);
-        uint8_t *dst = a->pixels + 3 * (size_t)y * (size_t)a->width;
-        for (int i = 0; i < 3 * a->width; i++)
-            dst[i] = ps_tonemap_8bit(src[i], 1.0f);
-    }
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glViewport(0, 0, a->width, a->height);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_STENCIL_TEST);
-    glDisable(GL_BLEND);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glWindowPos2i(0, 0);
-    glDrawPixels(a->width, a->height, GL_RGB, GL_UNSIGNED_BYTE, a->pixels);
-    return PS_OK;
 }
 
 static void draw_overlay(app *a)
 {
     if (!a->overlay && !a->help)
         return;
+    const ps_session_settings *set = ps_session_get_settings(a->session);
+    const ps_scene *scene = ps_session_scene(a->session);
+    ps_session_counts counts;
+    ps_session_get_counts(a->session, &counts);
+    bool float_layers = set->float_buffer;
+    bool counter_stopped = ps_session_counter_stopped(a->session, NULL);
     char text[2 * PS_ERROR_MSG_MAX + 1024];
-    ps_feed_lock(a->feed);
-    const ps_photon_map *maps = ps_feed_maps(a->feed);
-    uint64_t ce = maps[0].counters.emitted, ge = maps[1].counters.emitted;
-    bool ended = ps_feed_ended(a->feed), limited = ps_feed_store_limited(a->feed);
-    ps_feed_unlock(a->feed);
-    double elapsed = glfwGetTime() - a->edit_time;
+    uint64_t ce = counts.map[0].emitted, ge = counts.map[1].emitted;
+    double elapsed = ps_now_seconds() - a->edit_time;
     double rate = elapsed > 0.0 ? (double)(ce + ge) / elapsed : 0.0;
-    const char *state = a->counter_stopped ? "stopped by the error counter"
-                        : a->paused        ? "paused"
-                        : limited          ? "memory cap reached (--max-photons)"
-                        : ended            ? "cap reached"
-                                           : "tracing";
+    const char *state = counter_stopped                   ? "stopped by the error counter"
+                        : ps_session_paused(a->session) ? "paused"
+                        : counts.store_limited            ? "memory cap reached (--max-photons)"
+                        : counts.ended                    ? "cap reached"
+                                                          : "tracing";
     int n = snprintf(text, sizeof text,
                      "caustic %llu/%llu  global %llu/%llu  %s\n"
                      "%.3g photons/s  %.1f fps  tau %.3g s  frame %.0f ms\n"
                      "%s splats  %s kernel  r %.3g/%.3g  layers %s%s%s  %s  exposure %.3g\n",
-                     (unsigned long long)ce, (unsigned long long)a->cap[0], (unsigned long long)ge,
-                     (unsigned long long)a->cap[1], state, rate, a->fps, a->tau, 1000.0 * a->frame_seconds,
-                     ps_splat_mode_name(a->splat), ps_kernel_name(a->kernel_kind), a->splat_radius[0],
-                     a->splat_radius[1],
-                     a->shown & PS_LAYER_DIRECT ? "D" : "-", a->shown & PS_LAYER_CAUSTIC ? "C" : "-",
-                     a->shown & PS_LAYER_GLOBAL ? "G" : "-", float_layers(a) ? "float" : ps_precision_name(a->precision),
-                     a->exposure);
-    if (!float_layers(a) && n > 0 && (size_t)n < sizeof text)
+                     (unsigned long long)ce, (unsigned long long)set->caps[0], (unsigned long long)ge,
+                     (unsigned long long)set->caps[1], state, rate, a->fps, set->tau, 1000.0 * a->frame_seconds,
+                     ps_splat_mode_name(set->splat), ps_kernel_name(set->kernel),
+                     ps_session_radius(a->session, PS_MAP_CAUSTIC), ps_session_radius(a->session, PS_MAP_GLOBAL),
+                     set->layers & PS_LAYER_DIRECT ? "D" : "-", set->layers & PS_LAYER_CAUSTIC ? "C" : "-",
+                     set->layers & PS_LAYER_GLOBAL ? "G" : "-", float_layers ? "float" : ps_precision_name(set->precision),
+                     set->exposure);
+    if (!float_layers && n > 0 && (size_t)n < sizeof text)
         n += snprintf(text + n, sizeof text - (size_t)n, "error counter: %.1f %% of the last refresh rounded away%s\n",
-                      100.0 * a->lost_fraction, a->counter_stopped ? " (stopped shooting)" : "");
+                      100.0 * a->frame.round_off, counter_stopped ? " (stopped shooting)" : "");
     if (a->sel_kind != SEL_NONE && n > 0 && (size_t)n < sizeof text) {
         size_t count;
         if (a->sel_kind == SEL_LIGHT) {
-            const ps_light *L = &ps_scene_lights(a->scene, &count)[a->sel_index];
+            const ps_light *L = &ps_scene_lights(scene, &count)[a->sel_index];
             n += snprintf(text + n, sizeof text - (size_t)n, "selected: light %zu (%s) at %.3g %.3g %.3g, %.3g W",
                           a->sel_index, ps_light_type_name(L->type), L->position.x, L->position.y, L->position.z,
                           ps_rgb_mean(L->power));
             if (L->type == PS_LIGHT_SPOT)
                 n += snprintf(text + n, sizeof text - (size_t)n, ", %.3g deg", L->angle_deg);
         } else {
-            const ps_object *ob = &ps_scene_objects(a->scene, &count)[a->sel_index];
+            const ps_object *ob = &ps_scene_objects(scene, &count)[a->sel_index];
             ps_vec3 c = ps_aabb_center(ob->bounds);
             n += snprintf(text + n, sizeof text - (size_t)n, "selected: object %zu (line %d) at %.3g %.3g %.3g",
                           a->sel_index, ob->line, c.x, c.y, c.z);
@@ -463,111 +307,77 @@ static void draw_overlay(app *a)
         if (n > 0 && (size_t)n < sizeof text)
             n += snprintf(text + n, sizeof text - (size_t)n, "\n");
     }
+    if (a->message[0] && ps_now_seconds() - a->message_time > MESSAGE_SECONDS)
+        a->message[0] = '\0';
     if (a->message[0] && n > 0 && (size_t)n < sizeof text)
         snprintf(text + n, sizeof text - (size_t)n, "%s\n", a->message);
     ps_gl_overlay_begin(a->width, a->height);
-    const char *shown = a->help ? help_text : text;
-    const int pad = 4;
-    ps_gl_overlay_rect(0, 0, ps_gl_text_width(shown) + 2 * pad, ps_gl_text_height(shown) + 2 * pad, 0, 0, 0, 0.6f);
-    glColor3f(1.0f, 1.0f, 0.85f);
-    ps_gl_text(pad, pad, shown);
+    ps_gl_overlay_panel(a->help ? help_text : text);
     ps_gl_overlay_end();
 }
 
-/* One refresh: a new view if needed, the new splats, the composite, the
- * overlay, and the swap. */
+/* One refresh: the session's splats drawn into the layers (a new view first
+ * when it asks), the composite shown by GL, the overlay. */
 static ps_status refresh(app *a, ps_error *err)
 {
-    double t0 = glfwGetTime();
+    double t0 = ps_now_seconds();
     ps_camera_frame cam = camera_frame(a);
-    if (a->view_dirty) {
-        ps_gl_layers_view(a->layers, a->gl, &cam, float_layers(a) ? 1.0 : a->exposure, (a->shown & PS_LAYER_DIRECT) != 0);
-        a->drawn[0] = a->drawn[1] = 0;
-        a->emitted[0] = a->emitted[1] = 0;
-        a->view_dirty = false;
-    }
-    size_t upto[PS_MAP_COUNT];
-    double t_splat = glfwGetTime();
-    ps_status st = build_splats(a, upto, err);
+    ps_status st = ps_session_refresh(a->session, &cam, &a->frame, err);
     if (st != PS_OK)
         return st;
-    size_t splats = 0;
-    for (int k = 0; k < PS_MAP_COUNT; k++) {
-        if (!float_layers(a))
-            ps_gl_layers_clear_map(a->layers, k);
-        ps_gl_layers_add(a->layers, a->gl, k, &a->batch[k], a->splat, a->splat_radius[k], a->o.p.point_size);
-        a->drawn[k] = upto[k];
-        splats += a->batch[k].splats;
-    }
-    if (float_layers(a) && splats > 0) {
-        glFinish(); /* llvmpipe draws when flushed: time the drawing, not the queueing */
-        double rate = (double)splats / fmax(glfwGetTime() - t_splat, 1e-6);
-        a->budget = fmax(SPLAT_BUDGET_MIN, rate * a->tau * SPLAT_TIME_SHARE / PS_MAP_COUNT);
-    }
-    /* Thesis 5.1: once a refresh loses this much to round-off, more photons
-     * only add noise: stop shooting (until the next edit). */
-    if (!float_layers(a) && a->precision == PS_PRECISION_COUNTER && !a->counter_stopped &&
-        a->lost_fraction > a->o.p.counter_threshold) {
-        a->counter_stopped = true;
-        ps_feed_pause(a->feed, true);
-    }
-    st = compose(a, err);
-    if (st != PS_OK)
-        return st;
+    double t_draw = ps_now_seconds();
+    ps_gl_layers_draw(a->layers, a->gl, &cam, &a->frame);
+    if (a->frame.splats > 0)
+        ps_gl_finish();
+    double draw_seconds = ps_now_seconds() - t_draw;
+    double gains[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        gains[k] = a->frame.map[k].gain;
+    double t_show = ps_now_seconds();
+    ps_gl_layers_show(a->layers, a->frame.direct_gain, gains);
+    ps_gl_finish();
+    a->show_sum += ps_now_seconds() - t_show;
+    a->show_count++;
     draw_overlay(a);
-    double t1 = glfwGetTime();
+    /* Only now: a feed held for the first refresh (session.h) goes on once
+     * the whole refresh is done, so that the refresh had every core. */
+    ps_session_drawn(a->session, draw_seconds);
+    a->redraw = false;
+    double t1 = ps_now_seconds();
     a->frame_seconds = t1 - t0;
     if (a->frames > 0 && t1 > a->last_refresh)
         a->fps += FPS_SMOOTHING * (1.0 / (t1 - a->last_refresh) - a->fps);
     a->last_refresh = t1;
-    if (a->frames++ == 0)
+    if (a->frames++ == 0) {
         a->t_first_frame = t1;
-    if (a->release_feed) {
-        a->release_feed = false;
-        if (!a->paused && !a->counter_stopped)
-            ps_feed_pause(a->feed, false);
-    }
-    if (a->frames == 1)
         a->first_frame_seconds = t1 - a->start_time;
-    else if (a->awaiting_edit_frame) {
+    } else if (a->awaiting_edit_frame) {
         double latency = t1 - a->edit_time;
         a->edit_latency_sum += latency;
         a->edit_latency_count++;
         if (latency > a->edit_latency_max)
             a->edit_latency_max = latency;
-        a->awaiting_edit_frame = false;
     }
+    a->awaiting_edit_frame = false;
     return PS_OK;
 }
 
 /* The window as shown (before the swap), as a PNG: the 8-bit codes decoded
- * to linear and written through the same encoder, which gives them back. */
-static ps_status screenshot(app *a, const char *path, ps_error *err)
+ * to linear and written through the same encoder, which gives them back.
+ * `tell`: say so in the overlay (a key's screenshot; a script's stays quiet,
+ * so that the next screenshot does not show the message). */
+static ps_status screenshot(app *a, const char *path, bool tell, ps_error *err)
 {
     ps_image img;
-    ps_status st = ps_image_create(a->width, a->height, &img, err);
-    uint8_t *rgb = st == PS_OK ? malloc(3 * (size_t)a->width * (size_t)a->height) : NULL;
-    if (st == PS_OK && !rgb) {
-        ps_image_destroy(&img);
-        return ps_error_set(err, PS_ERR_NOMEM, "photosplat: out of memory for a screenshot");
-    }
-    if (st != PS_OK)
-        return st;
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glReadBuffer(GL_BACK);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, a->width, a->height, GL_RGB, GL_UNSIGNED_BYTE, rgb);
-    for (int y = 0; y < a->height; y++) {
-        float *dst = ps_image_at(&img, 0, y);
-        const uint8_t *src = rgb + 3 * (size_t)(a->height - 1 - y) * (size_t)a->width;
-        for (int i = 0; i < 3 * a->width; i++)
-            dst[i] = ps_srgb_decode((float)src[i] / 255.0f);
-    }
-    free(rgb);
-    st = ps_png_write(&img, path, 1.0f, err);
-    ps_image_destroy(&img);
+    ps_status st = ps_platform_read(a->platform, &img, err);
     if (st == PS_OK)
-        snprintf(a->message, sizeof a->message, "saved %s", path);
+        st = ps_png_write(&img, path, 1.0f, err);
+    ps_image_destroy(&img);
+    if (st == PS_OK && tell) {
+        char text[PS_ERROR_MSG_MAX];
+        snprintf(text, sizeof text, "saved %s", path);
+        say(a, text);
+    }
     return st;
 }
 
@@ -594,7 +404,7 @@ static void orbit(app *a, double yaw_deg, double pitch_deg)
     ps_vec3 right = ps_v3_norm(ps_v3_cross(v, up));
     v = rotate(v, right, -(want - elevation) * PS_PI / 180.0);
     a->camera.eye = ps_v3_add(a->camera.target, v);
-    a->view_dirty = true;
+    a->redraw = true;
 }
 
 static void pan(app *a, double dx, double dy)
@@ -604,39 +414,23 @@ static void pan(app *a, double dx, double dy)
     ps_vec3 move = ps_v3_add(ps_v3_scale(f.right, -dx * dist * PAN_PER_PIXEL), ps_v3_scale(f.up, dy * dist * PAN_PER_PIXEL));
     a->camera.eye = ps_v3_add(a->camera.eye, move);
     a->camera.target = ps_v3_add(a->camera.target, move);
-    a->view_dirty = true;
+    a->redraw = true;
 }
 
 static void zoom(app *a, double notches)
 {
     ps_vec3 v = ps_v3_sub(a->camera.eye, a->camera.target);
     a->camera.eye = ps_v3_add(a->camera.target, ps_v3_scale(v, pow(ZOOM_PER_NOTCH, notches)));
-    a->view_dirty = true;
+    a->redraw = true;
 }
 
 /* ---- editing ----------------------------------------------------------------------- */
 
-static void edited(app *a, bool geometry)
+/* An edit's outcome: refused ones are said in the overlay. */
+static void report(app *a, ps_status st, const ps_error *err)
 {
-    a->scene_dirty = true;
-    a->geometry_dirty = a->geometry_dirty || geometry;
-    a->edits++;
-}
-
-static ps_status move_light_to(app *a, size_t light, ps_vec3 p, ps_error *err)
-{
-    ps_status st = ps_scene_set_light_position(a->scene, light, p, err);
-    if (st == PS_OK)
-        edited(a, false);
-    return st;
-}
-
-static ps_status move_object_by(app *a, size_t object, ps_vec3 d, ps_error *err)
-{
-    ps_status st = ps_scene_translate_object(a->scene, object, d, err);
-    if (st == PS_OK)
-        edited(a, true);
-    return st;
+    if (st != PS_OK)
+        say(a, err->msg);
 }
 
 /* Moves the selection by d. */
@@ -646,13 +440,12 @@ static void move_selection(app *a, ps_vec3 d)
     size_t n;
     ps_status st = PS_OK;
     if (a->sel_kind == SEL_LIGHT) {
-        const ps_light *L = &ps_scene_lights(a->scene, &n)[a->sel_index];
-        st = move_light_to(a, a->sel_index, ps_v3_add(L->position, d), &err);
+        const ps_light *L = &ps_scene_lights(ps_session_scene(a->session), &n)[a->sel_index];
+        st = ps_session_move_light(a->session, a->sel_index, ps_v3_add(L->position, d), &err);
     } else if (a->sel_kind == SEL_OBJECT) {
-        st = move_object_by(a, a->sel_index, d, &err);
+        st = ps_session_move_object(a->session, a->sel_index, d, &err);
     }
-    if (st != PS_OK)
-        snprintf(a->message, sizeof a->message, "%s", err.msg);
+    report(a, st, &err);
 }
 
 /* The point where the cursor's ray meets the drag plane through the anchor. */
@@ -683,7 +476,7 @@ static void pick(app *a, double x, double y)
 {
     ps_camera_frame f = camera_frame(a);
     size_t nl;
-    const ps_light *lights = ps_scene_lights(a->scene, &nl);
+    const ps_light *lights = ps_scene_lights(ps_session_scene(a->session), &nl);
     double best = PICK_RADIUS_PX * PICK_RADIUS_PX;
     a->sel_kind = SEL_NONE;
     for (size_t l = 0; l < nl; l++) {
@@ -701,7 +494,7 @@ static void pick(app *a, double x, double y)
     if (a->sel_kind != SEL_NONE)
         return;
     ps_surface sp;
-    if (ps_world_intersect(a->world, ps_camera_ray(&f, x, y), INFINITY, &sp)) {
+    if (ps_world_intersect(ps_session_world(a->session), ps_camera_ray(&f, x, y), INFINITY, &sp)) {
         a->sel_kind = SEL_OBJECT;
         a->sel_index = sp.object;
         a->drag_anchor = sp.p;
@@ -712,9 +505,9 @@ static void select_next(app *a, int kind)
 {
     size_t n;
     if (kind == SEL_LIGHT)
-        (void)ps_scene_lights(a->scene, &n);
+        (void)ps_scene_lights(ps_session_scene(a->session), &n);
     else
-        (void)ps_scene_objects(a->scene, &n);
+        (void)ps_scene_objects(ps_session_scene(a->session), &n);
     if (n == 0)
         return;
     a->sel_index = a->sel_kind == kind ? (a->sel_index + 1) % n : 0;
@@ -726,12 +519,9 @@ static void scale_power(app *a, double f)
     size_t n;
     if (a->sel_kind != SEL_LIGHT)
         return;
-    const ps_light *L = &ps_scene_lights(a->scene, &n)[a->sel_index];
+    const ps_light *L = &ps_scene_lights(ps_session_scene(a->session), &n)[a->sel_index];
     ps_error err;
-    if (ps_scene_set_light_power(a->scene, a->sel_index, ps_rgb_scale(L->power, f), &err) == PS_OK)
-        edited(a, false);
-    else
-        snprintf(a->message, sizeof a->message, "%s", err.msg);
+    report(a, ps_session_set_light_power(a->session, a->sel_index, ps_rgb_scale(L->power, f), &err), &err);
 }
 
 static void step_angle(app *a, double d)
@@ -739,51 +529,37 @@ static void step_angle(app *a, double d)
     size_t n;
     if (a->sel_kind != SEL_LIGHT)
         return;
-    const ps_light *L = &ps_scene_lights(a->scene, &n)[a->sel_index];
+    const ps_light *L = &ps_scene_lights(ps_session_scene(a->session), &n)[a->sel_index];
     if (L->type != PS_LIGHT_SPOT)
         return;
     ps_error err;
     double want = fmin(90.0, fmax(KEY_ANGLE_STEP, L->angle_deg + d));
-    if (ps_scene_set_spot_angle(a->scene, a->sel_index, want, &err) == PS_OK)
-        edited(a, false);
-    else
-        snprintf(a->message, sizeof a->message, "%s", err.msg);
+    report(a, ps_session_set_spot_angle(a->session, a->sel_index, want, &err), &err);
 }
 
 /* ---- settings (keys and scripts) --------------------------------------------------- */
 
 static ps_status set_kernel(app *a, ps_kernel k, ps_error *err)
 {
-    ps_kernel_texture t;
-    ps_status st = ps_kernel_texture_make(k, PS_KERNEL_TEXTURE_SIZE, &t, err);
-    if (st != PS_OK)
-        return st;
-    ps_kernel_texture_free(&a->kernel);
-    a->kernel = t;
-    a->kernel_kind = k;
-    ps_gl_renderer_set_kernel(a->gl, &a->kernel);
-    a->view_dirty = true;
-    return PS_OK;
+    ps_status st = ps_session_set_kernel(a->session, k, err);
+    if (st == PS_OK)
+        ps_gl_renderer_set_kernel(a->gl, ps_session_kernel(a->session));
+    a->redraw = true;
+    return st;
 }
 
 static void set_layers(app *a, unsigned shown)
 {
-    a->shown = shown;
-    a->view_dirty = true;
+    ps_session_set_layers(a->session, shown);
+    a->redraw = true;
 }
 
-static void set_exposure(app *a, double e)
+static void scale_radii(app *a, double f)
 {
-    a->exposure = e;
-    if (!float_layers(a)) /* 8-bit layers hold exposed values */
-        a->view_dirty = true;
-}
-
-static void set_paused(app *a, bool paused)
-{
-    a->paused = paused;
-    if (!a->counter_stopped)
-        ps_feed_pause(a->feed, paused);
+    const ps_session_settings *set = ps_session_get_settings(a->session);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_session_set_radius(a->session, (ps_map_kind)k, set->radius[k] * f);
+    a->redraw = true;
 }
 
 /* ---- input ---------------------------------------------------------------------------- */
@@ -798,8 +574,8 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         return;
     bool shift = (mods & GLFW_MOD_SHIFT) != 0;
     ps_error err;
-    size_t n;
-    double step = KEY_STEP_FRACTION * ps_v3_len(ps_aabb_diag(ps_scene_bounds(a->scene)));
+    const ps_session_settings *set = ps_session_get_settings(a->session);
+    double step = KEY_STEP_FRACTION * ps_v3_len(ps_aabb_diag(ps_scene_bounds(ps_session_scene(a->session))));
     ps_camera_frame f = camera_frame(a);
     ps_vec3 up = ps_v3_norm(a->camera.up);
     /* Horizontal steps follow the view: right, and forward flattened. */
@@ -808,27 +584,30 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     ps_vec3 right = ps_v3_norm(ps_v3_cross(fwd, up));
     switch (key) {
     case GLFW_KEY_Q: a->quit = true; break;
-    case GLFW_KEY_H: a->help = !a->help; break;
-    case GLFW_KEY_V: a->overlay = !a->overlay; break;
-    case GLFW_KEY_SPACE: set_paused(a, !a->paused); break;
-    case GLFW_KEY_S: a->splat = (ps_splat_mode)((a->splat + 1) % PS_SPLAT_MODE_COUNT), a->view_dirty = true; break;
+    case GLFW_KEY_H: a->help = !a->help, a->redraw = true; break;
+    case GLFW_KEY_V: a->overlay = !a->overlay, a->redraw = true; break;
+    case GLFW_KEY_SPACE: ps_session_set_paused(a->session, !ps_session_paused(a->session)); break;
+    case GLFW_KEY_S:
+        ps_session_set_splat(a->session, (ps_splat_mode)((set->splat + 1) % PS_SPLAT_MODE_COUNT));
+        a->redraw = true;
+        break;
     case GLFW_KEY_K:
-        if (set_kernel(a, (ps_kernel)((a->kernel_kind + 1) % PS_KERNEL_COUNT), &err) != PS_OK)
-            snprintf(a->message, sizeof a->message, "%s", err.msg);
+        if (set_kernel(a, (ps_kernel)((set->kernel + 1) % PS_KERNEL_COUNT), &err) != PS_OK)
+            say(a, err.msg);
         break;
     case GLFW_KEY_C:
-        a->precision = (ps_precision)((a->precision + 1) % PS_PRECISION_COUNT), a->view_dirty = true;
+        ps_session_set_precision(a->session, (ps_precision)((set->precision + 1) % PS_PRECISION_COUNT));
+        a->redraw = true;
         break;
-    case GLFW_KEY_1: set_layers(a, a->shown ^ PS_LAYER_DIRECT); break;
-    case GLFW_KEY_2: set_layers(a, a->shown ^ PS_LAYER_CAUSTIC); break;
-    case GLFW_KEY_3: set_layers(a, a->shown ^ PS_LAYER_GLOBAL); break;
-    case GLFW_KEY_R:
-        for (int k = 0; k < PS_MAP_COUNT; k++)
-            a->radius[k] *= shift ? 1.0 / KEY_SCALE : KEY_SCALE;
-        a->view_dirty = true;
+    case GLFW_KEY_1: set_layers(a, set->layers ^ PS_LAYER_DIRECT); break;
+    case GLFW_KEY_2: set_layers(a, set->layers ^ PS_LAYER_CAUSTIC); break;
+    case GLFW_KEY_3: set_layers(a, set->layers ^ PS_LAYER_GLOBAL); break;
+    case GLFW_KEY_R: scale_radii(a, shift ? 1.0 / KEY_SCALE : KEY_SCALE); break;
+    case GLFW_KEY_T: ps_session_set_tau(a->session, fmax(1e-3, set->tau * (shift ? 0.5 : 2.0))); break;
+    case GLFW_KEY_E:
+        ps_session_set_exposure(a->session, set->exposure * (shift ? 1.0 / KEY_SCALE : KEY_SCALE));
+        a->redraw = true;
         break;
-    case GLFW_KEY_T: a->tau = fmax(1e-3, a->tau * (shift ? 0.5 : 2.0)); break;
-    case GLFW_KEY_E: set_exposure(a, a->exposure * (shift ? 1.0 / KEY_SCALE : KEY_SCALE)); break;
     case GLFW_KEY_TAB: select_next(a, shift ? SEL_OBJECT : SEL_LIGHT); break;
     case GLFW_KEY_ESCAPE: a->sel_kind = SEL_NONE; break;
     case GLFW_KEY_P: {
@@ -852,7 +631,6 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_RIGHT_BRACKET: step_angle(a, KEY_ANGLE_STEP); break;
     default: break;
     }
-    (void)n;
 }
 
 static void on_button(GLFWwindow *w, int button, int action, int mods)
@@ -904,42 +682,41 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
 
 /* ---- the script ------------------------------------------------------------------------- */
 
+/* An index the scene has, or a located error. */
+static ps_status check_index(const app *a, const ps_script_action *act, const char *what, const char *things,
+                             size_t n, ps_error *err)
+{
+    if (act->index < n)
+        return PS_OK;
+    return ps_error_set(err, PS_ERR_RANGE, "%s:%d: %s %u: the scene has %zu %s", a->o.script, act->line, what,
+                        act->index, n, things);
+}
+
 static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
 {
-    size_t n;
+    size_t nl, no;
+    (void)ps_scene_lights(ps_session_scene(a->session), &nl);
+    (void)ps_scene_objects(ps_session_scene(a->session), &no);
+    ps_session *s = a->session;
     switch (act->kind) {
     case PS_SCRIPT_SCREENSHOT:
-        return screenshot(a, act->path, err);
+        return screenshot(a, act->path, false, err);
     case PS_SCRIPT_MOVE_LIGHT:
-        (void)ps_scene_lights(a->scene, &n);
-        if (act->index >= n)
-            return ps_error_set(err, PS_ERR_RANGE, "%s:%d: move light %u: the scene has %zu lights", a->o.script,
-                                act->line, act->index, n);
-        return move_light_to(a, act->index, act->v, err);
+        if (check_index(a, act, "move light", "lights", nl, err) != PS_OK)
+            return err->status;
+        return ps_session_move_light(s, act->index, act->v, err);
     case PS_SCRIPT_MOVE_OBJECT:
-        (void)ps_scene_objects(a->scene, &n);
-        if (act->index >= n)
-            return ps_error_set(err, PS_ERR_RANGE, "%s:%d: move object %u: the scene has %zu objects", a->o.script,
-                                act->line, act->index, n);
-        return move_object_by(a, act->index, act->v, err);
+        if (check_index(a, act, "move object", "objects", no, err) != PS_OK)
+            return err->status;
+        return ps_session_move_object(s, act->index, act->v, err);
     case PS_SCRIPT_POWER:
-        (void)ps_scene_lights(a->scene, &n);
-        if (act->index >= n)
-            return ps_error_set(err, PS_ERR_RANGE, "%s:%d: power light %u: the scene has %zu lights", a->o.script,
-                                act->line, act->index, n);
-        if (ps_scene_set_light_power(a->scene, act->index, act->power, err) != PS_OK)
+        if (check_index(a, act, "power light", "lights", nl, err) != PS_OK)
             return err->status;
-        edited(a, false);
-        return PS_OK;
+        return ps_session_set_light_power(s, act->index, act->power, err);
     case PS_SCRIPT_ANGLE:
-        (void)ps_scene_lights(a->scene, &n);
-        if (act->index >= n)
-            return ps_error_set(err, PS_ERR_RANGE, "%s:%d: angle light %u: the scene has %zu lights", a->o.script,
-                                act->line, act->index, n);
-        if (ps_scene_set_spot_angle(a->scene, act->index, act->number, err) != PS_OK)
+        if (check_index(a, act, "angle light", "lights", nl, err) != PS_OK)
             return err->status;
-        edited(a, false);
-        return PS_OK;
+        return ps_session_set_spot_angle(s, act->index, act->number, err);
     case PS_SCRIPT_ORBIT:
         orbit(a, act->yaw, act->pitch);
         return PS_OK;
@@ -951,66 +728,44 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
         a->quit = true;
         return PS_OK;
     case PS_SCRIPT_SET:
+        a->redraw = true;
         switch (act->setting) {
-        case PS_SET_SPLAT: a->splat = (ps_splat_mode)act->choice, a->view_dirty = true; return PS_OK;
+        case PS_SET_SPLAT: ps_session_set_splat(s, (ps_splat_mode)act->choice); return PS_OK;
         case PS_SET_LAYERS: set_layers(a, act->layers); return PS_OK;
         case PS_SET_KERNEL: return set_kernel(a, (ps_kernel)act->choice, err);
         case PS_SET_RADIUS:
-            a->radius[PS_MAP_CAUSTIC] = act->number;
-            if (act->number2 > 0.0)
-                a->radius[PS_MAP_GLOBAL] = act->number2;
-            a->view_dirty = true;
+            ps_session_set_radius(s, PS_MAP_CAUSTIC, act->number);
+            ps_session_set_radius(s, PS_MAP_GLOBAL, act->number2);
             return PS_OK;
-        case PS_SET_TAU: a->tau = act->number; return PS_OK;
-        case PS_SET_PRECISION: a->precision = (ps_precision)act->choice, a->view_dirty = true; return PS_OK;
-        case PS_SET_EXPOSURE: set_exposure(a, act->number); return PS_OK;
-        case PS_SET_PAUSE: set_paused(a, act->choice != 0); return PS_OK;
+        case PS_SET_TAU: ps_session_set_tau(s, act->number); return PS_OK;
+        case PS_SET_PRECISION: ps_session_set_precision(s, (ps_precision)act->choice); return PS_OK;
+        case PS_SET_EXPOSURE: ps_session_set_exposure(s, act->number); return PS_OK;
+        case PS_SET_PAUSE: ps_session_set_paused(s, act->choice != 0); return PS_OK;
         }
         return PS_OK;
     }
     return PS_OK;
 }
 
-/* Whether a script's wait done is over: every map at its cap and all of it
- * drawn, with no edit or view change pending; or tracing paused (by the
- * user, a script or the error counter), which would otherwise never end it. */
-static bool script_wait_over(app *a)
-{
-    if (a->scene_dirty || a->view_dirty)
-        return false;
-    if (a->paused || a->counter_stopped)
-        return true;
-    ps_feed_lock(a->feed);
-    bool over = ps_feed_ended(a->feed);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        over = over && a->drawn[k] >= ps_feed_maps(a->feed)[k].count;
-    ps_feed_unlock(a->feed);
-    return over;
-}
+/* Whether a script's wait done is over: everything shown (session.h), and
+ * nothing the window itself has still to redraw. */
+static bool script_wait_over(app *a) { return !a->redraw && ps_session_settled(a->session); }
 
 /* ---- the session ---------------------------------------------------------------------- */
 
 static ps_status open_window(app *a, ps_error *err)
 {
-    if (!glfwInit())
-        return ps_error_set(err, PS_ERR_IO, "photosplat: cannot open a window (no display?); "
-                                            "photosplat-snap renders headless");
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 2);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 1);
-    glfwWindowHint(GLFW_DEPTH_BITS, 24);
-    glfwWindowHint(GLFW_STENCIL_BITS, 8);
-    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
     char title[512];
     snprintf(title, sizeof title, "photosplat - %s", a->o.c.scene);
-    a->win = glfwCreateWindow(a->width, a->height, title, NULL, NULL);
-    if (!a->win)
-        return ps_error_set(err, PS_ERR_IO, "photosplat: cannot create a %dx%d OpenGL 2.1 window", a->width, a->height);
-    glfwMakeContextCurrent(a->win);
-    glfwSwapInterval(0); /* refresh on our tau, not the monitor's */
-    int fw, fh;
-    glfwGetFramebufferSize(a->win, &fw, &fh);
-    a->width = fw;
-    a->height = fh;
+    ps_platform_config pc = {a->width, a->height, false, title};
+    ps_status st = ps_platform_open(&pc, &a->platform, err);
+    if (st != PS_OK) {
+        char why[PS_ERROR_MSG_MAX];
+        snprintf(why, sizeof why, "%s", err->msg);
+        return ps_error_set(err, st, "photosplat: %s", why);
+    }
+    ps_platform_size(a->platform, &a->width, &a->height);
+    a->win = ps_platform_window(a->platform);
     glfwSetWindowUserPointer(a->win, a);
     glfwSetKeyCallback(a->win, on_key);
     glfwSetMouseButtonCallback(a->win, on_button);
@@ -1025,40 +780,22 @@ static ps_status session(app *a, ps_error *err)
     a->width = a->o.c.width ? a->o.c.width : def->width;
     a->height = a->o.c.height ? a->o.c.height : def->height;
     a->camera = *ps_scene_camera(a->scene);
-    a->splat = (ps_splat_mode)a->o.p.splat;
-    a->kernel_kind = (ps_kernel)a->o.p.kernel;
-    a->precision = (ps_precision)a->o.p.precision;
-    a->shown = a->o.p.layers;
-    a->tau = a->o.p.tau;
-    a->exposure = a->o.c.exposure;
     a->overlay = a->o.overlay != 0;
-    a->budget = SPLAT_BUDGET_START;
-    for (int k = 0; k < PS_MAP_COUNT; k++) {
-        a->radius[k] = a->splat_radius[k] = ps_shared_radius(&a->o.c, def, (ps_map_kind)k);
-        a->cap[k] = ps_shared_photons(&a->o.c, def, (ps_map_kind)k);
-        ps_splat_batch_init(&a->batch[k]);
-    }
-    a->start_time = glfwGetTime();
+    a->start_time = ps_now_seconds();
     ps_status st = open_window(a, err);
     if (st == PS_OK)
-        st = ps_kernel_texture_make(a->kernel_kind, PS_KERNEL_TEXTURE_SIZE, &a->kernel, err);
-    if (st == PS_OK)
-        st = ps_gl_layers_create(a->width, a->height, float_layers(a), &a->layers, err);
-    a->pixels = malloc(3 * (size_t)a->width * (size_t)a->height);
-    if (st == PS_OK && !a->pixels)
-        st = ps_error_set(err, PS_ERR_NOMEM, "photosplat: out of memory for a %dx%d picture", a->width, a->height);
-    if (st == PS_OK)
-        st = rebuild(a, true, err);
-    a->edit_time = glfwGetTime();
+        st = open_session(a, err);
+    a->edit_time = ps_now_seconds();
     a->awaiting_edit_frame = true;
+    a->redraw = true;
     double next = 0.0;
     while (st == PS_OK && !a->quit && !glfwWindowShouldClose(a->win)) {
         if (ps_cancelled(a->o.cancel)) {
             st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %llu frames", (unsigned long long)a->frames);
             break;
         }
-        double now = glfwGetTime();
-        if (now < next && !a->view_dirty && !a->scene_dirty)
+        double now = ps_now_seconds();
+        if (now < next && !a->redraw && !ps_session_edited(a->session))
             glfwWaitEventsTimeout(next - now);
         else
             glfwPollEvents();
@@ -1069,9 +806,9 @@ static ps_status session(app *a, ps_error *err)
                 if (!script_wait_over(a))
                     break;
                 a->script_waiting = false;
-                a->script_delay = glfwGetTime() - a->t_first_frame - a->wait_time;
+                a->script_delay = ps_now_seconds() - a->t_first_frame - a->wait_time;
             }
-            if (act->time + a->script_delay > glfwGetTime() - a->t_first_frame)
+            if (act->time + a->script_delay > ps_now_seconds() - a->t_first_frame)
                 break;
             a->script_next++;
             if (act->kind == PS_SCRIPT_SCREENSHOT) /* the window as it is now: refresh first */
@@ -1081,33 +818,32 @@ static ps_status session(app *a, ps_error *err)
         }
         if (st != PS_OK || a->quit)
             break;
-        if (a->scene_dirty) {
+        if (ps_session_edited(a->session)) {
             /* Every edit restarts the maps (thesis 4.1.4); the first refresh
              * follows at once, with whatever the first batch brings. */
-            st = rebuild(a, a->geometry_dirty, err);
-            a->scene_dirty = a->geometry_dirty = false;
-            a->edit_time = glfwGetTime();
+            st = apply_edits(a, err);
+            a->edit_time = ps_now_seconds();
             a->awaiting_edit_frame = true;
             next = 0.0;
             if (st != PS_OK)
                 break;
         }
-        now = glfwGetTime();
-        if (now >= next || a->view_dirty || a->shot_path[0]) {
+        now = ps_now_seconds();
+        if (now >= next || a->redraw || a->shot_path[0]) {
             st = refresh(a, err);
             if (st == PS_OK && a->shot_path[0]) {
                 ps_error shot_err;
-                if (screenshot(a, a->shot_path, &shot_err) != PS_OK)
-                    snprintf(a->message, sizeof a->message, "%s", shot_err.msg);
+                if (screenshot(a, a->shot_path, true, &shot_err) != PS_OK)
+                    say(a, shot_err.msg);
                 a->shot_path[0] = '\0';
             }
             if (st == PS_OK)
-                glfwSwapBuffers(a->win);
-            next = now + a->tau;
+                ps_platform_present(a->platform);
+            next = now + ps_session_get_settings(a->session)->tau;
         }
     }
-    if (st == PS_OK && a->feed)
-        st = ps_feed_status(a->feed, err);
+    if (st == PS_OK && a->session)
+        st = ps_session_status(a->session, err);
     return st;
 }
 
@@ -1115,24 +851,20 @@ static ps_status write_stats(app *a, ps_error *err)
 {
     ps_run_stats rs;
     memset(&rs, 0, sizeof rs);
-    bool cap_reached = false, store_limited = false;
-    double map_bytes = 0.0; /* what the current maps hold allocated: bounded by the caps */
-    if (a->feed) {
-        ps_feed_lock(a->feed);
-        for (int k = 0; k < PS_MAP_COUNT; k++) {
-            const ps_photon_map *m = &ps_feed_maps(a->feed)[k];
-            rs.emitted[k] = m->counters.emitted;
-            rs.stored[k] = m->counters.stored;
-            rs.rays += m->counters.rays;
-            map_bytes += (double)(m->cap * sizeof *m->photons + m->mcap * sizeof *m->materials +
-                                  m->ocap * sizeof *m->objects);
-        }
-        store_limited = ps_feed_store_limited(a->feed);
-        cap_reached = ps_feed_ended(a->feed) && !store_limited;
-        ps_feed_unlock(a->feed);
-        rs.skips = ps_tracer_skips(a->tracer, &rs.skip_count);
+    ps_session_counts counts;
+    memset(&counts, 0, sizeof counts);
+    const ps_session_settings *set = NULL;
+    if (a->session) {
+        ps_session_get_counts(a->session, &counts);
+        set = ps_session_get_settings(a->session);
+        rs.skips = ps_tracer_skips(ps_session_tracer(a->session), &rs.skip_count);
     }
-    double elapsed = glfwGetTime() - a->edit_time;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        rs.emitted[k] = counts.map[k].emitted;
+        rs.stored[k] = counts.map[k].stored;
+        rs.rays += counts.map[k].rays;
+    }
+    double elapsed = ps_now_seconds() - a->edit_time;
     rs.trace_seconds = elapsed;
     rs.frames = a->frames;
     ps_stats_add(&rs, "width", a->width);
@@ -1140,18 +872,19 @@ static ps_status write_stats(app *a, ps_error *err)
     ps_stats_add(&rs, "fps", a->fps);
     ps_stats_add(&rs, "frame_seconds", a->frame_seconds);
     ps_stats_add(&rs, "first_frame_seconds", a->first_frame_seconds);
-    ps_stats_add(&rs, "edits", (double)a->edits);
+    ps_stats_add(&rs, "edits", a->session ? (double)ps_session_edits(a->session) : 0.0);
     ps_stats_add(&rs, "edit_to_frame_seconds_max", a->edit_latency_max);
     ps_stats_add(&rs, "edit_to_frame_seconds_mean",
                  a->edit_latency_count ? a->edit_latency_sum / (double)a->edit_latency_count : 0.0);
-    ps_stats_add(&rs, "tau", a->tau);
-    ps_stats_add(&rs, "counter_stopped", a->counter_stopped ? 1.0 : 0.0);
-    ps_stats_add(&rs, "caustic_cap", (double)a->cap[PS_MAP_CAUSTIC]);
-    ps_stats_add(&rs, "global_cap", (double)a->cap[PS_MAP_GLOBAL]);
-    ps_stats_add(&rs, "cap_reached", cap_reached ? 1.0 : 0.0);
-    ps_stats_add(&rs, "photon_map_bytes", map_bytes);
+    ps_stats_add(&rs, "tau", set ? set->tau : a->o.p.tau);
+    ps_stats_add(&rs, "composite_seconds_mean", a->show_count ? a->show_sum / (double)a->show_count : 0.0);
+    ps_stats_add(&rs, "counter_stopped", a->session && ps_session_counter_stopped(a->session, NULL) ? 1.0 : 0.0);
+    ps_stats_add(&rs, "caustic_cap", set ? (double)set->caps[PS_MAP_CAUSTIC] : 0.0);
+    ps_stats_add(&rs, "global_cap", set ? (double)set->caps[PS_MAP_GLOBAL] : 0.0);
+    ps_stats_add(&rs, "cap_reached", counts.ended && !counts.store_limited ? 1.0 : 0.0);
+    ps_stats_add(&rs, "photon_map_bytes", counts.map_bytes);
     ps_stats_add(&rs, "max_photons", (double)a->o.max_photons);
-    ps_stats_add(&rs, "max_photons_reached", store_limited ? 1.0 : 0.0);
+    ps_stats_add(&rs, "max_photons_reached", counts.store_limited ? 1.0 : 0.0);
     return ps_stats_write(a->o.c.stats, &rs, err);
 }
 
@@ -1197,23 +930,15 @@ int main(int argc, char **argv)
     st = session(&a, &err);
     if (st == PS_OK && a.o.c.stats)
         st = write_stats(&a, &err);
-    teardown_maps(&a);
+    uint64_t edits = a.session ? ps_session_edits(a.session) : 0;
+    ps_session_destroy(a.session);
     ps_gl_layers_destroy(a.layers);
     ps_gl_renderer_destroy(a.gl);
-    ps_kernel_texture_free(&a.kernel);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_splat_batch_free(&a.batch[k]);
-    ps_preview_mesh_free(&a.mesh);
-    ps_world_destroy(a.world);
-    ps_image_destroy(&a.picture);
-    free(a.pixels);
-    if (a.win)
-        glfwDestroyWindow(a.win);
-    glfwTerminate();
+    ps_platform_close(a.platform);
     ps_script_destroy(a.script);
     ps_scene_destroy(a.scene);
     if (st == PS_OK)
-        printf("photosplat: %llu frames, %llu edits\n", (unsigned long long)a.frames, (unsigned long long)a.edits);
+        printf("photosplat: %llu frames, %llu edits\n", (unsigned long long)a.frames, (unsigned long long)edits);
     if (st == PS_ERR_INTERRUPTED) { /* screenshots already taken stay; the stats are not written */
         fprintf(stderr, "photosplat: %s\n", err.msg);
         return ps_interrupt_exit_status();

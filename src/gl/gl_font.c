@@ -292,3 +292,11 @@ void ps_gl_overlay_rect(int x, int y, int w, int h, float r, float g, float b, f
     glRectd((double)x, (double)y, (double)x + w, (double)y + h);
     glPopAttrib();
 }
+
+void ps_gl_overlay_panel(const char *text)
+{
+    const int pad = 4;
+    ps_gl_overlay_rect(0, 0, ps_gl_text_width(text) + 2 * pad, ps_gl_text_height(text) + 2 * pad, 0, 0, 0, 0.6f);
+    glColor3f(1.0f, 1.0f, 0.85f);
+    ps_gl_text(pad, pad, text);
+}

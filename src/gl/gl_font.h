@@ -48,6 +48,10 @@ int ps_gl_text_height(const char *text);
  * glColor as it was. */
 void ps_gl_overlay_rect(int x, int y, int w, int h, float r, float g, float b, float a);
 
+/* The overlay's panel: text in pale yellow at the top-left corner over a
+ * translucent black backdrop, 4 pixels of margin. Between begin and end. */
+void ps_gl_overlay_panel(const char *text);
+
 /* The glyph that character c draws: PS_FONT_GLYPH_H rows, top row first, each
  * in the low PS_FONT_GLYPH_W bits with bit 4 the leftmost pixel. Characters
  * outside 32..126 give the box. For tests and text-mode dumps. */

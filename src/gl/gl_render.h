@@ -3,28 +3,28 @@
  * splats on top (the `caustic` and `global` layers), in the same physical
  * units as the reference renderer, times the exposure.
  *
- * Plain gl* calls only; the caller owns the context (OSMesa in
+ * libpsgl only draws: what it draws is prepared GL-free in src/preview (the
+ * meshes in mesh.h, the GL lights and their radiometry in lights.h, the
+ * splats in splat.h, what each refresh draws in session.h). Plain gl* calls
+ * only; the caller owns the context (src/gl/platform.h: OSMesa in
  * photosplat-snap, GLFW + libGL in the window) and must have made it current.
  *
- * Radiometry. A point light of flux P is a GL light of intensity P / (4 pi)
- * (spot: P over its cone's solid angle, GL_SPOT_EXPONENT 0) with quadratic
- * attenuation 1, and a diffuse material has GL diffuse albedo / pi, so a
- * vertex gets albedo / pi * I cos / d^2, the radiance the reference renderer's
- * `direct` term computes. Area lights become PS_GL_AREA_SAMPLES virtual point
- * lights spread over their area in strata, each a cosine-falloff GL spot
- * (cutoff 90, exponent 1) of intensity P / (pi * samples): 16 keep the
- * irradiance a light's width away within about 1 % of the area integral
- * (a midpoint rule's error falls with the square of the stratum size), and
- * every one costs a shadow map. Glossy highlights use GL's Blinn term with
- * shininess 4e (capped at 128) and colour specular (e + 2) / (2 pi): close to,
- * not equal to, the normalised Phong lobe.
+ * Radiometry. A GL light of intensity I (lights.h) has quadratic attenuation
+ * 1 and a diffuse material has GL diffuse albedo / pi, so a vertex gets
+ * albedo / pi * I cos / d^2, the radiance the reference renderer's `direct`
+ * term computes. Glossy highlights use GL's Blinn term with shininess 4e
+ * (capped at 128) and colour specular (e + 2) / (2 pi): close to, not equal
+ * to, the normalised Phong lobe.
  *
  * Shadows: each light renders its depth into a cube of six 90-degree shadow
  * maps (depth textures in framebuffer objects), and is drawn one cube face at
  * a time with ARB_shadow's depth compare fed by eye-linear texgen, the face's
  * half-space kept by a user clip plane; faces that cannot see any lit
  * direction (behind an area light, outside a spot cone) are skipped. Shadow
- * maps are kept until the lights or the scene change. */
+ * maps are kept until the lights or the geometry change. The code is split
+ * by concern: gl_render.c (the renderer, the mesh, the frame), gl_lights.c
+ * (GL lights, shadow cubes, spot cones, emitters), gl_splat.c (splats),
+ * gl_layers.c (layers kept between refreshes and their composite). */
 #ifndef PS_GL_GL_RENDER_H
 #define PS_GL_GL_RENDER_H
 
@@ -33,13 +33,14 @@
 #include "core/status.h"
 #include "image/image.h"
 #include "photon/photon.h"
+#include "preview/lights.h"
 #include "preview/mesh.h"
+#include "preview/session.h"
 #include "preview/splat.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
 
-#define PS_GL_AREA_SAMPLES 16
-#define PS_GL_SHADOW_SIZE 1024
+#define PS_GL_SHADOW_SIZE PS_SHADOW_SIZE_DEFAULT
 
 typedef struct ps_gl_renderer ps_gl_renderer;
 
@@ -49,16 +50,27 @@ typedef struct ps_gl_options {
     int shadow_size;   /* shadow maps' side in texels; 0: PS_GL_SHADOW_SIZE */
 } ps_gl_options;
 
-/* The scene's fine mesh for lighting (it must outlive the renderer; the
- * renderer makes its own coarse one for depth-only passes) and its lights; the kernel
- * texture is uploaded for the splats. Needs a current context. */
-ps_status ps_gl_renderer_create(const ps_scene *s, const ps_preview_mesh *mesh, const ps_kernel_texture *kernel,
-                                const ps_gl_options *o, ps_gl_renderer **out, ps_error *err);
+/* What the renderer draws, prepared GL-free; everything pointed to must
+ * outlive the renderer or its next set_scene. */
+typedef struct ps_gl_scene {
+    const ps_preview_mesh *mesh;     /* fine: what lit passes draw */
+    const ps_preview_mesh *coarse;   /* the same surfaces unsubdivided: depth-only passes */
+    const ps_material *materials;    /* indexed by the meshes' ranges */
+    const ps_preview_lights *lights; /* GL lights and visible emitters */
+    ps_aabb bounds;                  /* of geometry and lights: near and far planes */
+} ps_gl_scene;
+
+/* A session's meshes, lights and materials as they stand. */
+ps_gl_scene ps_gl_scene_of(const ps_session *s);
+
+/* The kernel texture is uploaded for the splats. Needs a current context. */
+ps_status ps_gl_renderer_create(const ps_gl_scene *in, const ps_kernel_texture *kernel, const ps_gl_options *o,
+                                ps_gl_renderer **out, ps_error *err);
 void ps_gl_renderer_destroy(ps_gl_renderer *r);
 
-/* Re-reads the lights (after an edit): their shadow maps are remade on the
- * next frame. */
-void ps_gl_renderer_lights_changed(ps_gl_renderer *r);
+/* New geometry or lights (after an edit): shadow maps are remade on the next
+ * frame. PS_ERR_NOMEM leaves the renderer drawing no lights. */
+ps_status ps_gl_renderer_set_scene(ps_gl_renderer *r, const ps_gl_scene *in, ps_error *err);
 /* The kernel texture changed (another kernel). */
 void ps_gl_renderer_set_kernel(ps_gl_renderer *r, const ps_kernel_texture *kernel);
 
@@ -66,12 +78,19 @@ void ps_gl_renderer_set_kernel(ps_gl_renderer *r, const ps_kernel_texture *kerne
  * and draws the direct layer (GL lights times exposure) or, without it, the
  * scene in black so that it still hides what lies behind. */
 void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct);
+/* A whole frame into the current framebuffer as a session's refresh says it
+ * (photosplat-snap: no layers kept): the scene, then each map's splats. */
+void ps_gl_draw_frame(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f);
 
 /* Adds a batch of splats (preview/splat.h) to the frame, depth tested against
  * the scene, additively. point_size: the points' side in pixels; sprites take
  * their size from the splat radius and the camera. */
 void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode mode, double radius,
                        double point_size);
+
+/* Waits until GL has drawn everything asked so far (llvmpipe draws when
+ * flushed): for timing the drawing, not the queueing. */
+void ps_gl_finish(void);
 
 /* Reads the colour buffer into out (created here; row 0 the top), as stored:
  * radiance times exposure. */
@@ -85,8 +104,9 @@ ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err);
  * splats accumulate at their stored power and the composite scales each map
  * by N/n, so old splats never need redrawing; with 8-bit buffers that would
  * lose every faint photon (thesis 5.1), so the caller clears a map's layer
- * and redraws all of it, already scaled, each refresh. The composite is read
- * back as radiance times exposure, for the same CPU encoding as snapshots. */
+ * and redraws all of it, already scaled, each refresh (session.h says which).
+ * The composite is drawn and encoded for display by GL (ps_gl_layers_show):
+ * nothing comes back to the CPU but a screenshot. */
 typedef struct ps_gl_layers ps_gl_layers;
 
 ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_layers **out, ps_error *err);
@@ -98,8 +118,17 @@ void ps_gl_layers_clear_map(ps_gl_layers *l, int map);
 /* Adds splats to a map's layer, tested against the view's depth and stencil. */
 void ps_gl_layers_add(ps_gl_layers *l, ps_gl_renderer *r, int map, const ps_splat_batch *b, ps_splat_mode mode,
                       double radius, double point_size);
-/* direct * direct_gain + sum of map * map_gain[map], read back into out
- * (created here; row 0 the top). */
+/* One refresh as a session says it (session.h): a new view if it asks, the
+ * map layers cleared if it asks, and its splats added. */
+void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f);
+/* direct * direct_gain + sum of map * map_gain[map], drawn into the default
+ * framebuffer (the window) with the display's encoding applied by GL: each
+ * channel clamped to [0, 1] and sRGB-encoded to 8 bits (GL_FRAMEBUFFER_SRGB
+ * into an sRGB texture, then copied as it is), the same codes as the PNG
+ * encoder's (image.h, ps_tonemap_8bit) within one rounding step. */
+void ps_gl_layers_show(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT]);
+/* The same composite, linear, read back into out (created here; row 0 the
+ * top): for tests. */
 ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
                                  ps_image *out, ps_error *err);
 

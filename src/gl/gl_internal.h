@@ -1,0 +1,58 @@
+/* gl_internal.h: what the files of libpsgl share and nobody else sees: the
+ * renderer's layout and the helpers one file draws with and another calls. */
+#ifndef PS_GL_GL_INTERNAL_H
+#define PS_GL_GL_INTERNAL_H
+
+#include <stdbool.h>
+
+#include "gl/gl_api.h"
+#include "gl/gl_render.h"
+
+struct ps_gl_renderer {
+    ps_gl_scene in;
+    ps_gl_options opt;
+    int shadow_size;
+    /* shadow[i][f]: GL light i's depth texture of cube face f (0: none yet). */
+    GLuint (*shadow)[PS_CUBE_FACES];
+    size_t shadow_lights; /* lights that shadow[] has room for */
+    bool shadows_valid;
+    GLuint fbo, kernel_tex, spot_tex;
+    double kernel_extent; /* the kernel texture's half side in splat radii */
+    double scene_diag;
+    /* The size of the eye coordinates GL computes this frame: the eye's
+     * distance from the origin plus the farthest scene point's from the eye. */
+    double eye_extent;
+    int width, height;
+    double view[16], proj[16];
+    ps_gl_stats stats;
+};
+
+/* Matrices, column-major as GL's (gl_render.c). */
+void ps_gl_mat_mul(const double a[16], const double b[16], double out[16]);
+/* gluLookAt with an orthonormal frame (right, up, -forward). */
+void ps_gl_mat_look(ps_vec3 eye, ps_vec3 forward, ps_vec3 right, ps_vec3 up, double m[16]);
+/* gluPerspective from tan(fov_y / 2). */
+void ps_gl_mat_perspective(double tan_half, double aspect, double znear, double zfar, double m[16]);
+/* Distances from p to the nearest and farthest points of box b. */
+void ps_gl_box_range(ps_aabb b, ps_vec3 p, double *nearest, double *farthest);
+
+/* The mesh (gl_render.c): fine with materials for lit passes, else the
+ * coarse one for depth; with `stencil` each object writes its stencil value
+ * (ps_splat_stencil). The exposure is in the lights, not here. */
+void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil);
+
+/* Lights (gl_lights.c). */
+ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err); /* new lights: shadow slots, maps remade */
+void ps_gl_lights_free(ps_gl_renderer *r);
+void ps_gl_make_spot_texture(ps_gl_renderer *r);
+void ps_gl_make_shadow_maps(ps_gl_renderer *r);
+/* Each GL light's pass added to the frame, times exposure, then emissive faces. */
+void ps_gl_draw_direct(ps_gl_renderer *r, double exposure);
+/* Area lights as the eye sees them, in their radiance times exposure, or
+ * black when the direct layer is off. */
+void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct);
+
+/* Splats (gl_splat.c). */
+void ps_gl_upload_kernel(ps_gl_renderer *r, const ps_kernel_texture *k);
+
+#endif

@@ -1,0 +1,202 @@
+/* gl_layers.c: the layers the window keeps between refreshes, and their
+ * composite shown with the display's encoding done by GL (gl_render.h). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_internal.h"
+
+
+
+/* The direct layer, a layer a map, the composite as linear floats (read back
+ * by tests), and the composite encoded for display (sRGB, 8 bits). */
+enum { LAYER_DIRECT_TEX, LAYER_CAUSTIC_TEX, LAYER_GLOBAL_TEX, LAYER_FINAL_TEX, LAYER_SHOWN_TEX, LAYER_TEX_COUNT };
+
+struct ps_gl_layers {
+    int width, height;
+    bool float_buffers;
+    GLuint tex[LAYER_TEX_COUNT], fbo[LAYER_TEX_COUNT], depth_stencil;
+};
+
+ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_layers **out, ps_error *err)
+{
+    *out = NULL;
+    ps_gl_layers *l = calloc(1, sizeof *l);
+    if (!l)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the GL layers");
+    l->width = width;
+    l->height = height;
+    l->float_buffers = float_buffers;
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    /* One depth-stencil buffer for all: the prepass drawn once serves every
+     * layer's depth test and stencil clipping. */
+    glGenRenderbuffers(1, &l->depth_stencil);
+    glBindRenderbuffer(GL_RENDERBUFFER, l->depth_stencil);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, width, height);
+    glGenTextures(LAYER_TEX_COUNT, l->tex);
+    glGenFramebuffers(LAYER_TEX_COUNT, l->fbo);
+    bool complete = true;
+    for (int i = 0; i < LAYER_TEX_COUNT; i++) {
+        glBindTexture(GL_TEXTURE_2D, l->tex[i]);
+        /* The linear composite is always float; the shown one is sRGB-encoded
+         * 8 bits, written through GL_FRAMEBUFFER_SRGB. */
+        bool is_float = float_buffers || i == LAYER_FINAL_TEX;
+        GLint format = i == LAYER_SHOWN_TEX ? GL_SRGB8_ALPHA8 : is_float ? GL_RGBA32F : GL_RGBA8;
+        glTexImage2D(GL_TEXTURE_2D, 0, format, width, height, 0, GL_RGBA, is_float ? GL_FLOAT : GL_UNSIGNED_BYTE,
+                     NULL);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[i]);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, l->tex[i], 0);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, l->depth_stencil);
+        complete = complete && glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    if (!complete) {
+        ps_gl_layers_destroy(l);
+        return ps_error_set(err, PS_ERR_IO, "the GL implementation cannot render to %s and sRGB textures of %dx%d",
+                            float_buffers ? "RGBA32F" : "RGBA8", width, height);
+    }
+    *out = l;
+    return PS_OK;
+}
+
+void ps_gl_layers_destroy(ps_gl_layers *l)
+{
+    if (!l)
+        return;
+    glDeleteFramebuffers(LAYER_TEX_COUNT, l->fbo);
+    glDeleteTextures(LAYER_TEX_COUNT, l->tex);
+    glDeleteRenderbuffers(1, &l->depth_stencil);
+    free(l);
+}
+
+void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_DIRECT_TEX]);
+    ps_gl_begin_frame(r, cam, exposure, direct);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_gl_layers_clear_map(l, k);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
+void ps_gl_layers_clear_map(ps_gl_layers *l, int map)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_CAUSTIC_TEX + map]);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT); /* colour only: the shared depth is the view's */
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
+void ps_gl_layers_add(ps_gl_layers *l, ps_gl_renderer *r, int map, const ps_splat_batch *b, ps_splat_mode mode,
+                      double radius, double point_size)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_CAUSTIC_TEX + map]);
+    glViewport(0, 0, l->width, l->height);
+    ps_gl_draw_splats(r, b, mode, radius, point_size);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
+/* A screen-filling quad of texture t times gain, added to what is there. */
+static void add_texture(GLuint t, double gain)
+{
+    glBindTexture(GL_TEXTURE_2D, t);
+    glColor4f((GLfloat)gain, (GLfloat)gain, (GLfloat)gain, 1.0f);
+    glBegin(GL_QUADS);
+    glTexCoord2f(0, 0), glVertex2f(-1, -1);
+    glTexCoord2f(1, 0), glVertex2f(1, -1);
+    glTexCoord2f(1, 1), glVertex2f(1, 1);
+    glTexCoord2f(0, 1), glVertex2f(-1, 1);
+    glEnd();
+}
+
+void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f)
+{
+    if (f->new_view)
+        ps_gl_layers_view(l, r, cam, f->direct_exposure, f->direct);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        if (f->map[k].clear)
+            ps_gl_layers_clear_map(l, k);
+        ps_gl_layers_add(l, r, k, f->map[k].batch, f->splat, f->map[k].radius, f->point_size);
+    }
+}
+
+/* direct * direct_gain + sum of map * map_gain into layer `target`. */
+static void composite(ps_gl_layers *l, int target, double direct_gain, const double map_gain[PS_MAP_COUNT])
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[target]);
+    glViewport(0, 0, l->width, l->height);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    /* Gains above 1 (N/n early on) must not clamp on the way. */
+    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
+    glMatrixMode(GL_PROJECTION);
+    glLoadIdentity();
+    glMatrixMode(GL_MODELVIEW);
+    glLoadIdentity();
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_LIGHTING);
+    glEnable(GL_TEXTURE_2D);
+    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    /* Into the sRGB texture the blend adds in linear and the store encodes:
+     * the sum of the layers, clamped to [0, 1], as sRGB codes. */
+    if (target == LAYER_SHOWN_TEX)
+        glEnable(GL_FRAMEBUFFER_SRGB);
+    add_texture(l->tex[LAYER_DIRECT_TEX], direct_gain);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        if (map_gain[k] > 0.0)
+            add_texture(l->tex[LAYER_CAUSTIC_TEX + k], map_gain[k]);
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glDisable(GL_BLEND);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glDisable(GL_TEXTURE_2D);
+}
+
+void ps_gl_layers_show(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT])
+{
+    composite(l, LAYER_SHOWN_TEX, direct_gain, map_gain);
+    /* Copied as stored: with GL_FRAMEBUFFER_SRGB off a blit neither decodes
+     * the sRGB source nor encodes again. */
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, l->fbo[LAYER_SHOWN_TEX]);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glBlitFramebuffer(0, 0, l->width, l->height, 0, 0, l->width, l->height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
+                                 ps_image *out, ps_error *err)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    composite(l, LAYER_FINAL_TEX, direct_gain, map_gain);
+    ps_status st = ps_image_create(l->width, l->height, out, err);
+    float *rows = st == PS_OK ? malloc(sizeof(float) * 3 * (size_t)l->width * (size_t)l->height) : NULL;
+    if (st == PS_OK && !rows) {
+        ps_image_destroy(out);
+        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory reading the picture back");
+    }
+    if (st == PS_OK) {
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadPixels(0, 0, l->width, l->height, GL_RGB, GL_FLOAT, rows);
+        for (int y = 0; y < l->height; y++)
+            memcpy(ps_image_at(out, 0, y), rows + 3 * (size_t)(l->height - 1 - y) * (size_t)l->width,
+                   sizeof(float) * 3 * (size_t)l->width);
+    }
+    free(rows);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    return st;
+}

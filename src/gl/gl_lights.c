@@ -1,0 +1,403 @@
+/* gl_lights.c: GL lights with shadow cubes, spot cones drawn per pixel, and
+ * the emitters the eye sees (gl_render.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_internal.h"
+
+/* The shadow test's slack for single-precision texgen. GL computes the
+ * compared depth R/Q from eye coordinates in floats, with an error of a few
+ * ulps of the coordinates' size (eye, scene and light positions, E), which
+ * is E / distance-to-light depth units: tens of units for the ceiling above
+ * a light (stress suite), beyond any polygon offset. Taking this many ulps
+ * of E off R (not R/Q) moves the test by that error's own 1/distance law. */
+#define SHADOW_TEXGEN_ULPS 32.0
+#define FLOAT_ULP 1.1920928955078125e-07 /* 2^-23 */
+/* Shadow maps are pushed back against self-shadowing (acne), in
+ * glPolygonOffset's (factor, units). */
+#define SHADOW_OFFSET_FACTOR 2.0f
+#define SHADOW_OFFSET_UNITS 4.0f
+/* A spot light's cone, drawn per pixel: a disc texture projected from the
+ * light (thesis departure: GL's GL_SPOT_CUTOFF is applied per vertex, so the
+ * cone's edge followed the mesh in steps a mesh edge wide, and photosplat-bench
+ * measured the direct light of spot-lit scenes 17-24 % off in relMSE, all of
+ * it along the edge). The texture is this many texels a side; the disc of the
+ * cone fills it to SPOT_TEX_RADIUS, outside is 0 (and so is the border). */
+#define SPOT_TEX_SIZE 512
+#define SPOT_TEX_RADIUS 0.5
+
+static const ps_preview_lights *lights_of(const ps_gl_renderer *r) { return r->in.lights; }
+
+/* ---- shadow cubes ------------------------------------------------------------ */
+
+static void face_frame(int f, ps_vec3 *forward, ps_vec3 *right, ps_vec3 *up)
+{
+    *forward = ps_cube_face_axes[f];
+    ps_vec3 hint = fabs(forward->y) > 0.5 ? ps_v3(0, 0, 1) : ps_v3(0, 1, 0);
+    *right = ps_v3_norm(ps_v3_cross(*forward, hint));
+    *up = ps_v3_cross(*right, *forward);
+}
+
+static void light_face_matrices(const ps_gl_renderer *r, const ps_preview_light *v, int f, double proj[16], double view[16])
+{
+    ps_vec3 fw, rt, up;
+    face_frame(f, &fw, &rt, &up);
+    double nearest, farthest;
+    ps_gl_box_range(r->in.bounds, v->pos, &nearest, &farthest);
+    double znear = v->shadow_near;
+    ps_gl_mat_perspective(1.0, 1.0, znear, fmax(farthest * 1.01, 2.0 * znear), proj);
+    ps_gl_mat_look(v->pos, fw, rt, up, view);
+}
+
+void ps_gl_lights_free(ps_gl_renderer *r)
+{
+    for (size_t i = 0; i < r->shadow_lights; i++)
+        for (int f = 0; f < PS_CUBE_FACES; f++)
+            if (r->shadow[i][f])
+                glDeleteTextures(1, &r->shadow[i][f]);
+    free(r->shadow);
+    r->shadow = NULL;
+    r->shadow_lights = 0;
+    r->shadows_valid = false;
+    if (r->spot_tex)
+        glDeleteTextures(1, &r->spot_tex);
+    r->spot_tex = 0;
+}
+
+ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err)
+{
+    GLuint spot = r->spot_tex;
+    r->spot_tex = 0; /* kept: it does not depend on the lights */
+    ps_gl_lights_free(r);
+    r->spot_tex = spot;
+    size_t n = lights_of(r)->count;
+    r->stats.virtual_lights = 0;
+    if (n == 0)
+        return PS_OK;
+    r->shadow = calloc(n, sizeof *r->shadow);
+    if (!r->shadow)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the shadow maps of %zu GL lights", n);
+    r->shadow_lights = n;
+    r->stats.virtual_lights = (unsigned)n;
+    return PS_OK;
+}
+
+void ps_gl_make_shadow_maps(ps_gl_renderer *r)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+    glViewport(0, 0, r->shadow_size, r->shadow_size);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(SHADOW_OFFSET_FACTOR, SHADOW_OFFSET_UNITS);
+    for (size_t i = 0; i < r->shadow_lights; i++) {
+        const ps_preview_light *v = &lights_of(r)->lights[i];
+        GLuint *shadow = r->shadow[i];
+        for (int f = 0; f < PS_CUBE_FACES; f++) {
+            if (!(v->faces & (1u << f)))
+                continue;
+            if (!shadow[f]) {
+                glGenTextures(1, &shadow[f]);
+                glBindTexture(GL_TEXTURE_2D, shadow[f]);
+                glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, r->shadow_size, r->shadow_size, 0,
+                             GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, NULL);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+                /* Outside the face's square: depth 0 at the border, so the
+                 * compare fails there and the neighbouring face lights it. */
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+                const GLfloat border[4] = {0, 0, 0, 0};
+                glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_R_TO_TEXTURE);
+                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+                glTexParameteri(GL_TEXTURE_2D, GL_DEPTH_TEXTURE_MODE, GL_INTENSITY);
+            }
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadow[f], 0);
+            glClear(GL_DEPTH_BUFFER_BIT);
+            double proj[16], view[16];
+            light_face_matrices(r, v, f, proj, view);
+            glMatrixMode(GL_PROJECTION);
+            glLoadMatrixd(proj);
+            glMatrixMode(GL_MODELVIEW);
+            glLoadMatrixd(view);
+            ps_gl_draw_mesh(r, false, false);
+            r->stats.shadow_maps++;
+        }
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    /* Draw and read buffers are per framebuffer: rebinding restores them. */
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    r->shadows_valid = true;
+}
+
+/* Emissive faces (MTL Ke) as their own radiance, front side only. */
+static void draw_emission(const ps_gl_renderer *r, double exposure)
+{
+    const ps_preview_mesh *m = r->in.mesh;
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, m->positions);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    for (size_t i = 0; i < m->range_count; i++) {
+        const ps_material *mat = &r->in.materials[m->ranges[i].material];
+        if (ps_rgb_is_black(mat->emission))
+            continue;
+        glColor4f((GLfloat)(mat->emission.r * exposure), (GLfloat)(mat->emission.g * exposure),
+                  (GLfloat)(mat->emission.b * exposure), 1.0f);
+        glDrawArrays(GL_TRIANGLES, (GLint)m->ranges[i].first, (GLsizei)m->ranges[i].count);
+    }
+    glDisable(GL_CULL_FACE);
+    glDisableClientState(GL_VERTEX_ARRAY);
+}
+
+/* ---- drawing ------------------------------------------------------------------ */
+
+static void set_gl_light(const ps_preview_light *v, double exposure)
+{
+    GLfloat pos[4] = {(GLfloat)v->pos.x, (GLfloat)v->pos.y, (GLfloat)v->pos.z, 1.0f};
+    GLfloat col[4] = {(GLfloat)(v->intensity.r * exposure), (GLfloat)(v->intensity.g * exposure),
+                      (GLfloat)(v->intensity.b * exposure), 1.0f};
+    GLfloat black[4] = {0, 0, 0, 1};
+    glLightfv(GL_LIGHT0, GL_POSITION, pos);
+    glLightfv(GL_LIGHT0, GL_AMBIENT, black);
+    glLightfv(GL_LIGHT0, GL_DIFFUSE, col);
+    glLightfv(GL_LIGHT0, GL_SPECULAR, col);
+    glLightf(GL_LIGHT0, GL_CONSTANT_ATTENUATION, 0.0f);
+    glLightf(GL_LIGHT0, GL_LINEAR_ATTENUATION, 0.0f);
+    glLightf(GL_LIGHT0, GL_QUADRATIC_ATTENUATION, 1.0f);
+    if (v->cutoff_deg < 180.0 && !ps_preview_light_is_spot(v)) {
+        GLfloat dir[3] = {(GLfloat)v->dir.x, (GLfloat)v->dir.y, (GLfloat)v->dir.z};
+        glLightfv(GL_LIGHT0, GL_SPOT_DIRECTION, dir);
+        glLightf(GL_LIGHT0, GL_SPOT_CUTOFF, (GLfloat)v->cutoff_deg);
+        glLightf(GL_LIGHT0, GL_SPOT_EXPONENT, (GLfloat)v->exponent);
+    } else {
+        glLightf(GL_LIGHT0, GL_SPOT_CUTOFF, 180.0f);
+        glLightf(GL_LIGHT0, GL_SPOT_EXPONENT, 0.0f);
+    }
+}
+
+/* The spot texture: 1 inside the disc, 0 outside and at the border. */
+void ps_gl_make_spot_texture(ps_gl_renderer *r)
+{
+    if (r->spot_tex)
+        return;
+    uint8_t *texels = malloc((size_t)SPOT_TEX_SIZE * SPOT_TEX_SIZE);
+    if (!texels)
+        return; /* no texture: the cone falls back to GL's per-vertex cutoff */
+    for (int y = 0; y < SPOT_TEX_SIZE; y++)
+        for (int x = 0; x < SPOT_TEX_SIZE; x++) {
+            double u = (x + 0.5) / SPOT_TEX_SIZE - 0.5, w = (y + 0.5) / SPOT_TEX_SIZE - 0.5;
+            texels[(size_t)y * SPOT_TEX_SIZE + (size_t)x] = u * u + w * w <= SPOT_TEX_RADIUS * SPOT_TEX_RADIUS ? 255 : 0;
+        }
+    glGenTextures(1, &r->spot_tex);
+    glBindTexture(GL_TEXTURE_2D, r->spot_tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_LUMINANCE8, SPOT_TEX_SIZE, SPOT_TEX_SIZE, 0, GL_LUMINANCE, GL_UNSIGNED_BYTE, texels);
+    /* Nearest: the edge is as sharp as the reference's, and a texel is far
+     * finer than a mesh edge. */
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const GLfloat border[4] = {0, 0, 0, 0};
+    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    free(texels);
+}
+
+/* On texture unit 1: the spot texture projected from spot v, so that a point
+ * p maps to 0.5 + 0.5 (p - L).(u, v) / (tan(cutoff) (p - L).axis), inside the
+ * disc exactly when inside the cone; clip plane 2 keeps what lies behind the
+ * light (where the projection flips) out. Set while the modelview is the
+ * camera's view (world-space eye-linear planes, as the shadow texgen). */
+static void begin_spot(const ps_gl_renderer *r, const ps_preview_light *v)
+{
+    ps_vec3 u, w;
+    ps_v3_basis(v->dir, &u, &w);
+    double k = SPOT_TEX_RADIUS / tan(v->cutoff_deg * PS_PI / 180.0);
+    ps_vec3 rows[3] = {ps_v3_add(ps_v3_scale(v->dir, 0.5), ps_v3_scale(u, k)),
+                       ps_v3_add(ps_v3_scale(v->dir, 0.5), ps_v3_scale(w, k)), v->dir};
+    const GLenum coords[3] = {GL_S, GL_T, GL_Q};
+    const GLenum gens[3] = {GL_TEXTURE_GEN_S, GL_TEXTURE_GEN_T, GL_TEXTURE_GEN_Q};
+    glActiveTexture(GL_TEXTURE1);
+    glEnable(GL_TEXTURE_2D);
+    glBindTexture(GL_TEXTURE_2D, r->spot_tex);
+    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+    for (int i = 0; i < 3; i++) {
+        GLdouble plane[4] = {rows[i].x, rows[i].y, rows[i].z, -ps_v3_dot(rows[i], v->pos)};
+        glTexGeni(coords[i], GL_TEXTURE_GEN_MODE, GL_EYE_LINEAR);
+        glTexGendv(coords[i], GL_EYE_PLANE, plane);
+        glEnable(gens[i]);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    GLdouble front[4] = {v->dir.x, v->dir.y, v->dir.z, -ps_v3_dot(v->dir, v->pos)};
+    glClipPlane(GL_CLIP_PLANE2, front);
+    glEnable(GL_CLIP_PLANE2);
+}
+
+static void end_spot(void)
+{
+    glActiveTexture(GL_TEXTURE1);
+    glDisable(GL_TEXTURE_GEN_S);
+    glDisable(GL_TEXTURE_GEN_T);
+    glDisable(GL_TEXTURE_GEN_Q);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glDisable(GL_TEXTURE_2D);
+    glActiveTexture(GL_TEXTURE0);
+    glDisable(GL_CLIP_PLANE2);
+}
+
+/* Texgen planes that take world points to the shadow map's [0,1]^3 (the
+ * rows of bias * projection * view), set while the modelview is the camera's
+ * view so that GL's eye-linear planes see world coordinates. */
+static void set_shadow_texgen(const double light_proj[16], const double light_view[16], double slack)
+{
+    static const double bias[16] = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 0.5, 0.5, 0.5, 1};
+    double t[16];
+    ps_gl_mat_mul(bias, light_proj, t);
+    ps_gl_mat_mul(t, light_view, t);
+    const GLenum coords[4] = {GL_S, GL_T, GL_R, GL_Q};
+    const GLenum gens[4] = {GL_TEXTURE_GEN_S, GL_TEXTURE_GEN_T, GL_TEXTURE_GEN_R, GL_TEXTURE_GEN_Q};
+    for (int k = 0; k < 4; k++) {
+        GLdouble plane[4] = {t[k], t[4 + k], t[8 + k], t[12 + k] - (k == 2 ? slack : 0.0)};
+        glTexGeni(coords[k], GL_TEXTURE_GEN_MODE, GL_EYE_LINEAR);
+        glTexGendv(coords[k], GL_EYE_PLANE, plane);
+        glEnable(gens[k]);
+    }
+}
+
+static void disable_texgen(void)
+{
+    glDisable(GL_TEXTURE_GEN_S);
+    glDisable(GL_TEXTURE_GEN_T);
+    glDisable(GL_TEXTURE_GEN_R);
+    glDisable(GL_TEXTURE_GEN_Q);
+}
+
+void ps_gl_draw_direct(ps_gl_renderer *r, double exposure)
+{
+    glEnable(GL_LIGHTING);
+    glEnable(GL_LIGHT0);
+    glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
+    glLightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, GL_TRUE);
+    const GLfloat no_ambient[4] = {0, 0, 0, 1};
+    glLightModelfv(GL_LIGHT_MODEL_AMBIENT, no_ambient);
+    glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT, no_ambient);
+    glMaterialfv(GL_FRONT_AND_BACK, GL_EMISSION, no_ambient);
+    for (size_t i = 0; i < r->shadow_lights; i++) {
+        const ps_preview_light *v = &lights_of(r)->lights[i];
+        set_gl_light(v, exposure);
+        bool spot = ps_preview_light_is_spot(v) && r->spot_tex;
+        if (spot)
+            begin_spot(r, v);
+        if (!r->opt.shadows) {
+            ps_gl_draw_mesh(r, true, false);
+            r->stats.light_passes++;
+            if (spot)
+                end_spot();
+            continue;
+        }
+        glEnable(GL_TEXTURE_2D);
+        glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+        glEnable(GL_CLIP_PLANE0);
+        glEnable(GL_CLIP_PLANE1);
+        for (int f = 0; f < PS_CUBE_FACES; f++) {
+            if (!(v->faces & (1u << f)))
+                continue;
+            const ps_vec3 axis = ps_cube_face_axes[f];
+            double proj[16], view[16];
+            light_face_matrices(r, v, f, proj, view);
+            set_shadow_texgen(proj, view, SHADOW_TEXGEN_ULPS * FLOAT_ULP * (r->eye_extent + ps_v3_len(v->pos)));
+            /* Only the half-space in front of the face: behind the light the
+             * projection would fold points back into the map. */
+            GLdouble plane[4] = {axis.x, axis.y, axis.z, -ps_v3_dot(axis, v->pos)};
+            glClipPlane(GL_CLIP_PLANE0, plane);
+            /* Nor what lies nearer than the near plane: outside the face's
+             * square its depth would pass the test against the border's 0.
+             * Every point this face owns lies beyond (at least nearest /
+             * sqrt 3 > PS_SHADOW_NEAR_SHARE * nearest away along the axis). */
+            plane[3] -= v->shadow_near;
+            glClipPlane(GL_CLIP_PLANE1, plane);
+            glBindTexture(GL_TEXTURE_2D, r->shadow[i][f]);
+            ps_gl_draw_mesh(r, true, false);
+            r->stats.light_passes++;
+        }
+        glDisable(GL_CLIP_PLANE0);
+        glDisable(GL_CLIP_PLANE1);
+        disable_texgen();
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glDisable(GL_TEXTURE_2D);
+        if (spot)
+            end_spot();
+    }
+    glDisable(GL_LIGHT0);
+    glDisable(GL_LIGHTING);
+    draw_emission(r, exposure);
+}
+
+/* Area lights as the eye sees them (the reference renderer's emitters): quad
+ * and disc lights from their emitting side, sphere lights from outside, in
+ * their radiance times exposure, or black when the direct layer is off (its
+ * term; the other layers still see them in the way). They are drawn over
+ * the lit scene with depth writes, so splats behind them stay hidden; they
+ * are not in the shadow maps, as photons and shadow rays pass through them. */
+#define DISC_SEGMENTS 64
+
+void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct)
+{
+    const ps_preview_lights *lights = lights_of(r);
+    glDisable(GL_BLEND);
+    glDisable(GL_LIGHTING);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    /* Their pixels belong to no object: splats are not clipped into them. */
+    glEnable(GL_STENCIL_TEST);
+    glStencilFunc(GL_ALWAYS, 0, 0xff);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+    for (size_t l = 0; l < lights->emitter_count; l++) {
+        const ps_preview_emitter *L = &lights->emitters[l];
+        double k = direct ? exposure : 0.0;
+        glColor4f((GLfloat)(L->radiance.r * k), (GLfloat)(L->radiance.g * k), (GLfloat)(L->radiance.b * k), 1.0f);
+        if (L->type == PS_LIGHT_QUAD) {
+            ps_vec3 c[4] = {L->position, ps_v3_add(L->position, L->edge1),
+                            ps_v3_add(ps_v3_add(L->position, L->edge1), L->edge2), ps_v3_add(L->position, L->edge2)};
+            glBegin(GL_QUADS); /* counter-clockwise about edge1 x edge2, the emitting side */
+            for (int i = 0; i < 4; i++)
+                glVertex3d(c[i].x, c[i].y, c[i].z);
+            glEnd();
+        } else if (L->type == PS_LIGHT_DISC) {
+            ps_vec3 t, b;
+            ps_v3_basis(L->normal, &t, &b);
+            glBegin(GL_TRIANGLE_FAN);
+            glVertex3d(L->position.x, L->position.y, L->position.z);
+            for (int i = 0; i <= DISC_SEGMENTS; i++) {
+                double a = 2.0 * PS_PI * i / DISC_SEGMENTS;
+                ps_vec3 q = ps_v3_add(L->position, ps_v3_add(ps_v3_scale(t, L->radius * cos(a)),
+                                                             ps_v3_scale(b, L->radius * sin(a))));
+                glVertex3d(q.x, q.y, q.z);
+            }
+            glEnd();
+        } else {
+            const ps_trimesh *m = &L->sphere;
+            glBegin(GL_TRIANGLES);
+            for (uint32_t i = 0; i < 3 * m->triangle_count; i++) {
+                ps_vec3 q = m->positions[m->indices[i]];
+                glVertex3d(q.x, q.y, q.z);
+            }
+            glEnd();
+        }
+    }
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_CULL_FACE);
+}
+

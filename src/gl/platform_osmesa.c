@@ -1,0 +1,98 @@
+/* platform_osmesa.c: the headless context (platform.h): an OSMesa buffer of
+ * RGBA with 24-bit depth and 8-bit stencil, and no accumulation buffer
+ * (platform notes: it wraps above 1.0 and is no place for photon sums). */
+#include "gl/platform.h"
+
+#include <GL/osmesa.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_api.h"
+
+struct ps_platform {
+    OSMesaContext ctx;
+    void *buffer;
+    GLenum type;
+    int width, height;
+};
+
+ps_status ps_platform_open(const ps_platform_config *c, ps_platform **out, ps_error *err)
+{
+    *out = NULL;
+    ps_platform *p = calloc(1, sizeof *p);
+    if (!p)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for an OSMesa context");
+    p->width = c->width;
+    p->height = c->height;
+    p->type = c->float_buffer ? GL_FLOAT : GL_UNSIGNED_BYTE;
+    p->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    size_t bytes = (size_t)c->width * (size_t)c->height * 4 * (c->float_buffer ? sizeof(float) : 1);
+    p->buffer = p->ctx ? malloc(bytes) : NULL;
+    ps_status st = PS_OK;
+    if (!p->ctx)
+        st = ps_error_set(err, PS_ERR_IO, "OSMesa could not create a context");
+    else if (!p->buffer)
+        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a %dx%d buffer", c->width, c->height);
+    else if (!OSMesaMakeCurrent(p->ctx, p->buffer, p->type, c->width, c->height))
+        st = ps_error_set(err, PS_ERR_LIMIT, "OSMesa cannot draw a %dx%d %s buffer", c->width, c->height,
+                          c->float_buffer ? "float" : "8-bit");
+    if (st != PS_OK) {
+        ps_platform_close(p);
+        return st;
+    }
+    *out = p;
+    return PS_OK;
+}
+
+void ps_platform_close(ps_platform *p)
+{
+    if (!p)
+        return;
+    if (p->ctx)
+        OSMesaDestroyContext(p->ctx);
+    free(p->buffer);
+    free(p);
+}
+
+void ps_platform_make_current(ps_platform *p) { OSMesaMakeCurrent(p->ctx, p->buffer, p->type, p->width, p->height); }
+
+void ps_platform_size(const ps_platform *p, int *width, int *height)
+{
+    *width = p->width;
+    *height = p->height;
+}
+
+void ps_platform_present(ps_platform *p)
+{
+    (void)p;
+    glFinish();
+}
+
+ps_status ps_platform_read(ps_platform *p, ps_image *out, ps_error *err)
+{
+    ps_status st = ps_image_create(p->width, p->height, out, err);
+    if (st != PS_OK)
+        return st;
+    float *rows = malloc(sizeof(float) * 3 * (size_t)p->width * (size_t)p->height);
+    if (!rows) {
+        ps_image_destroy(out);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory reading the picture back");
+    }
+    glFinish();
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, p->width, p->height, GL_RGB, GL_FLOAT, rows);
+    /* GL's row 0 is the bottom; ours the top. */
+    for (int y = 0; y < p->height; y++)
+        memcpy(ps_image_at(out, 0, y), rows + 3 * (size_t)(p->height - 1 - y) * (size_t)p->width,
+               sizeof(float) * 3 * (size_t)p->width);
+    free(rows);
+    return PS_OK;
+}
+
+void *ps_platform_window(ps_platform *p)
+{
+    (void)p;
+    return NULL;
+}

@@ -1,0 +1,545 @@
+/* session.c: the preview's progressive policy (session.h). */
+#include "preview/session.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/clock.h"
+#include "preview/feed.h"
+
+struct ps_session {
+    ps_scene *scene;
+    ps_session_settings set;
+    ps_world *world;
+    ps_tracer *tracer;
+    ps_feed *feed;
+    ps_preview_mesh mesh, coarse;
+    ps_preview_lights lights;
+    ps_kernel_texture kernel;
+    ps_splat_batch batch[PS_MAP_COUNT];
+    /* Invariant: drawn[k] photons of map k (a prefix ending at a feed mark,
+     * drawn_emitted[k] emitted) are in the layers since the last new view. */
+    size_t drawn[PS_MAP_COUNT];
+    uint64_t drawn_emitted[PS_MAP_COUNT];
+    double splat_radius[PS_MAP_COUNT];
+    double budget;         /* incremental: photons a map per refresh */
+    size_t last_splats;    /* built by the last refresh ... */
+    double last_build;     /* ... in this many seconds */
+    double round_off;
+    bool have_cam, view_dirty;
+    ps_camera_frame cam;
+    bool edited, geometry_edited;
+    uint64_t edits;
+    /* Tracing: the feed is held while any of these holds. */
+    bool started, user_paused, hold, first_pending, counter_stopped;
+    uint64_t counter_at;
+    double splat_seconds;
+    uint64_t refreshes;
+};
+
+ps_session_settings ps_session_default_settings(const ps_scene *scene)
+{
+    const ps_scene_defaults *d = ps_scene_get_defaults(scene);
+    ps_session_settings set;
+    memset(&set, 0, sizeof set);
+    set.caps[PS_MAP_CAUSTIC] = d->caustic_photons > 0 ? (uint64_t)d->caustic_photons : 0;
+    set.caps[PS_MAP_GLOBAL] = d->global_photons > 0 ? (uint64_t)d->global_photons : 0;
+    set.radius[PS_MAP_CAUSTIC] = d->caustic_radius;
+    set.radius[PS_MAP_GLOBAL] = d->global_radius;
+    set.layers = PS_LAYER_ALL;
+    set.splat = PS_SPLAT_TRIANGLES;
+    set.kernel = PS_KERNEL_CONE;
+    set.point_size = 1.0;
+    set.precision = PS_PRECISION_DIFFUSION;
+    set.counter_threshold = 0.1;
+    set.stencil_clip = true;
+    set.radius_schedule = PS_RADIUS_FIXED;
+    set.radius_alpha = PS_RADIUS_ALPHA_DEFAULT;
+    set.exposure = 1.0;
+    set.tau = 0.1;
+    set.shadow_size = PS_SHADOW_SIZE_DEFAULT;
+    return set;
+}
+
+static bool incremental(const ps_session *s) { return s->set.incremental && s->set.float_buffer; }
+
+/* The feed runs only while nothing holds it. */
+static void apply_pause(ps_session *s)
+{
+    if (s->feed)
+        ps_feed_pause(s->feed, s->user_paused || s->hold || s->first_pending || s->counter_stopped);
+}
+
+/* ---- building ----------------------------------------------------------------- */
+
+static ps_status build_geometry(ps_session *s, ps_error *err)
+{
+    ps_world_destroy(s->world);
+    s->world = NULL;
+    ps_preview_mesh_free(&s->mesh);
+    ps_preview_mesh_free(&s->coarse);
+    ps_status st = ps_world_create(s->scene, NULL, &s->world, err);
+    ps_mesh_options mo = ps_mesh_default_options(s->scene);
+    if (st == PS_OK)
+        st = ps_preview_mesh_build(s->scene, &mo, &s->mesh, err);
+    /* The scene's own triangles, not subdivided, for depth-only passes:
+     * subdividing changes no depth, only how many vertices are lit. */
+    mo.max_edge = HUGE_VAL;
+    if (st == PS_OK)
+        st = ps_preview_mesh_build(s->scene, &mo, &s->coarse, err);
+    return st;
+}
+
+static ps_status build_lights(ps_session *s, ps_error *err)
+{
+    ps_preview_lights_free(&s->lights);
+    return ps_preview_lights_build(s->scene, &s->coarse, s->set.shadow_size, &s->lights, err);
+}
+
+static void free_maps(ps_session *s)
+{
+    ps_feed_destroy(s->feed);
+    s->feed = NULL;
+    ps_tracer_destroy(s->tracer);
+    s->tracer = NULL;
+}
+
+static ps_status new_tracer(ps_session *s, ps_error *err)
+{
+    ps_tracer_options to = ps_tracer_default_options();
+    to.seed = s->set.seed;
+    to.threads = s->set.threads;
+    to.cancel = s->set.cancel;
+    to.max_stored = s->set.max_map_photons;
+    return ps_tracer_create(s->world, &to, &s->tracer, err);
+}
+
+/* A new feed from photon 0. Which maps it traces: a disabled one (the scene
+ * needs none) never; one of 0 photons, or not shown when the session skips
+ * hidden layers, is recorded as skipped with its reason. */
+static ps_status new_feed(ps_session *s, ps_error *err)
+{
+    bool active[PS_MAP_COUNT] = {false, false};
+    ps_status st = PS_OK;
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
+        if (!ps_tracer_map_enabled(s->tracer, (ps_map_kind)k))
+            continue;
+        const char *name = ps_map_name((ps_map_kind)k);
+        if (s->set.skip_hidden && !(s->set.layers & ps_map_layer((ps_map_kind)k)))
+            st = ps_tracer_note_skip(s->tracer, name, "layer not shown (--layers)");
+        else if (s->set.caps[k] == 0)
+            st = ps_tracer_note_skip(s->tracer, name, "0 photons requested");
+        else
+            active[k] = true;
+    }
+    if (st == PS_OK && s->set.skip_hidden && !(s->set.layers & PS_LAYER_DIRECT))
+        st = ps_tracer_note_skip(s->tracer, "direct", "layer not shown (--layers)");
+    if (st != PS_OK)
+        return ps_error_set(err, st, "%s: out of memory", ps_scene_path(s->scene));
+    st = ps_feed_create(s->tracer, s->set.caps, active, &s->feed, err);
+    if (st == PS_OK)
+        ps_feed_set_store_limit(s->feed, s->set.max_stored);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        s->drawn[k] = 0;
+        s->drawn_emitted[k] = 0;
+    }
+    s->counter_stopped = false;
+    s->view_dirty = true;
+    return st;
+}
+
+ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_session **out, ps_error *err)
+{
+    *out = NULL;
+    ps_session *s = calloc(1, sizeof *s);
+    if (!s)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for the preview", ps_scene_path(scene));
+    s->scene = scene;
+    s->set = *set;
+    s->budget = PS_SESSION_BUDGET_START;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        ps_splat_batch_init(&s->batch[k]);
+        s->splat_radius[k] = set->radius[k];
+    }
+    ps_status st = build_geometry(s, err);
+    if (st == PS_OK)
+        st = new_tracer(s, err);
+    if (st == PS_OK)
+        st = ps_kernel_texture_make(set->kernel, PS_KERNEL_TEXTURE_SIZE, &s->kernel, err);
+    if (st == PS_OK)
+        st = build_lights(s, err);
+    if (st == PS_OK)
+        st = new_feed(s, err);
+    if (st != PS_OK) {
+        ps_session_destroy(s);
+        return st;
+    }
+    *out = s;
+    return PS_OK;
+}
+
+void ps_session_destroy(ps_session *s)
+{
+    if (!s)
+        return;
+    free_maps(s);
+    ps_world_destroy(s->world);
+    ps_preview_mesh_free(&s->mesh);
+    ps_preview_mesh_free(&s->coarse);
+    ps_preview_lights_free(&s->lights);
+    ps_kernel_texture_free(&s->kernel);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_splat_batch_free(&s->batch[k]);
+    free(s);
+}
+
+/* ---- tracing ------------------------------------------------------------------- */
+
+ps_status ps_session_trace_all(ps_session *s, ps_error *err) { return ps_feed_run(s->feed, err); }
+
+ps_status ps_session_start(ps_session *s, bool held, ps_error *err)
+{
+    s->started = true;
+    ps_status st = ps_feed_prime(s->feed, err);
+    if (st != PS_OK)
+        return st;
+    s->first_pending = held;
+    apply_pause(s);
+    return ps_feed_start(s->feed, err);
+}
+
+ps_status ps_session_stop(ps_session *s, ps_error *err)
+{
+    ps_feed_stop(s->feed);
+    return ps_feed_status(s->feed, err);
+}
+
+ps_status ps_session_status(const ps_session *s, ps_error *err) { return ps_feed_status(s->feed, err); }
+
+void ps_session_set_paused(ps_session *s, bool paused)
+{
+    s->user_paused = paused;
+    apply_pause(s);
+}
+
+void ps_session_hold(ps_session *s, bool held)
+{
+    s->hold = held;
+    apply_pause(s);
+}
+
+bool ps_session_paused(const ps_session *s) { return s->user_paused; }
+
+bool ps_session_counter_stopped(const ps_session *s, uint64_t *at_photons)
+{
+    if (at_photons)
+        *at_photons = s->counter_at;
+    return s->counter_stopped;
+}
+
+/* ---- refreshing ------------------------------------------------------------------- */
+
+static bool same_vec(ps_vec3 a, ps_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+static bool same_camera(const ps_camera_frame *a, const ps_camera_frame *b)
+{
+    return same_vec(a->eye, b->eye) && same_vec(a->forward, b->forward) && same_vec(a->right, b->right) &&
+           same_vec(a->up, b->up) && a->tan_half_fov == b->tan_half_fov && a->aspect == b->aspect &&
+           a->width == b->width && a->height == b->height;
+}
+
+/* How far into map k this refresh draws, from `from` photons (`from_emitted`
+ * emitted): whole batches as the feed handed them over; incremental, at most
+ * the budget beyond `from`, but at least one batch. *emitted: the photons
+ * emitted for that prefix, which its splats are scaled by. Under the lock. */
+static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emitted, uint64_t *emitted)
+{
+    size_t n;
+    const ps_feed_mark *m = ps_feed_marks(s->feed, (ps_map_kind)k, &n);
+    size_t end = from;
+    *emitted = from_emitted;
+    for (size_t i = 0; i < n; i++) {
+        if (m[i].stored < from || m[i].emitted < *emitted)
+            continue;
+        bool over = incremental(s) && (double)(m[i].stored - from) > s->budget;
+        if (over && end > from)
+            break;
+        end = m[i].stored;
+        *emitted = m[i].emitted;
+        if (over)
+            break;
+    }
+    return end;
+}
+
+/* The radius of map k's splats after `emitted` photons: r0 under the
+ * schedule, its reference count the scene's photon count for the map (what
+ * r0 was chosen for), else the cap. */
+static double radius_at(const ps_session *s, int k, uint64_t emitted)
+{
+    const ps_scene_defaults *d = ps_scene_get_defaults(s->scene);
+    int64_t scene_n = k == PS_MAP_CAUSTIC ? d->caustic_photons : d->global_photons;
+    uint64_t n0 = scene_n > 0 ? (uint64_t)scene_n : s->set.caps[k];
+    return ps_splat_radius_at(s->set.radius_schedule, s->set.radius[k], n0, emitted, s->set.radius_alpha);
+}
+
+ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_session_frame *out, ps_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!s->have_cam || !same_camera(cam, &s->cam)) {
+        s->cam = *cam;
+        s->have_cam = true;
+        s->view_dirty = true;
+    }
+    bool inc = incremental(s);
+    out->new_view = s->view_dirty;
+    if (s->view_dirty) {
+        for (int k = 0; k < PS_MAP_COUNT; k++)
+            s->drawn[k] = 0, s->drawn_emitted[k] = 0;
+        s->view_dirty = false;
+    }
+    double t0 = ps_now_seconds();
+    size_t nmat;
+    const ps_material *materials = ps_scene_materials(s->scene, &nmat);
+    double wanted = 0.0, lost = 0.0;
+    ps_status st = PS_OK;
+    ps_feed_lock(s->feed);
+    const ps_photon_map *maps = ps_feed_maps(s->feed);
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
+        ps_splat_batch *b = &s->batch[k];
+        ps_splat_batch_clear(b);
+        /* A whole refresh is built afresh, so its round-off carry starts at 0:
+         * the same photons give the same picture. Incremental layers are
+         * float, where nothing rounds. */
+        b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
+        b->wanted = b->lost = 0.0;
+        const ps_photon_map *m = &maps[k];
+        size_t from = inc ? s->drawn[k] : 0;
+        uint64_t emitted;
+        size_t end = prefix(s, k, from, inc ? s->drawn_emitted[k] : 0, &emitted);
+        out->emitted[k] = emitted;
+        s->drawn[k] = end;
+        s->drawn_emitted[k] = emitted;
+        if (!(s->set.layers & ps_map_layer((ps_map_kind)k)) || end <= from || emitted == 0)
+            continue;
+        ps_splat_params p;
+        memset(&p, 0, sizeof p);
+        p.mode = s->set.splat;
+        s->splat_radius[k] = radius_at(s, k, emitted);
+        p.radius = s->splat_radius[k];
+        p.kernel_mean = s->kernel.mean;
+        p.kernel_extent = s->kernel.extent;
+        /* Powers are normalised for the cap N; n have been emitted so far.
+         * Incremental layers sum stored powers and the composite scales. */
+        p.scale = inc ? 1.0 : s->set.exposure * (double)s->set.caps[k] / (double)emitted;
+        p.point_size = s->set.point_size;
+        p.precision = s->set.precision;
+        p.levels = s->set.float_buffer ? 0 : 255;
+        p.materials = materials;
+        p.objects = s->set.stencil_clip ? m->objects + from : NULL;
+        p.cam = *cam;
+        st = ps_splat_build(m->photons + from, m->materials + from, end - from, &p, b, err);
+        wanted += b->wanted;
+        lost += b->lost;
+        out->splats += b->splats;
+    }
+    ps_feed_unlock(s->feed);
+    s->round_off = wanted > 0.0 ? lost / wanted : 0.0;
+    s->last_splats = out->splats;
+    s->last_build = ps_now_seconds() - t0;
+    s->splat_seconds += s->last_build;
+    s->refreshes++;
+    if (st != PS_OK)
+        return st;
+    out->direct = (s->set.layers & PS_LAYER_DIRECT) != 0;
+    out->direct_exposure = inc ? 1.0 : s->set.exposure;
+    out->direct_gain = inc ? s->set.exposure : 1.0;
+    out->splat = s->set.splat;
+    out->point_size = s->set.point_size;
+    out->round_off = s->round_off;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        ps_session_layer *l = &out->map[k];
+        bool shown = (s->set.layers & ps_map_layer((ps_map_kind)k)) && out->emitted[k] > 0;
+        l->clear = !inc;
+        l->batch = &s->batch[k];
+        l->radius = s->splat_radius[k];
+        l->gain = !shown ? 0.0 : inc ? s->set.exposure * (double)s->set.caps[k] / (double)out->emitted[k] : 1.0;
+    }
+    return PS_OK;
+}
+
+void ps_session_drawn(ps_session *s, double draw_seconds)
+{
+    if (incremental(s) && s->last_splats > 0) {
+        double rate = (double)s->last_splats / fmax(s->last_build + draw_seconds, 1e-6);
+        s->budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * PS_SESSION_SPLAT_TIME_SHARE / PS_MAP_COUNT);
+    }
+    /* Thesis 5.1: once a refresh loses this much to round-off, more photons
+     * only add noise: stop shooting (until the next edit). */
+    if (!s->set.float_buffer && s->set.precision == PS_PRECISION_COUNTER && !s->counter_stopped &&
+        s->round_off > s->set.counter_threshold) {
+        s->counter_stopped = true;
+        s->counter_at = s->drawn_emitted[0] + s->drawn_emitted[1];
+    }
+    s->first_pending = false;
+    apply_pause(s);
+}
+
+bool ps_session_settled(ps_session *s)
+{
+    if (s->edited || s->view_dirty || !s->have_cam)
+        return false;
+    if (s->user_paused || s->counter_stopped)
+        return true;
+    ps_feed_lock(s->feed);
+    bool over = ps_feed_ended(s->feed);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        over = over && s->drawn[k] >= ps_feed_maps(s->feed)[k].count;
+    ps_feed_unlock(s->feed);
+    return over;
+}
+
+/* ---- settings ---------------------------------------------------------------------- */
+
+const ps_session_settings *ps_session_get_settings(const ps_session *s) { return &s->set; }
+
+void ps_session_set_layers(ps_session *s, unsigned layers)
+{
+    s->set.layers = layers & PS_LAYER_ALL;
+    s->view_dirty = true;
+}
+
+void ps_session_set_splat(ps_session *s, ps_splat_mode mode)
+{
+    s->set.splat = mode;
+    s->view_dirty = true;
+}
+
+ps_status ps_session_set_kernel(ps_session *s, ps_kernel kernel, ps_error *err)
+{
+    ps_kernel_texture t;
+    ps_status st = ps_kernel_texture_make(kernel, PS_KERNEL_TEXTURE_SIZE, &t, err);
+    if (st != PS_OK)
+        return st;
+    ps_kernel_texture_free(&s->kernel);
+    s->kernel = t;
+    s->set.kernel = kernel;
+    s->view_dirty = true;
+    return PS_OK;
+}
+
+void ps_session_set_precision(ps_session *s, ps_precision precision)
+{
+    s->set.precision = precision;
+    s->view_dirty = true;
+}
+
+void ps_session_set_exposure(ps_session *s, double exposure)
+{
+    s->set.exposure = exposure;
+    /* Whole refreshes hold exposed values; incremental ones only change gains. */
+    if (!incremental(s))
+        s->view_dirty = true;
+}
+
+void ps_session_set_radius(ps_session *s, ps_map_kind k, double radius)
+{
+    if (radius > 0.0) {
+        s->set.radius[k] = radius;
+        s->view_dirty = true;
+    }
+}
+
+void ps_session_set_tau(ps_session *s, double tau) { s->set.tau = tau; }
+
+/* ---- edits --------------------------------------------------------------------------- */
+
+static ps_status edited(ps_session *s, ps_status st, bool geometry)
+{
+    if (st == PS_OK) {
+        s->edited = true;
+        s->geometry_edited = s->geometry_edited || geometry;
+        s->edits++;
+    }
+    return st;
+}
+
+ps_status ps_session_move_light(ps_session *s, size_t light, ps_vec3 position, ps_error *err)
+{
+    return edited(s, ps_scene_set_light_position(s->scene, light, position, err), false);
+}
+
+ps_status ps_session_move_object(ps_session *s, size_t object, ps_vec3 delta, ps_error *err)
+{
+    return edited(s, ps_scene_translate_object(s->scene, object, delta, err), true);
+}
+
+ps_status ps_session_set_light_power(ps_session *s, size_t light, ps_rgb power, ps_error *err)
+{
+    return edited(s, ps_scene_set_light_power(s->scene, light, power, err), false);
+}
+
+ps_status ps_session_set_spot_angle(ps_session *s, size_t light, double degrees, ps_error *err)
+{
+    return edited(s, ps_scene_set_spot_angle(s->scene, light, degrees, err), false);
+}
+
+bool ps_session_edited(const ps_session *s) { return s->edited; }
+uint64_t ps_session_edits(const ps_session *s) { return s->edits; }
+
+ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error *err)
+{
+    changes->geometry = s->geometry_edited;
+    changes->lights = true;
+    /* Every edit restarts both maps from photon 0 (thesis 4.1.4): the tracer's
+     * caustic cones follow lights and objects. */
+    free_maps(s);
+    ps_status st = PS_OK;
+    if (s->geometry_edited)
+        st = build_geometry(s, err);
+    if (st == PS_OK)
+        st = build_lights(s, err);
+    if (st == PS_OK)
+        st = new_tracer(s, err);
+    if (st == PS_OK)
+        st = new_feed(s, err);
+    s->edited = s->geometry_edited = false;
+    /* The first batch is traced here and the thread held until the first
+     * refresh has drawn it: that refresh then has every core. */
+    if (st == PS_OK && s->started)
+        st = ps_session_start(s, true, err);
+    return st;
+}
+
+/* ---- what it holds ------------------------------------------------------------------- */
+
+const ps_scene *ps_session_scene(const ps_session *s) { return s->scene; }
+const ps_world *ps_session_world(const ps_session *s) { return s->world; }
+const ps_preview_mesh *ps_session_mesh(const ps_session *s) { return &s->mesh; }
+const ps_preview_mesh *ps_session_coarse_mesh(const ps_session *s) { return &s->coarse; }
+const ps_preview_lights *ps_session_lights(const ps_session *s) { return &s->lights; }
+const ps_kernel_texture *ps_session_kernel(const ps_session *s) { return &s->kernel; }
+const ps_tracer *ps_session_tracer(const ps_session *s) { return s->tracer; }
+double ps_session_radius(const ps_session *s, ps_map_kind k) { return s->splat_radius[k]; }
+
+void ps_session_get_counts(ps_session *s, ps_session_counts *out)
+{
+    memset(out, 0, sizeof *out);
+    ps_feed_lock(s->feed);
+    const ps_photon_map *maps = ps_feed_maps(s->feed);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        const ps_photon_map *m = &maps[k];
+        out->map[k] = m->counters;
+        out->map_bytes += (double)(m->cap * sizeof *m->photons + m->mcap * sizeof *m->materials +
+                                   m->ocap * sizeof *m->objects);
+    }
+    out->store_limited = ps_feed_store_limited(s->feed);
+    out->ended = ps_feed_ended(s->feed);
+    ps_feed_unlock(s->feed);
+    out->trace_seconds = ps_feed_seconds(s->feed);
+    out->splat_seconds = s->splat_seconds;
+    out->refreshes = s->refreshes;
+}
+
+const ps_photon_map *ps_session_maps(const ps_session *s) { return ps_feed_maps(s->feed); }

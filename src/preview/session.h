@@ -1,0 +1,221 @@
+/* session.h: one preview session, GL-free: the progressive policy that the
+ * window and photosplat-snap share (thesis 4.1.4, 5.1).
+ *
+ * A session owns what a scene needs to be previewed: the ray accelerator
+ * (world), the photon tracer and its background feed, the GL-ready meshes
+ * and lights (preview/mesh.h, preview/lights.h), the kernel texture and the
+ * splat batches. Each refresh, a program asks it what to draw
+ * (ps_session_refresh): which photons become splats, at which radius (the
+ * radius schedule), with which gains (N / n), whether the layers start over;
+ * after drawing it says how long that took (ps_session_drawn), which sets the
+ * next refresh's splat budget. Edits (lights, objects) and settings go
+ * through the session, which restarts what they invalidate.
+ *
+ * Two ways to refresh, one policy:
+ *  - whole: every refresh splats every photon that has arrived, scaled for
+ *    display (exposure N / n) into layers cleared first. What an 8-bit
+ *    colour buffer needs (thesis 5.1: faint photons must be drawn at their
+ *    displayed value, or they round away), and what photosplat-snap does.
+ *  - incremental: layers keep their float sums between refreshes; a refresh
+ *    splats only the batches not drawn yet, at their stored power, at most
+ *    the budget's worth, and the composite scales each map by exposure N / n.
+ *    The window's float layers.
+ * Either way the photons drawn are a prefix of each map ending at a batch the
+ * feed handed over, so the picture after n photons is the same picture
+ * however fast they came. */
+#ifndef PS_PREVIEW_SESSION_H
+#define PS_PREVIEW_SESSION_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/cancel.h"
+#include "core/status.h"
+#include "photon/estimate.h"
+#include "photon/tracer.h"
+#include "photon/world.h"
+#include "preview/lights.h"
+#include "preview/mesh.h"
+#include "preview/splat.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+/* The layers of the preview (thesis eq. 6's terms as it draws them). */
+enum { PS_LAYER_DIRECT = 1, PS_LAYER_CAUSTIC = 2, PS_LAYER_GLOBAL = 4, PS_LAYER_ALL = 7 };
+/* Map k's layer bit. */
+static inline unsigned ps_map_layer(ps_map_kind k) { return k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL; }
+
+/* An incremental refresh splats at most as many photons a map as fit in this
+ * share of tau at the rate the last refreshes drew them, so that a refresh
+ * comes every tau however fast photons arrive (llvmpipe draws a few hundred
+ * thousand large splats a second); never fewer than the first bound. */
+#define PS_SESSION_SPLAT_TIME_SHARE 0.5
+#define PS_SESSION_BUDGET_MIN 2048
+#define PS_SESSION_BUDGET_START 16384
+
+typedef struct ps_session_settings {
+    /* The photons. */
+    uint64_t caps[PS_MAP_COUNT];   /* photons each map emits: the cap of refinement */
+    double radius[PS_MAP_COUNT];   /* r0, scene units (> 0) */
+    uint64_t seed;
+    int threads;                   /* tracing threads; 0: every core */
+    const ps_cancel_flag *cancel;  /* NULL, or a flag that stops tracing */
+    size_t max_stored;             /* the feed's store limit for both maps (0: none) */
+    uint64_t max_map_photons;      /* the most photons one map may hold (the memory budget's
+                                    * share, ps_tracer_options.max_stored; 0: none) */
+    bool skip_hidden;              /* a layer not shown is not traced (snap); else traced anyway,
+                                    * to be shown when switched on (the window) */
+    /* How they are drawn. */
+    unsigned layers;               /* PS_LAYER_* shown */
+    ps_splat_mode splat;
+    ps_kernel kernel;
+    double point_size;             /* points: their side in pixels */
+    bool float_buffer;             /* the colour buffer or layers keep floats; else 8 bits */
+    ps_precision precision;        /* 8 bits only */
+    double counter_threshold;      /* PS_PRECISION_COUNTER: stop past this fraction rounded away */
+    bool stencil_clip;             /* clip each object's splats to its pixels */
+    ps_radius_schedule radius_schedule;
+    double radius_alpha;
+    double exposure;
+    bool incremental;              /* see above: only with float_buffer */
+    double tau;                    /* seconds between refreshes: the budget's time */
+    int shadow_size;               /* the GL lights' shadow maps (texels a side), 0: none;
+                                    * only planned here, against the memory budget */
+} ps_session_settings;
+
+/* Defaults: the scene's photon counts and radii, every layer, triangles, the
+ * cone kernel, 8 bits with error diffusion, fixed radius, exposure 1, whole
+ * refreshes, tau 0.1, shadow maps of 1024. */
+ps_session_settings ps_session_default_settings(const ps_scene *scene);
+
+typedef struct ps_session ps_session;
+
+/* A session of `scene`, which it edits and which must outlive it. Builds the
+ * world, meshes, lights, tracer and feed; traces nothing yet. */
+ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_session **out, ps_error *err);
+void ps_session_destroy(ps_session *s); /* stops the feed; accepts NULL */
+
+/* ---- tracing ---------------------------------------------------------------- */
+
+/* Traces every map to its cap on the calling thread. */
+ps_status ps_session_trace_all(ps_session *s, ps_error *err);
+/* Traces the first round here (so that the first picture shows photons),
+ * then goes on in a background thread. held: the thread waits until the
+ * first refresh after this has been drawn (ps_session_drawn), so that the
+ * refresh has every core. */
+ps_status ps_session_start(ps_session *s, bool held, ps_error *err);
+/* Stops the background thread and waits for it; how tracing ended. */
+ps_status ps_session_stop(ps_session *s, ps_error *err);
+/* How tracing went so far: the tracer's error if it failed, else PS_OK. */
+ps_status ps_session_status(const ps_session *s, ps_error *err);
+/* Holds tracing (the user's pause) or lets it go on (unless the error
+ * counter stopped it). */
+void ps_session_set_paused(ps_session *s, bool paused);
+/* Holds the background thread without changing the user's pause (while a
+ * program writes files off its clock). */
+void ps_session_hold(ps_session *s, bool held);
+bool ps_session_paused(const ps_session *s);
+/* Whether the error counter stopped shooting (thesis 5.1), and at how many
+ * photons emitted (both maps). Until the next edit. */
+bool ps_session_counter_stopped(const ps_session *s, uint64_t *at_photons);
+
+/* ---- refreshing ---------------------------------------------------------------- */
+
+/* What one map's layer gets this refresh. */
+typedef struct ps_session_layer {
+    bool clear;                  /* empty the layer first (whole refreshes) */
+    const ps_splat_batch *batch; /* splats to add (possibly none) */
+    double radius;               /* the radius they were built with */
+    double gain;                 /* the layer's weight in the composite (0: not shown) */
+} ps_session_layer;
+
+typedef struct ps_session_frame {
+    /* The layers hold nothing valid (a new camera, setting or edit): draw the
+     * depth prepass and the direct layer again, and empty the map layers. */
+    bool new_view;
+    bool direct;             /* the direct layer is shown (else the scene is drawn black) */
+    double direct_exposure;  /* the exposure GL lights are drawn with */
+    double direct_gain;      /* the direct layer's weight in the composite */
+    ps_session_layer map[PS_MAP_COUNT];
+    ps_splat_mode splat;
+    double point_size;
+    uint64_t emitted[PS_MAP_COUNT]; /* the photons emitted that this picture shows */
+    size_t splats;           /* splats built this refresh */
+    double round_off;        /* 8 bits: the fraction of this refresh's splat energy rounded away */
+} ps_session_frame;
+
+/* Builds this refresh's splats for camera cam (a camera unlike the last
+ * refresh's starts a new view). Briefly holds the feed's lock. */
+ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_session_frame *out, ps_error *err);
+/* After the refresh's splats were drawn, in draw_seconds (finished, not only
+ * queued): the budget for the next, a held feed let go, and the error
+ * counter's verdict (which pauses tracing). */
+void ps_session_drawn(ps_session *s, double draw_seconds);
+
+/* Whether everything is shown: no edit or new view pending, and every map at
+ * its end and drawn, or tracing held for good (paused, counter stopped). */
+bool ps_session_settled(ps_session *s);
+
+/* ---- settings ----------------------------------------------------------------- */
+
+const ps_session_settings *ps_session_get_settings(const ps_session *s);
+void ps_session_set_layers(ps_session *s, unsigned layers);
+void ps_session_set_splat(ps_session *s, ps_splat_mode mode);
+ps_status ps_session_set_kernel(ps_session *s, ps_kernel kernel, ps_error *err);
+void ps_session_set_precision(ps_session *s, ps_precision precision);
+void ps_session_set_exposure(ps_session *s, double exposure);
+/* Map k's r0; radius <= 0 leaves it. */
+void ps_session_set_radius(ps_session *s, ps_map_kind k, double radius);
+void ps_session_set_tau(ps_session *s, double tau);
+
+/* ---- edits ------------------------------------------------------------------------
+ * Each checks its arguments as the scene's edits do (scene.h: an error names
+ * the scene line, and leaves everything as it was) and marks what it
+ * invalidates; ps_session_update then rebuilds it. Today every edit restarts
+ * both maps from photon 0. */
+ps_status ps_session_move_light(ps_session *s, size_t light, ps_vec3 position, ps_error *err);
+ps_status ps_session_move_object(ps_session *s, size_t object, ps_vec3 delta, ps_error *err);
+ps_status ps_session_set_light_power(ps_session *s, size_t light, ps_rgb power, ps_error *err);
+ps_status ps_session_set_spot_angle(ps_session *s, size_t light, double degrees, ps_error *err);
+
+/* What ps_session_update rebuilt, for the drawing side to follow. */
+typedef struct ps_session_changes {
+    bool geometry; /* meshes and lights are new (ps_session_mesh, _coarse_mesh, _lights) */
+    bool lights;   /* lights are new */
+} ps_session_changes;
+/* Whether edits wait for ps_session_update. */
+bool ps_session_edited(const ps_session *s);
+/* Applies pending edits: new world and meshes if geometry moved, new lights,
+ * new maps from photon 0 (traced as ps_session_start(held) does once the
+ * session has been started). Number of edits so far: ps_session_edits. */
+ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error *err);
+uint64_t ps_session_edits(const ps_session *s);
+
+/* ---- what it holds ------------------------------------------------------------ */
+
+const ps_scene *ps_session_scene(const ps_session *s);
+const ps_world *ps_session_world(const ps_session *s);
+const ps_preview_mesh *ps_session_mesh(const ps_session *s);        /* fine: lit passes */
+const ps_preview_mesh *ps_session_coarse_mesh(const ps_session *s); /* the scene's own triangles: depth only */
+const ps_preview_lights *ps_session_lights(const ps_session *s);
+const ps_kernel_texture *ps_session_kernel(const ps_session *s);
+const ps_tracer *ps_session_tracer(const ps_session *s);
+/* Map k's splat radius for the last refresh (under the radius schedule). */
+double ps_session_radius(const ps_session *s, ps_map_kind k);
+
+/* Counts, read under the feed's lock. */
+typedef struct ps_session_counts {
+    ps_trace_counters map[PS_MAP_COUNT];
+    bool ended;          /* every map at its cap, stopped, or failed */
+    bool store_limited;  /* ended at the store limit */
+    double trace_seconds;/* the feed's time tracing */
+    double map_bytes;    /* what the maps hold allocated */
+    double splat_seconds;/* building splats, all refreshes */
+    uint64_t refreshes;
+} ps_session_counts;
+void ps_session_get_counts(ps_session *s, ps_session_counts *out);
+/* The maps; only while tracing is stopped (after trace_all or stop). */
+const ps_photon_map *ps_session_maps(const ps_session *s);
+
+#endif

@@ -1,0 +1,388 @@
+/* test_session.c: the preview's progressive policy (preview/session.h),
+ * with no GL at all: which photons each refresh splats, with which gains,
+ * when a view starts over, when the error counter stops shooting, what an
+ * edit restarts, and what a left-out layer skips. */
+#include "test.h"
+
+#include <string.h>
+#include <time.h>
+
+#include "preview/feed.h"
+#include "preview/session.h"
+#include "scene/scene.h"
+
+#define SCENE "data/scenes/cornell-caustic.scn"
+#define CAUSTIC_CAP 40000
+#define GLOBAL_CAP 10000
+#define EXPOSURE 0.3
+
+static ps_scene *load(void)
+{
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load(SCENE, NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    return scene;
+}
+
+static ps_session_settings settings(const ps_scene *scene, bool incremental)
+{
+    ps_session_settings set = ps_session_default_settings(scene);
+    set.caps[PS_MAP_CAUSTIC] = CAUSTIC_CAP;
+    set.caps[PS_MAP_GLOBAL] = GLOBAL_CAP;
+    set.seed = 5;
+    set.threads = 2;
+    set.exposure = EXPOSURE;
+    set.float_buffer = incremental;
+    set.incremental = incremental;
+    return set;
+}
+
+static ps_session *open_session(ps_scene *scene, const ps_session_settings *set)
+{
+    ps_session *s;
+    ps_error err;
+    if (ps_session_create(scene, set, &s, &err) != PS_OK)
+        fail_msg("session: %s", err.msg);
+    return s;
+}
+
+static ps_camera_frame camera(const ps_scene *scene)
+{
+    return ps_camera_frame_make(ps_scene_camera(scene), 64, 64);
+}
+
+static void refresh(ps_session *s, const ps_camera_frame *cam, ps_session_frame *f)
+{
+    ps_error err;
+    if (ps_session_refresh(s, cam, f, &err) != PS_OK)
+        fail_msg("refresh: %s", err.msg);
+}
+
+/* Sum of one colour channel over a batch's vertices. */
+static double batch_sum(const ps_splat_batch *b)
+{
+    double sum = 0.0;
+    for (size_t i = 0; i < b->vertex_count; i++)
+        sum += b->colors[4 * i];
+    return sum;
+}
+
+/* Waits (at most 10 s) until the feed has ended. */
+static void wait_ended(ps_session *s)
+{
+    ps_session_counts c;
+    for (int i = 0; i < 2000; i++) {
+        ps_session_get_counts(s, &c);
+        if (c.ended)
+            return;
+        struct timespec ts = {0, 5000000};
+        nanosleep(&ts, NULL);
+    }
+    fail_msg("the feed did not end within 10 s");
+}
+
+/* Whole refreshes: every photon, scaled by exposure N / n into layers cleared
+ * first; the direct layer drawn at the exposure. */
+static void whole_refresh_splats_everything(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, false);
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    assert_true(f.new_view);
+    assert_true(f.direct);
+    assert_near(f.direct_exposure, EXPOSURE, 0.0);
+    assert_near(f.direct_gain, 1.0, 0.0);
+    const ps_photon_map *maps = ps_session_maps(s);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        assert_int_equal(f.emitted[k], set.caps[k]);
+        assert_true(f.map[k].clear);
+        assert_near(f.map[k].gain, 1.0, 0.0);
+        assert_true(f.map[k].batch->splats > 0);
+        assert_true(f.map[k].batch->splats <= maps[k].count);
+    }
+    /* The same camera: no new view, the same splats, built afresh. */
+    double sum = batch_sum(f.map[PS_MAP_CAUSTIC].batch);
+    refresh(s, &cam, &f);
+    assert_false(f.new_view);
+    assert_near(batch_sum(f.map[PS_MAP_CAUSTIC].batch), sum, 0.0);
+    /* Another camera: a new view. */
+    cam.eye.x += 0.1;
+    refresh(s, &cam, &f);
+    assert_true(f.new_view);
+    /* Exposure is in the splats: doubling it doubles them and redraws. */
+    ps_session_set_exposure(s, 2.0 * EXPOSURE);
+    refresh(s, &cam, &f);
+    assert_true(f.new_view);
+    assert_near(f.direct_exposure, 2.0 * EXPOSURE, 0.0);
+    cam.eye.x -= 0.1;
+    refresh(s, &cam, &f);
+    /* 8-bit codes with error diffusion: the sum within the carry's rounding. */
+    assert_near(batch_sum(f.map[PS_MAP_CAUSTIC].batch), 2.0 * sum, 1e-4 * sum);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* Incremental refreshes: the first shows the first round (the feed held
+ * until it is drawn), later ones only batches not drawn yet, at stored power,
+ * with the gain exposure N / n in the composite; together they splat every
+ * photon exactly once, as one whole refresh would. */
+static void incremental_refresh_splats_each_photon_once(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    assert_true(f.new_view);
+    assert_near(f.direct_exposure, 1.0, 0.0);
+    assert_near(f.direct_gain, EXPOSURE, 0.0);
+    /* The first round: PS_FEED_BATCH photons of the larger map, the other in proportion. */
+    assert_int_equal(f.emitted[PS_MAP_CAUSTIC], PS_FEED_BATCH);
+    assert_int_equal(f.emitted[PS_MAP_GLOBAL], PS_FEED_BATCH / 4);
+    assert_near(f.map[PS_MAP_CAUSTIC].gain, EXPOSURE * CAUSTIC_CAP / (double)PS_FEED_BATCH, 1e-12);
+    assert_false(f.map[PS_MAP_CAUSTIC].clear);
+    double sum[PS_MAP_COUNT];
+    size_t splats[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        sum[k] = batch_sum(f.map[k].batch);
+        splats[k] = f.map[k].batch->splats;
+    }
+    /* Held until drawn: nothing new arrives. */
+    refresh(s, &cam, &f);
+    assert_false(f.new_view);
+    assert_int_equal(f.splats, 0);
+    ps_session_drawn(s, 0.001);
+    wait_ended(s);
+    for (int i = 0; i < 1000 && !ps_session_settled(s); i++) {
+        refresh(s, &cam, &f);
+        ps_session_drawn(s, 0.001);
+        for (int k = 0; k < PS_MAP_COUNT; k++) {
+            sum[k] += batch_sum(f.map[k].batch);
+            splats[k] += f.map[k].batch->splats;
+        }
+    }
+    assert_true(ps_session_settled(s));
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        assert_int_equal(f.emitted[k], set.caps[k]);
+        assert_near(f.map[k].gain, EXPOSURE, 1e-12);
+    }
+    assert_int_equal(ps_session_stop(s, &err), PS_OK);
+    ps_session_destroy(s);
+
+    /* One whole refresh of the same photons: the same splats, scaled by the
+     * exposure (N / n = 1 at the caps). */
+    set = settings(scene, false);
+    s = open_session(scene, &set);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    refresh(s, &cam, &f);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        assert_int_equal(f.map[k].batch->splats, splats[k]);
+        assert_near(batch_sum(f.map[k].batch), EXPOSURE * sum[k], 1e-4 * EXPOSURE * sum[k]);
+    }
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* The budget: a refresh that took long makes the next draw one batch, not all. */
+static void budget_bounds_a_refresh(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = 4 * PS_FEED_BATCH;
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    /* A second per splat: the budget falls to its floor, PS_SESSION_BUDGET_MIN. */
+    ps_session_drawn(s, (double)f.splats);
+    wait_ended(s);
+    uint64_t before = f.emitted[PS_MAP_CAUSTIC];
+    refresh(s, &cam, &f);
+    /* One batch more, however many have arrived. */
+    assert_int_equal(f.emitted[PS_MAP_CAUSTIC], before + PS_FEED_BATCH);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* The error counter (thesis 5.1): in 8 bits, once a refresh loses more than
+ * the threshold to round-off, tracing stops and says at how many photons. */
+static void counter_stops_shooting(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, false);
+    set.precision = PS_PRECISION_COUNTER;
+    set.counter_threshold = 1e-6;
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    assert_true(f.round_off > set.counter_threshold);
+    uint64_t at = 0;
+    assert_false(ps_session_counter_stopped(s, NULL));
+    ps_session_drawn(s, 0.001);
+    assert_true(ps_session_counter_stopped(s, &at));
+    assert_int_equal(at, f.emitted[0] + f.emitted[1]);
+    /* Stopped for good: settled, and nothing more is traced. */
+    assert_true(ps_session_settled(s));
+    struct timespec ts = {0, 50000000};
+    nanosleep(&ts, NULL);
+    ps_session_counts c;
+    ps_session_get_counts(s, &c);
+    assert_true(c.map[PS_MAP_CAUSTIC].emitted <= 2 * PS_FEED_BATCH); /* at most the batch under way */
+    /* Diffusion keeps the light: the same refresh loses less, and goes on. */
+    ps_session_set_precision(s, PS_PRECISION_DIFFUSION);
+    refresh(s, &cam, &f);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* An edit restarts the maps from photon 0 with the edited scene; geometry
+ * rebuilds the meshes, a light only the lights; a refused edit changes nothing. */
+static void edits_restart_the_maps(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, false);
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    assert_false(ps_session_edited(s));
+    assert_int_equal(ps_session_move_light(s, 7, ps_v3(0, 1, 0), &err), PS_ERR_RANGE);
+    assert_false(ps_session_edited(s));
+    assert_int_equal(ps_session_move_light(s, 0, ps_v3(0.3, 1.8, 0), &err), PS_OK);
+    assert_true(ps_session_edited(s));
+    ps_session_changes ch;
+    assert_int_equal(ps_session_update(s, &ch, &err), PS_OK);
+    assert_false(ch.geometry);
+    assert_true(ch.lights);
+    assert_false(ps_session_edited(s));
+    assert_int_equal(ps_session_edits(s), 1);
+    assert_near(ps_session_lights(s)->lights[0].pos.x, 0.3, 0.0);
+    ps_session_counts c;
+    ps_session_get_counts(s, &c);
+    assert_int_equal(c.map[PS_MAP_CAUSTIC].emitted, 0); /* freed: a new feed from photon 0 */
+    refresh(s, &cam, &f);
+    assert_true(f.new_view);
+    assert_int_equal(f.splats, 0);
+    /* The restarted maps are a fresh trace's of the edited scene. */
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    refresh(s, &cam, &f);
+    assert_int_equal(f.emitted[PS_MAP_CAUSTIC], CAUSTIC_CAP);
+    /* Moving an object rebuilds the meshes: the sphere's vertices move. */
+    size_t nobj;
+    (void)ps_scene_objects(ps_session_scene(s), &nobj);
+    float x0 = ps_session_mesh(s)->positions[3 * (ps_session_mesh(s)->vertex_count - 1)];
+    assert_int_equal(ps_session_move_object(s, nobj - 1, ps_v3(0.1, 0, 0), &err), PS_OK);
+    assert_int_equal(ps_session_update(s, &ch, &err), PS_OK);
+    assert_true(ch.geometry);
+    float x1 = ps_session_mesh(s)->positions[3 * (ps_session_mesh(s)->vertex_count - 1)];
+    assert_near(x1 - x0, 0.1, 1e-5);
+    assert_int_equal(ps_session_edits(s), 2);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* A layer left out is not traced when the session skips hidden layers (snap),
+ * and says so; shown or not, the window traces it. */
+static void hidden_layers_are_skipped(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, false);
+    set.layers = PS_LAYER_CAUSTIC;
+    set.skip_hidden = true;
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    ps_session_counts c;
+    ps_session_get_counts(s, &c);
+    assert_int_equal(c.map[PS_MAP_GLOBAL].emitted, 0);
+    assert_int_equal(c.map[PS_MAP_CAUSTIC].emitted, CAUSTIC_CAP);
+    size_t n;
+    const ps_skip *skips = ps_tracer_skips(ps_session_tracer(s), &n);
+    int global = 0, direct = 0;
+    for (size_t i = 0; i < n; i++) {
+        global += strcmp(skips[i].pass, "global") == 0 && strstr(skips[i].reason, "--layers") != NULL;
+        direct += strcmp(skips[i].pass, "direct") == 0;
+    }
+    assert_int_equal(global, 1);
+    assert_int_equal(direct, 1);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    assert_false(f.direct);
+    assert_near(f.map[PS_MAP_GLOBAL].gain, 0.0, 0.0);
+    ps_session_destroy(s);
+
+    set.skip_hidden = false;
+    s = open_session(scene, &set);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    ps_session_get_counts(s, &c);
+    assert_int_equal(c.map[PS_MAP_GLOBAL].emitted, GLOBAL_CAP);
+    refresh(s, &cam, &f);
+    assert_near(f.map[PS_MAP_GLOBAL].gain, 0.0, 0.0); /* traced, not shown */
+    assert_int_equal(f.map[PS_MAP_GLOBAL].batch->splats, 0);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* The radius schedule: fixed keeps r0; progressive shrinks it as photons arrive. */
+static void radius_follows_the_schedule(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, false);
+    set.radius_schedule = PS_RADIUS_PROGRESSIVE;
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    const ps_scene_defaults *d = ps_scene_get_defaults(scene);
+    double want = ps_splat_radius_at(PS_RADIUS_PROGRESSIVE, set.radius[PS_MAP_CAUSTIC], (uint64_t)d->caustic_photons,
+                                     CAUSTIC_CAP, set.radius_alpha);
+    assert_near(ps_session_radius(s, PS_MAP_CAUSTIC), want, 1e-15);
+    assert_near(f.map[PS_MAP_CAUSTIC].radius, want, 1e-15);
+    /* A new r0 starts the view over. */
+    ps_session_set_radius(s, PS_MAP_CAUSTIC, 2.0 * set.radius[PS_MAP_CAUSTIC]);
+    refresh(s, &cam, &f);
+    assert_true(f.new_view);
+    assert_near(f.map[PS_MAP_CAUSTIC].radius, 2.0 * want, 1e-15);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(whole_refresh_splats_everything),
+        cmocka_unit_test(incremental_refresh_splats_each_photon_once),
+        cmocka_unit_test(budget_bounds_a_refresh),
+        cmocka_unit_test(counter_stops_shooting),
+        cmocka_unit_test(edits_restart_the_maps),
+        cmocka_unit_test(hidden_layers_are_skipped),
+        cmocka_unit_test(radius_follows_the_schedule),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
