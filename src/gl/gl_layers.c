@@ -183,20 +183,7 @@ ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const doub
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     composite(l, LAYER_FINAL_TEX, direct_gain, map_gain);
-    ps_status st = ps_image_create(l->width, l->height, out, err);
-    float *rows = st == PS_OK ? malloc(sizeof(float) * 3 * (size_t)l->width * (size_t)l->height) : NULL;
-    if (st == PS_OK && !rows) {
-        ps_image_destroy(out);
-        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory reading the picture back");
-    }
-    if (st == PS_OK) {
-        glPixelStorei(GL_PACK_ALIGNMENT, 1);
-        glReadPixels(0, 0, l->width, l->height, GL_RGB, GL_FLOAT, rows);
-        for (int y = 0; y < l->height; y++)
-            memcpy(ps_image_at(out, 0, y), rows + 3 * (size_t)(l->height - 1 - y) * (size_t)l->width,
-                   sizeof(float) * 3 * (size_t)l->width);
-    }
-    free(rows);
+    ps_status st = ps_gl_read_pixels(l->width, l->height, out, err);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     return st;
 }

@@ -29,6 +29,17 @@
 
 static const ps_preview_lights *lights_of(const ps_gl_renderer *r) { return r->in.lights; }
 
+/* The bound texture: nearest texels, and 0 beyond its edges. */
+static void nearest_with_zero_border(void)
+{
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const GLfloat border[4] = {0, 0, 0, 0};
+    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+}
+
 /* ---- shadow cubes ------------------------------------------------------------ */
 
 static void face_frame(int f, ps_vec3 *forward, ps_vec3 *right, ps_vec3 *up)
@@ -107,14 +118,9 @@ void ps_gl_make_shadow_maps(ps_gl_renderer *r)
                 glBindTexture(GL_TEXTURE_2D, shadow[f]);
                 glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, r->shadow_size, r->shadow_size, 0,
                              GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, NULL);
-                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
                 /* Outside the face's square: depth 0 at the border, so the
                  * compare fails there and the neighbouring face lights it. */
-                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-                const GLfloat border[4] = {0, 0, 0, 0};
-                glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+                nearest_with_zero_border();
                 glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_R_TO_TEXTURE);
                 glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
                 glTexParameteri(GL_TEXTURE_2D, GL_DEPTH_TEXTURE_MODE, GL_INTENSITY);
@@ -203,12 +209,7 @@ void ps_gl_make_spot_texture(ps_gl_renderer *r)
     glTexImage2D(GL_TEXTURE_2D, 0, GL_LUMINANCE8, SPOT_TEX_SIZE, SPOT_TEX_SIZE, 0, GL_LUMINANCE, GL_UNSIGNED_BYTE, texels);
     /* Nearest: the edge is as sharp as the reference's, and a texel is far
      * finer than a mesh edge. */
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-    const GLfloat border[4] = {0, 0, 0, 0};
-    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+    nearest_with_zero_border();
     glBindTexture(GL_TEXTURE_2D, 0);
     free(texels);
 }

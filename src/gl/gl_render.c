@@ -184,25 +184,30 @@ void ps_gl_draw_frame(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_se
 
 void ps_gl_finish(void) { glFinish(); }
 
-ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err)
+ps_status ps_gl_read_pixels(int width, int height, ps_image *out, ps_error *err)
 {
-    ps_status st = ps_image_create(r->width, r->height, out, err);
+    ps_status st = ps_image_create(width, height, out, err);
     if (st != PS_OK)
         return st;
-    float *rows = malloc(sizeof(float) * 3 * (size_t)r->width * (size_t)r->height);
+    float *rows = malloc(sizeof(float) * 3 * (size_t)width * (size_t)height);
     if (!rows) {
         ps_image_destroy(out);
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory reading the picture back");
     }
     glFinish();
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, r->width, r->height, GL_RGB, GL_FLOAT, rows);
+    glReadPixels(0, 0, width, height, GL_RGB, GL_FLOAT, rows);
     /* GL's row 0 is the bottom; ours the top. */
-    for (int y = 0; y < r->height; y++)
-        memcpy(ps_image_at(out, 0, y), rows + 3 * (size_t)(r->height - 1 - y) * (size_t)r->width,
-               sizeof(float) * 3 * (size_t)r->width);
+    for (int y = 0; y < height; y++)
+        memcpy(ps_image_at(out, 0, y), rows + 3 * (size_t)(height - 1 - y) * (size_t)width,
+               sizeof(float) * 3 * (size_t)width);
     free(rows);
     return PS_OK;
+}
+
+ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err)
+{
+    return ps_gl_read_pixels(r->width, r->height, out, err);
 }
 
 ps_gl_scene ps_gl_scene_of(const ps_session *s)

@@ -92,6 +92,10 @@ void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode
  * flushed): for timing the drawing, not the queueing. */
 void ps_gl_finish(void);
 
+/* Reads width x height pixels of the current read framebuffer into out
+ * (created here; row 0 the top) as floats, unclamped where GL_CLAMP_READ_COLOR
+ * is off. */
+ps_status ps_gl_read_pixels(int width, int height, ps_image *out, ps_error *err);
 /* Reads the colour buffer into out (created here; row 0 the top), as stored:
  * radiance times exposure. */
 ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err);

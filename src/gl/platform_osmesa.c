@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "gl/gl_api.h"
+#include "gl/gl_render.h"
 
 struct ps_platform {
     OSMesaContext ctx;
@@ -70,25 +71,9 @@ void ps_platform_present(ps_platform *p)
 
 ps_status ps_platform_read(ps_platform *p, ps_image *out, ps_error *err)
 {
-    ps_status st = ps_image_create(p->width, p->height, out, err);
-    if (st != PS_OK)
-        return st;
-    float *rows = malloc(sizeof(float) * 3 * (size_t)p->width * (size_t)p->height);
-    if (!rows) {
-        ps_image_destroy(out);
-        return ps_error_set(err, PS_ERR_NOMEM, "out of memory reading the picture back");
-    }
-    glFinish();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, p->width, p->height, GL_RGB, GL_FLOAT, rows);
-    /* GL's row 0 is the bottom; ours the top. */
-    for (int y = 0; y < p->height; y++)
-        memcpy(ps_image_at(out, 0, y), rows + 3 * (size_t)(p->height - 1 - y) * (size_t)p->width,
-               sizeof(float) * 3 * (size_t)p->width);
-    free(rows);
-    return PS_OK;
+    return ps_gl_read_pixels(p->width, p->height, out, err);
 }
 
 void *ps_platform_window(ps_platform *p)
