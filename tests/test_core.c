@@ -2,6 +2,9 @@
  * memory budget, the interrupt flag and the name map. */
 #include "test.h"
 
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <dirent.h>
@@ -362,6 +365,43 @@ static void output_checks(void **state)
     assert_string_equal(err.msg, "/dev/full: write failed: No space left on device");
 }
 
+/* A worker thread sees a flag another thread raises (the flag is atomic:
+ * workers read it while the signal handler's thread stores to it). */
+typedef struct spinner {
+    const ps_cancel_flag *flag;
+    atomic_int started;
+    long long spins;
+    bool saw;
+} spinner;
+
+static void *spin_until_cancelled(void *arg)
+{
+    spinner *s = arg;
+    atomic_store(&s->started, 1);
+    /* Bounded, so that a flag never seen fails the test instead of hanging it. */
+    for (s->spins = 0; s->spins < 4000000000LL && !s->saw; s->spins++)
+        s->saw = ps_cancelled(s->flag) != 0;
+    return NULL;
+}
+
+static void cancel_flag_across_threads(void **state)
+{
+    (void)state;
+    assert_false(ps_cancelled(NULL));
+    ps_cancel_flag flag;
+    atomic_init(&flag, 0);
+    spinner s = {&flag, 0, 0, false};
+    pthread_t tid;
+    assert_int_equal(pthread_create(&tid, NULL, spin_until_cancelled, &s), 0);
+    while (!atomic_load(&s.started))
+        ;
+    assert_false(ps_cancelled(&flag));
+    atomic_store(&flag, SIGINT);
+    pthread_join(tid, NULL);
+    assert_true(s.saw);
+    assert_true(ps_cancelled(&flag));
+}
+
 /* The programs' SIGINT/SIGTERM flag: the signal's number, the exit status
  * 128 + it, the handler gone after the first signal; SIGXFSZ ignored. */
 static void interrupt_flag(void **state)
@@ -372,7 +412,7 @@ static void interrupt_flag(void **state)
     assert_int_equal(ps_interrupt_exit_status(), 130); /* none yet: as for SIGINT */
     raise(SIGTERM);
     assert_true(ps_cancelled(flag));
-    assert_int_equal(*flag, SIGTERM);
+    assert_int_equal(atomic_load(flag), SIGTERM);
     assert_int_equal(ps_interrupt_exit_status(), 143);
     struct sigaction sa;
     assert_int_equal(sigaction(SIGTERM, NULL, &sa), 0);
@@ -399,7 +439,7 @@ int main(void)
         cmocka_unit_test(error_messages_are_one_line),
         cmocka_unit_test(memory_budget),
         cmocka_unit_test(output_checks),
-        cmocka_unit_test(interrupt_flag),
+        cmocka_unit_test(cancel_flag_across_threads), cmocka_unit_test(interrupt_flag),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -10,6 +10,7 @@
 #include "core/clock.h"
 #include "core/status.h"
 #include "photon/tracer.h"
+#include "preview/splat.h"
 
 typedef struct ps_shared_options {
     const char *scene, *out_png, *out_hdr, *stats, *dump;
@@ -39,13 +40,13 @@ typedef struct ps_preview_options {
     double tau;               /* seconds between refreshes (0.1) */
     double counter_threshold; /* the error counter's stopping fraction (0.1) */
     double point_size;        /* points: side in pixels (1) */
-    int splat;                /* ps_splat_mode (triangles) */
-    int kernel;               /* ps_kernel (cone) */
-    int color_depth;          /* 0: 8 bits, 1: float */
-    int precision;            /* ps_precision (diffusion) */
-    int shadows, stencil_clip; /* on/off (on) */
+    ps_splat_mode splat;      /* triangles */
+    ps_kernel kernel;         /* cone */
+    ps_color_depth color_depth; /* 8 bits (snap) or float (the window) */
+    ps_precision precision;   /* diffusion */
+    bool shadows, stencil_clip; /* on/off (on) */
     unsigned layers;          /* PS_LAYER_* bits (all) */
-    int radius_schedule;      /* ps_radius_schedule (fixed) */
+    ps_radius_schedule radius_schedule; /* fixed */
     double radius_alpha;      /* progressive schedule's alpha (2/3) */
 } ps_preview_options;
 

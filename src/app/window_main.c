@@ -1124,8 +1124,7 @@ static ps_status write_stats(app *a, ps_error *err)
             rs.emitted[k] = m->counters.emitted;
             rs.stored[k] = m->counters.stored;
             rs.rays += m->counters.rays;
-            map_bytes += (double)(m->cap * sizeof *m->photons + m->mcap * sizeof *m->materials +
-                                  m->ocap * sizeof *m->objects);
+            map_bytes += (double)ps_photon_map_bytes(m);
         }
         store_limited = ps_feed_store_limited(a->feed);
         cap_reached = ps_feed_ended(a->feed) && !store_limited;

@@ -50,23 +50,27 @@ ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const 
 }
 
 /* Traces photons [first, first + count) of map k outside the lock, then
- * appends them under it. */
+ * joins them to the map under it: each photon is copied once, from the
+ * tracer's chunk into the map the drawing thread reads. */
 static ps_status batch(ps_feed *f, int k, uint64_t first, uint64_t count, ps_error *err)
 {
-    ps_photon_map local;
-    ps_photon_map_init(&local, (ps_map_kind)k);
-    ps_status st = ps_tracer_trace(f->tracer, (ps_map_kind)k, first, count, f->cap[k], &local, err);
+    ps_traced *traced;
+    /* Only this thread adds to the maps, so the count can be read without the lock. */
+    ps_status st = ps_tracer_trace_range(f->tracer, (ps_map_kind)k, first, count, f->cap[k], f->maps[k].count,
+                                         &traced, err);
+    if (st != PS_OK)
+        return st;
     pthread_mutex_lock(&f->lock);
-    if (st == PS_OK && (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1) ||
-                        !ps_photon_map_append(&f->maps[k], &local)))
+    if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1) ||
+        ps_traced_join(traced, &f->maps[k], err) != PS_OK)
         st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for %llu more photons",
-                          (unsigned long long)local.count);
+                          (unsigned long long)ps_traced_count(traced));
     if (st == PS_OK) {
         ps_feed_mark m = {f->maps[k].count, f->maps[k].counters.emitted};
         f->marks[k][f->mark_count[k]++] = m;
     }
     pthread_mutex_unlock(&f->lock);
-    ps_photon_map_free(&local);
+    ps_traced_destroy(traced);
     return st;
 }
 

@@ -9,6 +9,8 @@
 
 #include "core/fileio.h"
 #include "core/number.h"
+#include "photon/estimate.h"
+#include "preview/splat.h"
 
 /* The longest action, "T move light I X Y Z", has 7 words; a line may hold
  * more (they are counted, so that "expected N numbers" can be said), but only
@@ -43,15 +45,13 @@ typedef struct choice_list {
     const char *said; /* the list as a message says it */
 } choice_list;
 
-static const char *const SPLAT_NAMES[] = {"points", "triangles", "sprites"};
-static const char *const KERNEL_NAMES[] = {"box", "cone", "gauss", "epanechnikov"};
-static const char *const PRECISION_NAMES[] = {"none", "diffusion", "counter"};
+/* The enums' own name tables, so that a choice is the enum's value. */
 static const char *const PAUSE_NAMES[] = {"off", "on"}; /* so that on = 1 */
 static const char *const LAYER_NAMES[] = {"direct", "caustic", "global"}; /* bit k is LAYER_NAMES[k] */
 
-static const choice_list SPLAT_CHOICES = {SPLAT_NAMES, 3, "points, triangles or sprites"};
-static const choice_list KERNEL_CHOICES = {KERNEL_NAMES, 4, "box, cone, gauss or epanechnikov"};
-static const choice_list PRECISION_CHOICES = {PRECISION_NAMES, 3, "none, diffusion or counter"};
+static const choice_list SPLAT_CHOICES = {ps_splat_mode_names, PS_SPLAT_MODE_COUNT, "points, triangles or sprites"};
+static const choice_list KERNEL_CHOICES = {ps_kernel_names, PS_KERNEL_COUNT, "box, cone, gauss or epanechnikov"};
+static const choice_list PRECISION_CHOICES = {ps_precision_names, PS_PRECISION_COUNT, "none, diffusion or counter"};
 static const choice_list PAUSE_CHOICES = {PAUSE_NAMES, 2, "on or off"};
 
 /* ---- words ------------------------------------------------------------------- */
