@@ -287,6 +287,31 @@ static void error_messages_are_one_line(void **state)
     assert_string_equal(ps_status_name(PS_ERR_NOMEM), "out of memory");
 }
 
+/* A located error keeps its line as a field, with the same one-line text
+ * ps_error_set would make; an unlocated one, or a cleared one, has line 0. */
+static void errors_carry_their_line(void **state)
+{
+    (void)state;
+    ps_error err;
+    assert_int_equal(ps_error_at(&err, PS_ERR_RANGE, "a\nb.obj", 17, "'%s' is %d", "v", 4), PS_ERR_RANGE);
+    assert_string_equal(err.msg, "a b.obj:17: 'v' is 4");
+    assert_int_equal(err.line, 17);
+    assert_int_equal(err.status, PS_ERR_RANGE);
+    assert_int_equal(ps_error_set(&err, PS_ERR_IO, "%s: cannot open", "x.obj"), PS_ERR_IO);
+    assert_int_equal(err.line, 0);
+    ps_error_at(&err, PS_ERR_PARSE, "x", 2, "y");
+    ps_error_clear(&err);
+    assert_int_equal(err.line, 0);
+    assert_int_equal(ps_error_at(NULL, PS_ERR_PARSE, "x", 1, "y"), PS_ERR_PARSE); /* NULL err is allowed */
+    /* A file name that fills the message leaves a truncated, still one-line message. */
+    char longname[2 * PS_ERROR_MSG_MAX];
+    memset(longname, 'n', sizeof longname - 1);
+    longname[sizeof longname - 1] = '\0';
+    ps_error_at(&err, PS_ERR_PARSE, longname, 5, "problem");
+    assert_int_equal(strlen(err.msg), PS_ERROR_MSG_MAX - 1);
+    assert_int_equal(err.line, 5);
+}
+
 /* PS_MEMORY_LIMIT sets the budget; sizes parse with K/M/G; a check over it
  * is PS_ERR_LIMIT with the one-line message; products saturate. */
 static void memory_budget(void **state)
@@ -436,7 +461,7 @@ int main(void)
         cmocka_unit_test(read_file_limits),
         cmocka_unit_test(name_map),
         cmocka_unit_test(line_lengths),
-        cmocka_unit_test(error_messages_are_one_line),
+        cmocka_unit_test(error_messages_are_one_line), cmocka_unit_test(errors_carry_their_line),
         cmocka_unit_test(memory_budget),
         cmocka_unit_test(output_checks),
         cmocka_unit_test(cancel_flag_across_threads), cmocka_unit_test(interrupt_flag),

@@ -615,7 +615,8 @@ ps_status ps_tracer_trace_range(ps_tracer *t, ps_map_kind kind, uint64_t first, 
     job.outs = r ? calloc(job.chunks, sizeof *job.outs) : NULL;
     if (!job.outs) {
         free(r);
-        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory tracing %llu photons", path, (unsigned long long)count);
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory tracing %llu photons", path,
+                            (unsigned long long)count);
     }
     r->path = path;
     r->kind = kind;
