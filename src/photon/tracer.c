@@ -16,17 +16,17 @@
 #include "photon/emit.h"
 #include "scene/bsdf.h"
 
-/* Emission uses Halton dimensions 1..4 (dimension 0 picks the light/cone). */
+/* Emission uses Halton dimensions 1..4 (dimension 0 picks the light and caustic cone). */
 #define EMIT_DIMS 4
 
-/* One way photons leave: a light, and for caustic photons the cone around one
- * specular object. Photon indices are shared between strata in proportion to
- * `share` (the flux each is expected to carry). */
+/* One way photons leave: a light, and for caustic photons the caustic cone
+ * around one specular object. Photon indices are shared between strata in
+ * proportion to `share` (the flux each is expected to carry). */
 typedef struct stratum {
     uint32_t light;
-    int64_t target; /* caustic: the object the cone is aimed at; -1: none */
-    bool has_cone;
-    ps_cone cone;
+    int64_t target; /* caustic: the object the caustic cone is aimed at; -1: none */
+    bool has_caustic_cone;
+    ps_caustic_cone caustic_cone;
     double share;
     double cdf; /* cumulative share, normalised; the last is 1 */
 } stratum;
@@ -82,7 +82,8 @@ static ps_status add_skip(ps_tracer *t, const char *pass, const char *fmt, ...)
     return PS_OK;
 }
 
-static bool add_stratum(map_plan *p, uint32_t light, int64_t target, const ps_cone *cone, double share)
+static bool add_stratum(map_plan *p, uint32_t light, int64_t target, const ps_caustic_cone *caustic_cone,
+                        double share)
 {
     if (!PS_RESERVE(p->strata, p->cap, p->count + 1))
         return false;
@@ -90,9 +91,9 @@ static bool add_stratum(map_plan *p, uint32_t light, int64_t target, const ps_co
     memset(s, 0, sizeof *s);
     s->light = light;
     s->target = target;
-    s->has_cone = cone != NULL;
-    if (cone)
-        s->cone = *cone;
+    s->has_caustic_cone = caustic_cone != NULL;
+    if (caustic_cone)
+        s->caustic_cone = *caustic_cone;
     s->share = share;
     return true;
 }
@@ -115,7 +116,7 @@ static void finish_plan(map_plan *p)
     p->strata[p->count - 1].cdf = 1.0;
 }
 
-/* The sphere around object o that its cone is built on: exact for spheres,
+/* The sphere around object o that its caustic cones are built on: exact for spheres,
  * around the box centre through the farthest vertex for meshes. */
 static void object_sphere(const ps_scene *s, const ps_object *o, ps_vec3 *c, double *r)
 {
@@ -210,22 +211,22 @@ static ps_status plan_maps(ps_tracer *t, ps_error *err)
                 return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
             continue;
         }
-        size_t cones = 0;
+        size_t caustic_cones = 0;
         for (size_t o = 0; o < no; o++) {
             if (!objs[o].specular)
                 continue;
             ps_vec3 c;
             double r;
-            ps_cone cone;
+            ps_caustic_cone caustic_cone;
             object_sphere(s, &objs[o], &c, &r);
-            if (!ps_light_cone(t->lights, l, c, r, &cone))
+            if (!ps_light_caustic_cone(t->lights, l, c, r, &caustic_cone))
                 continue;
-            double share = flux * ps_light_cone_share(t->lights, l, &cone);
-            if (!add_stratum(caustic, l, (int64_t)o, &cone, share))
+            double share = flux * ps_light_caustic_cone_share(t->lights, l, &caustic_cone);
+            if (!add_stratum(caustic, l, (int64_t)o, &caustic_cone, share))
                 return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
-            cones++;
+            caustic_cones++;
         }
-        if (cones == 0)
+        if (caustic_cones == 0)
             SKIP("caustic", "%s light %u (line %d): no specular object inside its emission", ps_light_type_name(lights[l].type),
                  l, lights[l].line);
     }
@@ -410,7 +411,8 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
     for (unsigned d = 0; d < EMIT_DIMS; d++)
         u[d] = shift(ps_halton(d + 1, i), plan->rotation[d + 1]);
     ps_emission e;
-    if (!ps_light_emit(t->lights, st->light, st->has_cone ? &st->cone : NULL, u, &e) || plan->scale[k] == 0.0) {
+    if (!ps_light_emit(t->lights, st->light, st->has_caustic_cone ? &st->caustic_cone : NULL, u, &e) ||
+        plan->scale[k] == 0.0) {
         c->empty++;
         return;
     }
@@ -437,9 +439,9 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
         bool specular = ps_material_is_specular(m);
         if (kind == PS_MAP_CAUSTIC && bounce == 0) {
             /* The first-hit test (thesis 4.1.1): a photon aimed at one object
-             * that first meets another is not that cone's to carry; the other
-             * object's own cone carries it. Without it overlapping cones count
-             * the same caustic twice. And a first diffuse hit is no caustic. */
+             * that first meets another is not that caustic cone's to carry; the
+             * other object's own caustic cone carries it. Without it overlapping
+             * caustic cones count the same caustic twice. And a first diffuse hit is no caustic. */
             bool other = st->target >= 0 && t->opt.first_hit_test && sp.object != (uint32_t)st->target;
             if (other || !specular) {
                 c->discarded++;

@@ -2,7 +2,7 @@
  * lights, follows them through the scene and fills the caustic and global maps.
  *
  * Photon i of a map is a pure function of (scene, seed, map, i) (thesis 4.1.3):
- * which light (and cone) emits it, where and in which direction come from the
+ * which light (and caustic cone) emits it, where and in which direction come from the
  * Halton sequence at index i, Cranley-Patterson rotated by the seed; every
  * later choice comes from a PCG stream made from (seed, map, i). Tracing runs
  * on worker threads in fixed chunks whose results are joined in index order,
@@ -39,7 +39,7 @@ typedef struct ps_tracer_options {
     uint64_t seed;
     int threads;         /* 0: one per online core */
     bool caustic_cones;  /* aim caustic photons only at specular objects (default true) */
-    bool first_hit_test; /* discard a cone's photon whose first hit is another object
+    bool first_hit_test; /* discard a caustic cone's photon whose first hit is another object
                           * (default true; off only to show the double counting it prevents) */
     bool global_direct;  /* the global map also keeps each path's first diffuse hit, as
                           * Jensen's global map does (default false: the preview draws
@@ -56,7 +56,7 @@ typedef struct ps_tracer_options {
  * thread count. */
 int ps_online_cores(void);
 
-/* seed 0, all cores, cones and the first-hit test on. */
+/* seed 0, all cores, caustic cones and the first-hit test on. */
 ps_tracer_options ps_tracer_default_options(void);
 
 /* A stage the scene did not need, and why (contract: --stats "skipped"). */
@@ -86,7 +86,7 @@ int ps_tracer_threads(const ps_tracer *t);
 /* Traces photons [first, first + count) of map `kind` and appends those stored
  * to m in index order. `total` is the number of photons the whole map will
  * have emitted (first + count <= total): photon powers are normalised so that
- * the total photons of each light and cone carry exactly its flux. Tracing the
+ * the total photons of each light and caustic cone carry exactly its flux. Tracing the
  * same range in one call or in several gives the same bytes. A disabled map
  * traces nothing. */
 ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
@@ -114,7 +114,7 @@ ps_status ps_traced_join(ps_traced *r, ps_photon_map *m, ps_error *err);
 /* Frees the chunks; accepts NULL. */
 void ps_traced_destroy(ps_traced *r);
 
-/* How many of photons [0, total) light l emits for map kind (all its cones
+/* How many of photons [0, total) light l emits for map kind (all its caustic cones
  * together): the tracer shares photons between lights in proportion to flux. */
 uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light, uint64_t total);
 
