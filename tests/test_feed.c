@@ -71,6 +71,10 @@ static void ends_at_the_caps(void **state)
         assert_true(n >= 2);
         assert_int_equal(marks[n - 1].stored, m[k].count);
         assert_int_equal(marks[n - 1].emitted, m[k].counters.emitted);
+        /* Grown batch by batch from the first batch's exact size: never more
+         * than twice what it holds (the memory plan's two entries a photon). */
+        assert_true(m[k].cap >= m[k].count && m[k].cap <= 2 * m[k].count);
+        assert_int_equal(ps_photon_map_bytes(&m[k]), m[k].cap * PS_PHOTON_MAP_BYTES);
     }
     assert_true(stored(f) > STORE_LIMIT); /* else the limit below would not bite */
     ps_feed_destroy(f);

@@ -342,7 +342,8 @@ static void mesh_light(void **state)
 
 /* Inside a cone, the expected power that reaches a target equals what the
  * light's own distribution sends there: the cone changes variance, not flux. */
-static double flux_into_sphere(const ps_light_sampler *ls, uint32_t l, const ps_caustic_cone *cone, ps_vec3 c, double rad, int n)
+static double flux_into_sphere(const ps_light_sampler *ls, uint32_t l, const ps_caustic_cone *cone, ps_vec3 c,
+                               double rad, int n)
 {
     ps_rng r = ps_rng_make(6, PS_STREAM_TEST, l * 2 + (cone != NULL));
     double sum = 0;

@@ -52,6 +52,16 @@ static void one_capacity_grows(void **state)
     assert_int_equal(m.cap, 1024);
     ps_photon_map_free(&m);
     assert_int_equal(m.kind, PS_MAP_GLOBAL);
+    /* Exact: a map filled once holds no unused capacity; growing on from
+     * there doubles the exact size. */
+    assert_true(ps_photon_map_reserve_exact(&m, 100));
+    assert_int_equal(m.cap, 100);
+    assert_int_equal(ps_photon_map_bytes(&m), 2600);
+    assert_true(ps_photon_map_reserve_exact(&m, 50)); /* never shrinks */
+    assert_int_equal(m.cap, 100);
+    assert_true(ps_photon_map_reserve(&m, 101));
+    assert_int_equal(m.cap, 200);
+    ps_photon_map_free(&m);
     assert_int_equal(m.cap, 0);
     assert_null(m.photons);
 }

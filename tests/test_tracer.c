@@ -515,6 +515,8 @@ static void traced_range_and_join(void **state)
     assert_int_equal(ps_traced_join(t, &m, &err), PS_OK);
     ps_traced_destroy(t);
     assert_true(maps_equal(&m, &whole));
+    /* Traced in one call, a map is allocated to its exact size. */
+    assert_int_equal(whole.cap, whole.count);
     assert_int_equal(m.cap, whole.cap);
     assert_int_equal(ps_photon_map_bytes(&m), whole.cap * PS_PHOTON_MAP_BYTES);
     assert_memory_equal(&m.counters, &whole.counters, sizeof m.counters);
@@ -536,7 +538,8 @@ static void traced_range_and_join(void **state)
     r = rig_make(text, "", &o, PS_ACCEL_AUTO);
     t = (ps_traced *)&o; /* set to NULL on failure */
     assert_int_equal(ps_tracer_trace_range(r.tracer, PS_MAP_GLOBAL, 0, 100, 20000, 3000, &t, &err), PS_ERR_LIMIT);
-    assert_string_equal(err.msg, "inline.scn: the global photon map is full: 3000 photons, the most the memory budget allows");
+    assert_string_equal(err.msg,
+                        "inline.scn: the global photon map is full: 3000 photons, the most the memory budget allows");
     assert_null(t);
     /* 100 paths store about 900 photons: alone they fit, after 2900 they do not. */
     assert_int_equal(ps_tracer_trace_range(r.tracer, PS_MAP_GLOBAL, 0, 100, 20000, 0, &t, &err), PS_OK);

@@ -71,10 +71,13 @@ ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP
 ps_status ps_check_outputs(const ps_shared_options *o, ps_error *err);
 
 /* What one emitted photon is planned at when checking a run against the
- * memory budget: its map entry twice (the chunks and the map while they are
- * joined) and its kd-tree node with the build's index. One stored photon per
- * emitted one: the global map may store more, which the tracer's cap
- * (ps_photon_cap) catches as it grows. */
+ * memory budget: its map entry twice and its kd-tree node with the build's
+ * index. Twice: while a traced range is joined, its chunks and the map exist
+ * at once (each photon is copied once, chunk to map; a map traced in one
+ * call is allocated to its exact size); a map that grows batch by batch (the
+ * preview's feed) holds at most twice its entries in capacity, its chunks
+ * then only one batch's. One stored photon per emitted one: the global map
+ * may store more, which the tracer's cap (ps_photon_cap) catches as it grows. */
 #define PS_PHOTON_PLAN_BYTES (2 * PS_PHOTON_MAP_BYTES + sizeof(ps_photon) + sizeof(uint32_t))
 
 /* A photon of the preview (snap, window): its map entry and its splat

@@ -41,16 +41,9 @@ static bool grow(void **p, size_t n, size_t elem)
     return true;
 }
 
-bool ps_photon_map_reserve(ps_photon_map *m, size_t need)
+/* Grows all three arrays to n entries (n > cap). */
+static bool resize(ps_photon_map *m, size_t n)
 {
-    if (need <= m->cap)
-        return true;
-    size_t n = m->cap ? m->cap : 16;
-    while (n < need) {
-        if (n > SIZE_MAX / 2)
-            return false;
-        n *= 2;
-    }
     if (n > SIZE_MAX / sizeof *m->photons)
         return false;
     /* An array grown before a later one fails keeps its larger block: every
@@ -61,6 +54,21 @@ bool ps_photon_map_reserve(ps_photon_map *m, size_t need)
     m->cap = n;
     return true;
 }
+
+bool ps_photon_map_reserve(ps_photon_map *m, size_t need)
+{
+    if (need <= m->cap)
+        return true;
+    size_t n = m->cap ? m->cap : 16;
+    while (n < need) {
+        if (n > SIZE_MAX / 2)
+            return false;
+        n *= 2;
+    }
+    return resize(m, n);
+}
+
+bool ps_photon_map_reserve_exact(ps_photon_map *m, size_t need) { return need <= m->cap || resize(m, need); }
 
 bool ps_photon_map_push(ps_photon_map *m, ps_photon p, uint16_t material, uint32_t object)
 {

@@ -49,9 +49,13 @@ typedef struct ps_photon_map {
 
 void ps_photon_map_init(ps_photon_map *m, ps_map_kind kind);
 void ps_photon_map_free(ps_photon_map *m); /* and reset to empty */
-/* Room for at least `need` entries (capacity grown geometrically). False, with
- * m unchanged in count and capacity, when out of memory. */
+/* Room for at least `need` entries (capacity grown geometrically, doubling
+ * from 16). False, with m unchanged in count and capacity, when out of memory. */
 bool ps_photon_map_reserve(ps_photon_map *m, size_t need);
+/* Room for at least `need` entries, growing to exactly `need` when it must
+ * grow: for a map filled once (the reference renderer's), which then holds no
+ * unused capacity. */
+bool ps_photon_map_reserve_exact(ps_photon_map *m, size_t need);
 /* Appends one photon with its material and object (counters untouched);
  * false, with m unchanged, when out of memory. */
 bool ps_photon_map_push(ps_photon_map *m, ps_photon p, uint16_t material, uint32_t object);

@@ -664,8 +664,14 @@ ps_status ps_traced_join(ps_traced *r, ps_photon_map *m, ps_error *err)
 {
     if (!r)
         return PS_OK;
-    /* Join the chunks in index order: the array never depends on who traced what. */
-    if (r->count > SIZE_MAX - m->count || !ps_photon_map_reserve(m, m->count + r->count))
+    /* Join the chunks in index order: the array never depends on who traced what.
+     * An empty map takes exactly what was traced: a map traced in one call
+     * (the reference renderer's) then has no unused capacity, and a map that
+     * grows batch by batch (the feed's) doubles from its first batch. */
+    if (r->count > SIZE_MAX - m->count)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory storing photons", r->path);
+    size_t need = m->count + r->count;
+    if (!(m->count == 0 ? ps_photon_map_reserve_exact(m, need) : ps_photon_map_reserve(m, need)))
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory storing photons", r->path);
     for (size_t k = 0; k < r->chunks; k++) {
         /* Cannot fail: the room is reserved. */
