@@ -1,5 +1,6 @@
 /* test_options.c: the preview's options (app/options.h) read through the
- * enums' own name tables: every name of every table sets its value in the
+ * enums' own name tables (and those tables: NULL-terminated, each name() the
+ * table's entry): every name of every table sets its value in the
  * typed field, and a name outside a table is refused with the table's names. */
 #include "test.h"
 
@@ -38,6 +39,7 @@ static const char *splat_of(int k) { return ps_splat_mode_name((ps_splat_mode)k)
 static const char *precision_of(int k) { return ps_precision_name((ps_precision)k); }
 static const char *depth_of(int k) { return ps_color_depth_name((ps_color_depth)k); }
 static const char *schedule_of(int k) { return ps_radius_schedule_name((ps_radius_schedule)k); }
+static const char *map_of(int k) { return ps_map_name((ps_map_kind)k); }
 
 static void tables(void **state)
 {
@@ -47,6 +49,7 @@ static void tables(void **state)
     check_table(ps_precision_names, PS_PRECISION_COUNT, precision_of);
     check_table(ps_color_depth_names, PS_COLOR_DEPTH_COUNT, depth_of);
     check_table(ps_radius_schedule_names, PS_RADIUS_SCHEDULE_COUNT, schedule_of);
+    check_table(ps_map_names, PS_MAP_COUNT, map_of);
     /* The contract's spellings (command lines and scripts depend on them). */
     assert_string_equal(ps_kernel_names[PS_KERNEL_CONE], "cone");
     assert_string_equal(ps_kernel_names[PS_KERNEL_EPANECHNIKOV], "epanechnikov");
@@ -55,6 +58,7 @@ static void tables(void **state)
     assert_string_equal(ps_color_depth_names[PS_COLOR_DEPTH_8], "8");
     assert_string_equal(ps_color_depth_names[PS_COLOR_DEPTH_FLOAT], "float");
     assert_string_equal(ps_radius_schedule_names[PS_RADIUS_PROGRESSIVE], "progressive");
+    assert_string_equal(ps_map_names[PS_MAP_GLOBAL], "global");
 }
 
 static void defaults(void **state)
