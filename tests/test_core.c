@@ -2,6 +2,9 @@
  * memory budget, the interrupt flag and the name map. */
 #include "test.h"
 
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <dirent.h>
@@ -284,6 +287,31 @@ static void error_messages_are_one_line(void **state)
     assert_string_equal(ps_status_name(PS_ERR_NOMEM), "out of memory");
 }
 
+/* A located error keeps its line as a field, with the same one-line text
+ * ps_error_set would make; an unlocated one, or a cleared one, has line 0. */
+static void errors_carry_their_line(void **state)
+{
+    (void)state;
+    ps_error err;
+    assert_int_equal(ps_error_at(&err, PS_ERR_RANGE, "a\nb.obj", 17, "'%s' is %d", "v", 4), PS_ERR_RANGE);
+    assert_string_equal(err.msg, "a b.obj:17: 'v' is 4");
+    assert_int_equal(err.line, 17);
+    assert_int_equal(err.status, PS_ERR_RANGE);
+    assert_int_equal(ps_error_set(&err, PS_ERR_IO, "%s: cannot open", "x.obj"), PS_ERR_IO);
+    assert_int_equal(err.line, 0);
+    ps_error_at(&err, PS_ERR_PARSE, "x", 2, "y");
+    ps_error_clear(&err);
+    assert_int_equal(err.line, 0);
+    assert_int_equal(ps_error_at(NULL, PS_ERR_PARSE, "x", 1, "y"), PS_ERR_PARSE); /* NULL err is allowed */
+    /* A file name that fills the message leaves a truncated, still one-line message. */
+    char longname[2 * PS_ERROR_MSG_MAX];
+    memset(longname, 'n', sizeof longname - 1);
+    longname[sizeof longname - 1] = '\0';
+    ps_error_at(&err, PS_ERR_PARSE, longname, 5, "problem");
+    assert_int_equal(strlen(err.msg), PS_ERROR_MSG_MAX - 1);
+    assert_int_equal(err.line, 5);
+}
+
 /* PS_MEMORY_LIMIT sets the budget; sizes parse with K/M/G; a check over it
  * is PS_ERR_LIMIT with the one-line message; products saturate. */
 static void memory_budget(void **state)
@@ -362,6 +390,43 @@ static void output_checks(void **state)
     assert_string_equal(err.msg, "/dev/full: write failed: No space left on device");
 }
 
+/* A worker thread sees a flag another thread raises (the flag is atomic:
+ * workers read it while the signal handler's thread stores to it). */
+typedef struct spinner {
+    const ps_cancel_flag *flag;
+    atomic_int started;
+    long long spins;
+    bool saw;
+} spinner;
+
+static void *spin_until_cancelled(void *arg)
+{
+    spinner *s = arg;
+    atomic_store(&s->started, 1);
+    /* Bounded, so that a flag never seen fails the test instead of hanging it. */
+    for (s->spins = 0; s->spins < 4000000000LL && !s->saw; s->spins++)
+        s->saw = ps_cancelled(s->flag) != 0;
+    return NULL;
+}
+
+static void cancel_flag_across_threads(void **state)
+{
+    (void)state;
+    assert_false(ps_cancelled(NULL));
+    ps_cancel_flag flag;
+    atomic_init(&flag, 0);
+    spinner s = {&flag, 0, 0, false};
+    pthread_t tid;
+    assert_int_equal(pthread_create(&tid, NULL, spin_until_cancelled, &s), 0);
+    while (!atomic_load(&s.started))
+        ;
+    assert_false(ps_cancelled(&flag));
+    atomic_store(&flag, SIGINT);
+    pthread_join(tid, NULL);
+    assert_true(s.saw);
+    assert_true(ps_cancelled(&flag));
+}
+
 /* The programs' SIGINT/SIGTERM flag: the signal's number, the exit status
  * 128 + it, the handler gone after the first signal; SIGXFSZ ignored. */
 static void interrupt_flag(void **state)
@@ -372,7 +437,7 @@ static void interrupt_flag(void **state)
     assert_int_equal(ps_interrupt_exit_status(), 130); /* none yet: as for SIGINT */
     raise(SIGTERM);
     assert_true(ps_cancelled(flag));
-    assert_int_equal(*flag, SIGTERM);
+    assert_int_equal(atomic_load(flag), SIGTERM);
     assert_int_equal(ps_interrupt_exit_status(), 143);
     struct sigaction sa;
     assert_int_equal(sigaction(SIGTERM, NULL, &sa), 0);
@@ -396,10 +461,10 @@ int main(void)
         cmocka_unit_test(read_file_limits),
         cmocka_unit_test(name_map),
         cmocka_unit_test(line_lengths),
-        cmocka_unit_test(error_messages_are_one_line),
+        cmocka_unit_test(error_messages_are_one_line), cmocka_unit_test(errors_carry_their_line),
         cmocka_unit_test(memory_budget),
         cmocka_unit_test(output_checks),
-        cmocka_unit_test(interrupt_flag),
+        cmocka_unit_test(cancel_flag_across_threads), cmocka_unit_test(interrupt_flag),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

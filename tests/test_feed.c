@@ -71,6 +71,10 @@ static void ends_at_the_caps(void **state)
         assert_true(n >= 2);
         assert_int_equal(marks[n - 1].stored, m[k].count);
         assert_int_equal(marks[n - 1].emitted, m[k].counters.emitted);
+        /* Grown batch by batch from the first batch's exact size: never more
+         * than twice what it holds (the memory plan's two entries a photon). */
+        assert_true(m[k].cap >= m[k].count && m[k].cap <= 2 * m[k].count);
+        assert_int_equal(ps_photon_map_bytes(&m[k]), m[k].cap * PS_PHOTON_MAP_BYTES);
     }
     assert_true(stored(f) > STORE_LIMIT); /* else the limit below would not bite */
     ps_feed_destroy(f);
@@ -111,6 +115,38 @@ static void ends_at_the_store_limit(void **state)
     rig_free(&r);
 }
 
+/* A map's share of the memory budget (the tracer's max_stored) ends the feed
+ * the same quiet way: no error, the maps as they were before the batch that
+ * would have passed it, a prefix of the uncapped maps. */
+static void ends_at_the_map_memory_cap(void **state)
+{
+    (void)state;
+    rig full_rig = feed_rig();
+    ps_feed *full = run_feed(&full_rig, 0);
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load(SCENE, NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_tracer_options o = ps_tracer_default_options();
+    o.seed = 3;
+    o.threads = 2;
+    o.max_stored = 20000; /* the caustic map stores about 15 000 a round */
+    rig r = rig_of_scene(scene, NULL, &o);
+    ps_feed *f = run_feed(&r, 0);
+    assert_int_equal(ps_feed_status(f, &err), PS_OK);
+    assert_true(ps_feed_ended(f));
+    assert_true(ps_feed_store_limited(f));
+    const ps_photon_map *m = ps_feed_maps(f), *all = ps_feed_maps(full);
+    assert_true(m[PS_MAP_CAUSTIC].count > 0 && m[PS_MAP_CAUSTIC].count <= 20000);
+    assert_true(m[PS_MAP_CAUSTIC].counters.emitted < CAUSTIC_CAP);
+    assert_memory_equal(m[PS_MAP_CAUSTIC].photons, all[PS_MAP_CAUSTIC].photons,
+                        m[PS_MAP_CAUSTIC].count * sizeof *m[PS_MAP_CAUSTIC].photons);
+    ps_feed_destroy(f);
+    ps_feed_destroy(full);
+    rig_free(&r);
+    rig_free(&full_rig);
+}
+
 /* The limit holds from the background thread too (start, then wait for the end). */
 static void background_thread_stops(void **state)
 {
@@ -148,6 +184,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(ends_at_the_caps),
         cmocka_unit_test(ends_at_the_store_limit),
+        cmocka_unit_test(ends_at_the_map_memory_cap),
         cmocka_unit_test(background_thread_stops),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -196,7 +196,7 @@ typedef struct emit_moments {
     int count;
 } emit_moments;
 
-static emit_moments emit_many(const ps_scene *s, uint32_t light, const ps_cone *cone, ps_vec3 axis_or_zero,
+static emit_moments emit_many(const ps_scene *s, uint32_t light, const ps_caustic_cone *cone, ps_vec3 axis_or_zero,
                               ps_vec3 center, int n)
 {
     ps_light_sampler *ls;
@@ -342,7 +342,8 @@ static void mesh_light(void **state)
 
 /* Inside a cone, the expected power that reaches a target equals what the
  * light's own distribution sends there: the cone changes variance, not flux. */
-static double flux_into_sphere(const ps_light_sampler *ls, uint32_t l, const ps_cone *cone, ps_vec3 c, double rad, int n)
+static double flux_into_sphere(const ps_light_sampler *ls, uint32_t l, const ps_caustic_cone *cone, ps_vec3 c,
+                               double rad, int n)
 {
     ps_rng r = ps_rng_make(6, PS_STREAM_TEST, l * 2 + (cone != NULL));
     double sum = 0;
@@ -369,27 +370,27 @@ static void cones_keep_flux(void **state)
     ps_vec3 target = ps_v3(0.3, 0.3, 0.2);
     double rad = 0.15;
     /* Point light: analytic, P * Omega / (4 pi) with Omega = 2 pi (1 - cos). */
-    ps_cone cone;
-    assert_true(ps_light_cone(ls, 0, target, rad, &cone));
+    ps_caustic_cone cone;
+    assert_true(ps_light_caustic_cone(ls, 0, target, rad, &cone));
     double d = ps_v3_len(ps_v3_sub(target, ps_v3(0, 1, 0)));
     double exact = 100.0 * (1.0 - sqrt(1.0 - rad * rad / (d * d))) / 2.0;
     assert_near(flux_into_sphere(ls, 0, &cone, target, rad, 400000), exact, exact * 0.01);
     assert_near(flux_into_sphere(ls, 0, NULL, target, rad, 400000), exact, exact * 0.03);
     /* Spot, quad, disc and sphere lights: cone against own distribution. */
     for (uint32_t l = 1; l <= 4; l++) {
-        assert_true(ps_light_cone(ls, l, target, rad, &cone));
+        assert_true(ps_light_caustic_cone(ls, l, target, rad, &cone));
         double with = flux_into_sphere(ls, l, &cone, target, rad, 400000);
         double without = flux_into_sphere(ls, l, NULL, target, rad, 1600000);
         if (fabs(with - without) > 0.03 * without)
             fail_msg("light %u: %g W into the sphere with the cone, %g W without", l, with, without);
     }
     /* Empty cones: behind the one-sided quad light, and outside the spot. */
-    assert_false(ps_light_cone(ls, 2, ps_v3(0, 3, 0), 0.2, &cone));
-    assert_true(ps_light_cone(ls, 2, ps_v3(0, 2.0, 0), 0.2, &cone)); /* straddles its plane */
-    assert_false(ps_light_cone(ls, 1, ps_v3(3, 0, 0), 0.1, &cone));
-    assert_false(ps_light_cone(ls, 1, ps_v3(0, 3, 0), 0.1, &cone));
+    assert_false(ps_light_caustic_cone(ls, 2, ps_v3(0, 3, 0), 0.2, &cone));
+    assert_true(ps_light_caustic_cone(ls, 2, ps_v3(0, 2.0, 0), 0.2, &cone)); /* straddles its plane */
+    assert_false(ps_light_caustic_cone(ls, 1, ps_v3(3, 0, 0), 0.1, &cone));
+    assert_false(ps_light_caustic_cone(ls, 1, ps_v3(0, 3, 0), 0.1, &cone));
     /* Inside the widened sphere: every direction. */
-    assert_true(ps_light_cone(ls, 0, ps_v3(0, 1.1, 0), 0.2, &cone));
+    assert_true(ps_light_caustic_cone(ls, 0, ps_v3(0, 1.1, 0), 0.2, &cone));
     assert_near(cone.cos_half, -1.0, 0);
     ps_light_sampler_destroy(ls);
     ps_scene_destroy(s);

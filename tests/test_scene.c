@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/fileio.h"
+#include "scene/obj.h"
 #include "scene/scene.h"
 
 static ps_scene *load_ok(const char *path)
@@ -107,7 +108,8 @@ static void every_light_type(void **state)
                        "light quad   corner -0.25 1.999 -0.25  edge1 0.5 0 0  edge2 0 0 0.5  power 100 100 100\n"
                        "light sphere center 0 1.8 0  radius 0.05  power 100 100 100\n"
                        "light disc   center 0 1.99 0  normal 0 -3 0  radius 0.2  power 100 100 100\n"
-                       "light point  position 0 1 0  power 0 0 0\n";
+                       "light point  position 0 1 0  power 0 0 0\n"
+                       "sphere center 0 0 0 radius 0.5\n"; /* something to light */
     assert_int_equal(load_text(text, &s, &err, &log), PS_OK);
     size_t n;
     const ps_light *l = ps_scene_lights(s, &n);
@@ -253,6 +255,90 @@ static void malformed_corpus(void **state)
     }
 }
 
+/* Lights and nothing for them to fall on: valid, but every photon escapes,
+ * so the loader says so, naming the file; any geometry at all silences it. */
+static void no_geometry_warning(void **state)
+{
+    (void)state;
+    const char *lights_only = "camera eye 0 1 3 target 0 1 0\n"
+                              "light point position 0 1.9 0 power 10 10 10\n"
+                              "light quad corner -0.25 1.999 -0.25 edge1 0.5 0 0 edge2 0 0 0.5 power 10 10 10\n";
+    const char *with_mesh = "camera eye 0 1 3 target 0 1 0\n"
+                            "light point position 0 1.9 0 power 10 10 10\n"
+                            "mesh tri.obj\n";
+    ps_scene *s;
+    ps_error err;
+    warn_log log = {0, ""};
+    assert_int_equal(load_text(lights_only, &s, &err, &log), PS_OK);
+    assert_int_equal(log.count, 1);
+    assert_string_equal(log.last, "inline.scn: scene has no geometry");
+    size_t n;
+    (void)ps_scene_objects(s, &n);
+    assert_int_equal(n, 0);
+    ps_scene_destroy(s);
+    warn_log quiet = {0, ""};
+    assert_int_equal(load_text(with_mesh, &s, &err, &quiet), PS_OK);
+    assert_int_equal(quiet.count, 0);
+    ps_scene_destroy(s);
+    /* From a file, the warning names it as given. */
+    const char *path = test_path("lights-only.scn");
+    FILE *fp = fopen(path, "wb");
+    assert_non_null(fp);
+    fputs(lights_only, fp);
+    fclose(fp);
+    warn_log from_file = {0, ""};
+    ps_scene_load_options opts = {{log_warning, &from_file}};
+    assert_int_equal(ps_scene_load(path, &opts, &s, &err), PS_OK);
+    char want[1100];
+    snprintf(want, sizeof want, "%s: scene has no geometry", path);
+    assert_int_equal(from_file.count, 1);
+    assert_string_equal(from_file.last, want);
+    ps_scene_destroy(s);
+}
+
+/* An OBJ's own problem keeps its line in the error (err.line, the OBJ's line,
+ * the one the message starts with), also where the path has a space; a mesh
+ * that cannot be read at all is the scene line's problem (its line). The
+ * scene loader decides between them from err.line, not from the text. */
+static void mesh_error_lines(void **state)
+{
+    (void)state;
+    char dir[1100], obj[1200], scn[1200], want[2600];
+    snprintf(dir, sizeof dir, "%s", test_path("with space"));
+    mkdir(dir, 0777);
+    snprintf(obj, sizeof obj, "%s/bad.obj", dir);
+    snprintf(scn, sizeof scn, "%s/bad.scn", dir);
+    FILE *fp = fopen(obj, "wb");
+    assert_non_null(fp);
+    fputs("v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n", fp);
+    fclose(fp);
+    fp = fopen(scn, "wb");
+    assert_non_null(fp);
+    fputs("camera eye 0 1 3 target 0 1 0\nlight point position 0 1.9 0 power 1 1 1\nmesh bad.obj\n", fp);
+    fclose(fp);
+    ps_scene *s;
+    ps_error err;
+    assert_int_equal(ps_scene_load(scn, NULL, &s, &err), PS_ERR_PARSE);
+    assert_int_equal(err.line, 3);
+    snprintf(want, sizeof want, "%s:3: 'v': 'x' is not a finite number (mesh at %s:3)", obj, scn);
+    assert_string_equal(err.msg, want);
+    /* The OBJ loader itself. */
+    ps_obj_mesh om;
+    assert_int_equal(ps_obj_load(obj, &om, NULL, &err), PS_ERR_PARSE);
+    assert_int_equal(err.line, 3);
+    snprintf(want, sizeof want, "%s:3: 'v': 'x' is not a finite number", obj);
+    assert_string_equal(err.msg, want);
+    /* A missing OBJ: no line of its own, the scene's line 4 instead. */
+    fp = fopen(scn, "wb");
+    assert_non_null(fp);
+    fputs("camera eye 0 1 3 target 0 1 0\nlight point position 0 1.9 0 power 1 1 1\n\nmesh gone.obj\n", fp);
+    fclose(fp);
+    assert_int_equal(ps_scene_load(scn, NULL, &s, &err), PS_ERR_IO);
+    assert_int_equal(err.line, 4);
+    snprintf(want, sizeof want, "%s:4: mesh: ", scn);
+    assert_int_equal(strncmp(err.msg, want, strlen(want)), 0);
+}
+
 static void missing_and_unreadable_files(void **state)
 {
     (void)state;
@@ -281,6 +367,8 @@ int main(void)
         cmocka_unit_test(lexical_details),
         cmocka_unit_test(malformed_corpus),
         cmocka_unit_test(missing_and_unreadable_files),
+        cmocka_unit_test(no_geometry_warning),
+        cmocka_unit_test(mesh_error_lines),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -242,6 +242,27 @@ static void choices_match_enums(void **state)
         assert_string_equal(name, words[i]);
     }
     ps_script_destroy(s);
+    /* Every name of the enums' own tables, in table order, is its value. */
+    struct {
+        const char *setting;
+        const char *const *names;
+        int count;
+    } tables[] = {{"splat", ps_splat_mode_names, PS_SPLAT_MODE_COUNT},
+                  {"kernel", ps_kernel_names, PS_KERNEL_COUNT},
+                  {"precision", ps_precision_names, PS_PRECISION_COUNT}};
+    for (size_t t = 0; t < 3; t++) {
+        char text[512] = "";
+        for (int k = 0; k < tables[t].count; k++) {
+            size_t used = strlen(text);
+            snprintf(text + used, sizeof text - used, "0 set %s %s\n", tables[t].setting, tables[t].names[k]);
+        }
+        assert_null(tables[t].names[tables[t].count]);
+        s = parse_ok(text);
+        assert_int_equal(ps_script_count(s), tables[t].count);
+        for (int k = 0; k < tables[t].count; k++)
+            assert_int_equal(ps_script_at(s, (size_t)k)->choice, k);
+        ps_script_destroy(s);
+    }
 }
 
 static void sorted_by_time_stable(void **state)
@@ -449,6 +470,12 @@ static void malformed_inputs(void **state)
         assert_int_equal(err.status, st);
         assert_null(s);
         assert_null(strchr(err.msg, '\n'));
+        /* The line the message names is the error's line too. */
+        int line = 0;
+        if (strncmp(BAD[i].msg, "s.txt:", 6) == 0 && BAD[i].msg[6] >= '1' && BAD[i].msg[6] <= '9')
+            line = atoi(BAD[i].msg + 6);
+        if (err.line != line)
+            fail_msg("case %zu '%s': err.line %d, expected %d", i, BAD[i].text, err.line, line);
         /* A NULL err is allowed and changes nothing else. */
         s = (ps_script *)&s;
         assert_int_equal(ps_script_parse(BAD[i].text, "s.txt", &s, NULL), BAD[i].status);
@@ -491,6 +518,7 @@ static void limits(void **state)
     s = (ps_script *)&s;
     assert_int_equal(ps_script_parse(text, "s.txt", &s, &err), PS_ERR_PARSE);
     assert_string_equal(err.msg, "s.txt:2: line longer than 8191 characters");
+    assert_int_equal(err.line, 2);
     assert_null(s);
 
     /* Screenshot paths of up to PS_SCRIPT_PATH_MAX characters. */
@@ -520,6 +548,7 @@ static void limits(void **state)
     s = (ps_script *)&s;
     assert_int_equal(ps_script_parse(text, "s.txt", &s, &err), PS_ERR_LIMIT);
     assert_string_equal(err.msg, "s.txt:100002: more than 100000 actions");
+    assert_int_equal(err.line, 100002);
     assert_null(s);
     free(text);
 

@@ -692,8 +692,8 @@ static void light_inside_bounding_sphere(void **state)
             ps_light_sampler *ls;
             ps_error err;
             assert_int_equal(ps_light_sampler_create(r.scene, &ls, &err), PS_OK);
-            ps_cone cone;
-            assert_true(ps_light_cone(ls, 0, ps_v3(0, 0.5, 0), sqrt(0.5), &cone));
+            ps_caustic_cone cone;
+            assert_true(ps_light_caustic_cone(ls, 0, ps_v3(0, 0.5, 0), sqrt(0.5), &cone));
             assert_true(cone.cos_half <= -1.0);
             ps_light_sampler_destroy(ls);
         }

@@ -4,6 +4,7 @@
 #include "test.h"
 #include "rig.h"
 
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -466,7 +467,8 @@ static void cancel_and_cap(void **state)
 {
     (void)state;
     ps_tracer_options o = options(2);
-    ps_cancel_flag flag = 15; /* SIGTERM */
+    ps_cancel_flag flag;
+    atomic_init(&flag, 15); /* SIGTERM */
     o.cancel = &flag;
     o.max_stored = 3000;
     char text[2048];
@@ -478,7 +480,7 @@ static void cancel_and_cap(void **state)
     assert_int_equal(ps_tracer_trace(r.tracer, PS_MAP_GLOBAL, 0, 5000, 5000, &m, &err), PS_ERR_INTERRUPTED);
     assert_string_equal(err.msg, "interrupted after 0 % of the global photons");
     assert_int_equal(m.count, 0);
-    flag = 0;
+    atomic_store(&flag, 0);
     /* A closed box of albedo 0.9 stores several photons per path: 100 paths
      * fit, 20000 would pass 3000 (about 9 a path). */
     assert_int_equal(ps_tracer_trace(r.tracer, PS_MAP_GLOBAL, 0, 100, 20000, &m, &err), PS_OK);
@@ -492,13 +494,70 @@ static void cancel_and_cap(void **state)
     rig_free(&r);
 }
 
+/* ps_tracer_trace in its two steps: the traced range holds what one call
+ * would store, joined it gives the same bytes and counters; nothing traced
+ * is NULL, and joining NULL does nothing. The store cap counts the photons
+ * the destination already holds. */
+static void traced_range_and_join(void **state)
+{
+    (void)state;
+    ps_tracer_options o = options(2);
+    rig r = rig_file(default_scene_path, &o);
+    ps_photon_map whole = rig_trace(&r, PS_MAP_GLOBAL, 5000);
+    assert_true(whole.count > 1000);
+    ps_traced *t = NULL;
+    ps_error err;
+    assert_int_equal(ps_tracer_trace_range(r.tracer, PS_MAP_GLOBAL, 0, 5000, 5000, 0, &t, &err), PS_OK);
+    assert_non_null(t);
+    assert_int_equal(ps_traced_count(t), whole.count);
+    ps_photon_map m;
+    ps_photon_map_init(&m, PS_MAP_GLOBAL);
+    assert_int_equal(ps_traced_join(t, &m, &err), PS_OK);
+    ps_traced_destroy(t);
+    assert_true(maps_equal(&m, &whole));
+    /* Traced in one call, a map is allocated to its exact size. */
+    assert_int_equal(whole.cap, whole.count);
+    assert_int_equal(m.cap, whole.cap);
+    assert_int_equal(ps_photon_map_bytes(&m), whole.cap * PS_PHOTON_MAP_BYTES);
+    assert_memory_equal(&m.counters, &whole.counters, sizeof m.counters);
+    assert_int_equal(m.counters.emitted, 5000);
+    assert_int_equal(m.counters.stored, m.count);
+    assert_int_equal(ps_tracer_trace_range(r.tracer, PS_MAP_GLOBAL, 5000, 0, 5000, m.count, &t, &err), PS_OK);
+    assert_null(t);
+    assert_int_equal(ps_traced_count(t), 0);
+    assert_int_equal(ps_traced_join(NULL, &m, &err), PS_OK);
+    assert_int_equal(m.count, whole.count);
+    ps_traced_destroy(NULL);
+    ps_photon_map_free(&m);
+    ps_photon_map_free(&whole);
+    rig_free(&r);
+
+    o.max_stored = 3000;
+    char text[2048];
+    box_scene(text, sizeof text, 0.9);
+    r = rig_make(text, "", &o, PS_ACCEL_AUTO);
+    t = (ps_traced *)&o; /* set to NULL on failure */
+    assert_int_equal(ps_tracer_trace_range(r.tracer, PS_MAP_GLOBAL, 0, 100, 20000, 3000, &t, &err), PS_ERR_LIMIT);
+    assert_string_equal(err.msg,
+                        "inline.scn: the global photon map is full: 3000 photons, the most the memory budget allows");
+    assert_null(t);
+    /* 100 paths store about 900 photons: alone they fit, after 2900 they do not. */
+    assert_int_equal(ps_tracer_trace_range(r.tracer, PS_MAP_GLOBAL, 0, 100, 20000, 0, &t, &err), PS_OK);
+    assert_true(ps_traced_count(t) > 100 && ps_traced_count(t) < 3000);
+    ps_traced_destroy(t);
+    assert_int_equal(ps_tracer_trace_range(r.tracer, PS_MAP_GLOBAL, 0, 100, 20000, 2900, &t, &err), PS_ERR_LIMIT);
+    assert_non_null(strstr(err.msg, "the global photon map would hold more than 3000 photons"));
+    assert_null(t);
+    rig_free(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(furnace_box),    cmocka_unit_test(photons_per_light), cmocka_unit_test(mirror_caustic),
         cmocka_unit_test(overlapping_cones), cmocka_unit_test(no_leaks),      cmocka_unit_test(determinism),
         cmocka_unit_test(scale_invariance), cmocka_unit_test(skips),
-        cmocka_unit_test(photon_materials), cmocka_unit_test(cancel_and_cap),
+        cmocka_unit_test(photon_materials), cmocka_unit_test(cancel_and_cap), cmocka_unit_test(traced_range_and_join),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -102,21 +102,26 @@ static const double default_budgets[] = {0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10};
  * curves (the accurate splats, 8-bit with diffusion as the thesis, the float
  * buffer, each with both radius schedules); the rest compare modes. */
 typedef struct bench_config {
-    const char *splat, *depth, *precision, *schedule;
+    ps_splat_mode splat;
+    ps_color_depth depth;
+    ps_precision precision;
+    ps_radius_schedule schedule;
 } bench_config;
 
 static const bench_config configs[] = {
-    {"triangles", "8", "diffusion", "fixed"},
-    {"triangles", "8", "diffusion", "progressive"},
-    {"triangles", "float", "diffusion", "fixed"},
-    {"triangles", "float", "diffusion", "progressive"},
-    {"triangles", "8", "none", "fixed"},
-    {"triangles", "8", "counter", "fixed"},
-    {"points", "8", "diffusion", "fixed"},
-    {"points", "float", "diffusion", "fixed"},
-    {"sprites", "8", "diffusion", "fixed"},
-    {"sprites", "float", "diffusion", "fixed"},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_PROGRESSIVE},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_PROGRESSIVE},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_NONE, PS_RADIUS_FIXED},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_COUNTER, PS_RADIUS_FIXED},
+    {PS_SPLAT_POINTS, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
+    {PS_SPLAT_POINTS, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
+    {PS_SPLAT_SPRITES, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
+    {PS_SPLAT_SPRITES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
 };
+/* The buffer as the CSV and labels say it. */
+static const char *depth_label(ps_color_depth d) { return d == PS_COLOR_DEPTH_FLOAT ? "float" : "8-bit"; }
 #define BENCH_CONFIGS (sizeof configs / sizeof configs[0])
 #define BENCH_MAIN_CONFIGS 4
 
@@ -583,10 +588,11 @@ static bool config_wanted(const bench_options *o, size_t c) { return !o->quick |
 static void config_label(size_t c, char *buf, size_t size)
 {
     const bench_config *k = &configs[c];
-    if (strcmp(k->depth, "float") == 0)
-        snprintf(buf, size, "%s float %s", k->splat, k->schedule);
+    if (k->depth == PS_COLOR_DEPTH_FLOAT)
+        snprintf(buf, size, "%s float %s", ps_splat_mode_name(k->splat), ps_radius_schedule_name(k->schedule));
     else
-        snprintf(buf, size, "%s 8-bit %s %s", k->splat, k->precision, k->schedule);
+        snprintf(buf, size, "%s 8-bit %s %s", ps_splat_mode_name(k->splat), ps_precision_name(k->precision),
+                 ps_radius_schedule_name(k->schedule));
 }
 
 static ps_status add_row(bench_state *b, const bench_row *r, ps_error *err)
@@ -682,8 +688,10 @@ static ps_status snapshots(bench_state *b, int si, char refs[BENCH_LAYERS][PATH_
     snprintf(gp, sizeof gp, "%lld", (long long)(counts[1] * BENCH_CAP_FACTOR));
     char *args[] = {snap, (char *)sc->path, "--size", size, "--exposure", exposure, "--time", time_text,
                     "--checkpoints", list, "--checkpoint-prefix", prefix, "--caustic-photons", cp,
-                    "--global-photons", gp, "--splat", (char *)k->splat, "--color-depth", (char *)k->depth,
-                    "--precision", (char *)k->precision, "--radius-schedule", (char *)k->schedule,
+                    "--global-photons", gp, "--splat", (char *)ps_splat_mode_name(k->splat),
+                    "--color-depth", (char *)ps_color_depth_name(k->depth), "--precision",
+                    (char *)ps_precision_name(k->precision), "--radius-schedule",
+                    (char *)ps_radius_schedule_name(k->schedule),
                     /* all cores unless told: snap's own default */
                     o->threads > 0 ? "--threads" : NULL, threads, NULL};
     st = run_checked(args, NULL, 0, err);
@@ -731,7 +739,8 @@ static ps_status write_csv(const bench_state *b, const char *path, ps_error *err
         const bench_config *k = &configs[r->config];
         char name[256];
         fprintf(fp, "%s,%s,%s,%s,%s,%d,%.6g,%.4f,%llu,%llu,%.6g,%.6g", stem(b->o->scenes[r->scene].path, name, sizeof name),
-                k->splat, strcmp(k->depth, "float") == 0 ? "float" : "8-bit", k->precision, k->schedule, r->checkpoint,
+                ps_splat_mode_name(k->splat), depth_label(k->depth), ps_precision_name(k->precision),
+                ps_radius_schedule_name(k->schedule), r->checkpoint,
                 r->requested, r->seconds, (unsigned long long)r->emitted[0], (unsigned long long)r->emitted[1],
                 r->radius[0], r->radius[1]);
         for (int l = 0; l < BENCH_LAYERS; l++)
@@ -989,8 +998,9 @@ static ps_status read_csv(bench_state *b, const char *path, ps_error *err)
         }
         for (size_t c = 0; c < BENCH_CONFIGS; c++) {
             const bench_config *k = &configs[c];
-            if (!strcmp(k->splat, splat) && !strcmp(strcmp(k->depth, "float") == 0 ? "float" : "8-bit", buffer) &&
-                !strcmp(k->precision, precision) && !strcmp(k->schedule, schedule))
+            if (!strcmp(ps_splat_mode_name(k->splat), splat) && !strcmp(depth_label(k->depth), buffer) &&
+                !strcmp(ps_precision_name(k->precision), precision) &&
+                !strcmp(ps_radius_schedule_name(k->schedule), schedule))
                 r.config = (int)c;
         }
         if (st == PS_OK && (r.scene < 0 || r.config < 0 || r.checkpoint < 0 || r.checkpoint >= o->budget_count))

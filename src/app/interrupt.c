@@ -6,10 +6,11 @@
 #include <string.h>
 
 /* The one piece of process state: a signal handler has nowhere else to put
- * what it saw. Written only by the handler. */
+ * what it saw. Written only by the handler (a lock-free atomic store, which a
+ * handler may make); read by the workers through ps_cancelled. */
 static ps_cancel_flag interrupted_by;
 
-static void on_signal(int sig) { interrupted_by = sig; }
+static void on_signal(int sig) { atomic_store_explicit(&interrupted_by, sig, memory_order_relaxed); }
 
 const ps_cancel_flag *ps_interrupt_install(void)
 {
@@ -27,7 +28,8 @@ const ps_cancel_flag *ps_interrupt_install(void)
 
 int ps_interrupt_exit_status(void)
 {
-    return PS_EXIT_SIGNAL_BASE + (interrupted_by ? (int)interrupted_by : SIGINT);
+    int sig = atomic_load_explicit(&interrupted_by, memory_order_relaxed);
+    return PS_EXIT_SIGNAL_BASE + (sig ? sig : SIGINT);
 }
 
 int ps_interrupt_fail(const char *prog, const ps_error *err)

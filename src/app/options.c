@@ -119,9 +119,9 @@ void ps_preview_options_init(ps_preview_options *o, bool float_depth)
     o->point_size = 1.0;
     o->splat = PS_SPLAT_TRIANGLES;
     o->kernel = PS_KERNEL_CONE;
-    o->color_depth = float_depth ? 1 : 0;
+    o->color_depth = float_depth ? PS_COLOR_DEPTH_FLOAT : PS_COLOR_DEPTH_8;
     o->precision = PS_PRECISION_DIFFUSION;
-    o->shadows = o->stencil_clip = 1;
+    o->shadows = o->stencil_clip = true;
     o->layers = PS_LAYER_ALL;
     o->radius_schedule = PS_RADIUS_FIXED;
     o->radius_alpha = PS_RADIUS_ALPHA_DEFAULT;
@@ -139,14 +139,14 @@ ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_pre
     set.threads = (int)c->threads;
     set.max_map_photons = ps_photon_cap(PS_PREVIEW_MAPS, PS_PREVIEW_PHOTON_BYTES);
     set.layers = o->layers;
-    set.splat = (ps_splat_mode)o->splat;
-    set.kernel = (ps_kernel)o->kernel;
+    set.splat = o->splat;
+    set.kernel = o->kernel;
     set.point_size = o->point_size;
-    set.float_buffer = o->color_depth != 0;
-    set.precision = (ps_precision)o->precision;
+    set.float_buffer = o->color_depth == PS_COLOR_DEPTH_FLOAT;
+    set.precision = o->precision;
     set.counter_threshold = o->counter_threshold;
-    set.stencil_clip = o->stencil_clip != 0;
-    set.radius_schedule = (ps_radius_schedule)o->radius_schedule;
+    set.stencil_clip = o->stencil_clip;
+    set.radius_schedule = o->radius_schedule;
     set.radius_alpha = o->radius_alpha;
     set.exposure = c->exposure;
     set.tau = o->tau;
@@ -175,37 +175,52 @@ ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_
     }
 }
 
+/* ps_cli_choice into a typed field: the index is read as an int and stored
+ * as the field's own type (an enum's size is the compiler's choice, so the
+ * field is never written through an int pointer). */
+#define TYPED_CHOICE(fn, type)                                                                            \
+    static ps_status fn(ps_cli *cli, const char *const *names, type *out, ps_error *err)               \
+    {                                                                                                     \
+        int k;                                                                                            \
+        ps_status st = ps_cli_choice(cli, names, &k, err);                                                \
+        if (st == PS_OK)                                                                                  \
+            *out = (type)k;                                                                               \
+        return st;                                                                                        \
+    }
+TYPED_CHOICE(choose_splat, ps_splat_mode)
+TYPED_CHOICE(choose_kernel, ps_kernel)
+TYPED_CHOICE(choose_depth, ps_color_depth)
+TYPED_CHOICE(choose_precision, ps_precision)
+TYPED_CHOICE(choose_schedule, ps_radius_schedule)
+TYPED_CHOICE(choose_bool, bool)
+#undef TYPED_CHOICE
+
 bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_status *st, ps_error *err)
 {
-    static const char *const splats[] = {"points", "triangles", "sprites", NULL};
-    static const char *const kernels[] = {"box", "cone", "gauss", "epanechnikov", NULL};
-    static const char *const depths[] = {"8", "float", NULL};
-    static const char *const precisions[] = {"none", "diffusion", "counter", NULL};
-    static const char *const on_off[] = {"off", "on", NULL};
-    static const char *const schedules[] = {"fixed", "progressive", NULL};
+    static const char *const on_off[] = {"off", "on", NULL}; /* so that on = true */
     /* Times: from a millisecond (a refresh faster than GL can draw is no use) up. */
     const double min_time = 1e-3, max_time = 1e6;
     const char *text;
     if (ps_cli_is(cli, "--tau"))
         *st = ps_cli_double(cli, min_time, max_time, &o->tau, err);
     else if (ps_cli_is(cli, "--splat"))
-        *st = ps_cli_choice(cli, splats, &o->splat, err);
+        *st = choose_splat(cli, ps_splat_mode_names, &o->splat, err);
     else if (ps_cli_is(cli, "--kernel"))
-        *st = ps_cli_choice(cli, kernels, &o->kernel, err);
+        *st = choose_kernel(cli, ps_kernel_names, &o->kernel, err);
     else if (ps_cli_is(cli, "--color-depth"))
-        *st = ps_cli_choice(cli, depths, &o->color_depth, err);
+        *st = choose_depth(cli, ps_color_depth_names, &o->color_depth, err);
     else if (ps_cli_is(cli, "--precision"))
-        *st = ps_cli_choice(cli, precisions, &o->precision, err);
+        *st = choose_precision(cli, ps_precision_names, &o->precision, err);
     else if (ps_cli_is(cli, "--counter-threshold"))
         *st = ps_cli_double(cli, 1e-9, 1.0, &o->counter_threshold, err);
     else if (ps_cli_is(cli, "--point-size"))
         *st = ps_cli_double(cli, 1.0, 64.0, &o->point_size, err);
     else if (ps_cli_is(cli, "--shadows"))
-        *st = ps_cli_choice(cli, on_off, &o->shadows, err);
+        *st = choose_bool(cli, on_off, &o->shadows, err);
     else if (ps_cli_is(cli, "--stencil-clip"))
-        *st = ps_cli_choice(cli, on_off, &o->stencil_clip, err);
+        *st = choose_bool(cli, on_off, &o->stencil_clip, err);
     else if (ps_cli_is(cli, "--radius-schedule"))
-        *st = ps_cli_choice(cli, schedules, &o->radius_schedule, err);
+        *st = choose_schedule(cli, ps_radius_schedule_names, &o->radius_schedule, err);
     else if (ps_cli_is(cli, "--radius-alpha"))
         *st = ps_cli_double(cli, 0.01, 1.0, &o->radius_alpha, err);
     else if (ps_cli_is(cli, "--layers")) {

@@ -40,13 +40,13 @@ typedef struct ps_preview_options {
     double tau;               /* seconds between refreshes (0.1) */
     double counter_threshold; /* the error counter's stopping fraction (0.1) */
     double point_size;        /* points: side in pixels (1) */
-    int splat;                /* ps_splat_mode (triangles) */
-    int kernel;               /* ps_kernel (cone) */
-    int color_depth;          /* 0: 8 bits, 1: float */
-    int precision;            /* ps_precision (diffusion) */
-    int shadows, stencil_clip; /* on/off (on) */
+    ps_splat_mode splat;      /* triangles */
+    ps_kernel kernel;         /* cone */
+    ps_color_depth color_depth; /* 8 bits (snap) or float (the window) */
+    ps_precision precision;   /* diffusion */
+    bool shadows, stencil_clip; /* on/off (on) */
     unsigned layers;          /* PS_LAYER_* bits (all) */
-    int radius_schedule;      /* ps_radius_schedule (fixed) */
+    ps_radius_schedule radius_schedule; /* fixed */
     double radius_alpha;      /* progressive schedule's alpha (2/3) */
 } ps_preview_options;
 
@@ -71,10 +71,13 @@ ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP
 ps_status ps_check_outputs(const ps_shared_options *o, ps_error *err);
 
 /* What one emitted photon is planned at when checking a run against the
- * memory budget: its map entry twice (the chunks and the map while they are
- * joined) and its kd-tree node with the build's index. One stored photon per
- * emitted one: the global map may store more, which the tracer's cap
- * (ps_photon_cap) catches as it grows. */
+ * memory budget: its map entry twice and its kd-tree node with the build's
+ * index. Twice: while a traced range is joined, its chunks and the map exist
+ * at once (each photon is copied once, chunk to map; a map traced in one
+ * call is allocated to its exact size); a map that grows batch by batch (the
+ * preview's feed) holds at most twice its entries in capacity, its chunks
+ * then only one batch's. One stored photon per emitted one: the global map
+ * may store more, which the tracer's cap (ps_photon_cap) catches as it grows. */
 #define PS_PHOTON_PLAN_BYTES (2 * PS_PHOTON_MAP_BYTES + sizeof(ps_photon) + sizeof(uint32_t))
 
 /* A photon of the preview (snap, window): its map entry and its splat

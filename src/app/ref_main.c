@@ -90,7 +90,6 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
     static const char *const on_off[] = {"off", "on", NULL};
     static const char *const components[] = {"all", "direct", "caustic", "indirect", "specular", NULL};
     static const char *const accels[] = {"auto", "octree", "brute", NULL};
-    static const char *const kernels[] = {"box", "cone", "gauss", "epanechnikov", NULL};
     ps_cli cli = ps_cli_begin("photosplat-ref", argc, argv);
     memset(o, 0, sizeof *o);
     ps_shared_options_init(&o->c);
@@ -127,7 +126,7 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
         } else if (ps_cli_is(&cli, "--component")) {
             st = ps_cli_choice(&cli, components, &o->component, err);
         } else if (ps_cli_is(&cli, "--kernel")) {
-            st = ps_cli_choice(&cli, kernels, &o->kernel, err);
+            st = ps_cli_choice(&cli, ps_kernel_names, &o->kernel, err);
         } else if (ps_cli_is(&cli, "--photons-only")) {
             o->photons_only = true;
         } else if (ps_cli_is(&cli, "--caustic-cones")) {

@@ -253,7 +253,7 @@ ps_status ps_text_lines(const char *text, const char *name, size_t max_len, ps_l
         const char *nl = at[n] ? at + n : NULL;
         (*line)++;
         if (n > max_len) {
-            st = ps_error_set(err, PS_ERR_PARSE, "%s:%d: line longer than %zu characters", name, *line, max_len);
+            st = ps_error_at(err, PS_ERR_PARSE, name, *line, "line longer than %zu characters", max_len);
             break;
         }
         memcpy(buf, at, n);

@@ -23,6 +23,24 @@ ps_status ps_error_set(ps_error *err, ps_status status, const char *fmt, ...)
         va_end(ap);
         flatten(err->msg);
         err->status = status;
+        err->line = 0;
+    }
+    return status;
+}
+
+ps_status ps_error_at(ps_error *err, ps_status status, const char *file, int line, const char *fmt, ...)
+{
+    if (err) {
+        int n = snprintf(err->msg, sizeof err->msg, "%s:%d: ", file, line);
+        if (n >= 0 && (size_t)n < sizeof err->msg) {
+            va_list ap;
+            va_start(ap, fmt);
+            vsnprintf(err->msg + n, sizeof err->msg - (size_t)n, fmt, ap);
+            va_end(ap);
+        }
+        flatten(err->msg);
+        err->status = status;
+        err->line = line;
     }
     return status;
 }
@@ -31,6 +49,7 @@ void ps_error_clear(ps_error *err)
 {
     if (err) {
         err->status = PS_OK;
+        err->line = 0;
         err->msg[0] = '\0';
     }
 }

@@ -25,14 +25,27 @@ typedef enum ps_status {
  * program can print it as the single line the contract promises. */
 typedef struct ps_error {
     ps_status status;
+    /* The line the message starts with ("file:line: problem"), set by
+     * ps_error_at; 0 when the message names no line. A caller that needs to
+     * know where a problem lies reads this, never the text. */
+    int line;
     char msg[PS_ERROR_MSG_MAX];
 } ps_error;
 
 /* Records status and a printf-style message in err (err may be NULL) and returns
- * status, so that callers can write `return ps_error_set(err, ...)`. */
+ * status, so that callers can write `return ps_error_set(err, ...)`. The
+ * message names no line of its own (line 0). */
 ps_status ps_error_set(ps_error *err, ps_status status, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* The located form: "file:line: " and the printf-style message, with line
+ * (> 0) kept in err->line. */
+ps_status ps_error_at(ps_error *err, ps_status status, const char *file, int line, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
 #endif
     ;
 

@@ -7,8 +7,8 @@
 #include "core/sampling.h"
 
 /* Directions within this of a full sphere are sampled as the light's own
- * distribution: a cone that wide gains nothing and only adds variance. */
-#define FULL_CONE_COS (-1.0 + 1e-12)
+ * distribution: a caustic cone that wide gains nothing and only adds variance. */
+#define FULL_CAUSTIC_CONE_COS (-1.0 + 1e-12)
 
 typedef struct light_data {
     ps_vec3 center;
@@ -117,7 +117,8 @@ void ps_light_bounding_sphere(const ps_light_sampler *ls, uint32_t l, ps_vec3 *c
     *radius = ls->lights[l].radius;
 }
 
-bool ps_light_cone(const ps_light_sampler *ls, uint32_t l, ps_vec3 center, double radius, ps_cone *out)
+bool ps_light_caustic_cone(const ps_light_sampler *ls, uint32_t l, ps_vec3 center, double radius,
+                           ps_caustic_cone *out)
 {
     const ps_light *L = light_at(ls, l);
     const light_data *d = &ls->lights[l];
@@ -138,7 +139,7 @@ bool ps_light_cone(const ps_light_sampler *ls, uint32_t l, ps_vec3 center, doubl
         if (out->cos_half > -1.0) {
             double between = acos(fmin(1.0, fmax(-1.0, ps_v3_dot(out->axis, L->direction))));
             if (between >= acos(L->cos_angle) + acos(out->cos_half))
-                return false; /* the two cones do not overlap */
+                return false; /* the caustic cone and the spot's cone do not overlap */
         }
         return true;
     case PS_LIGHT_QUAD:
@@ -150,12 +151,12 @@ bool ps_light_cone(const ps_light_sampler *ls, uint32_t l, ps_vec3 center, doubl
     }
 }
 
-double ps_light_cone_share(const ps_light_sampler *ls, uint32_t l, const ps_cone *cone)
+double ps_light_caustic_cone_share(const ps_light_sampler *ls, uint32_t l, const ps_caustic_cone *caustic)
 {
     const ps_light *L = light_at(ls, l);
-    if (cone->cos_half <= FULL_CONE_COS)
+    if (caustic->cos_half <= FULL_CAUSTIC_CONE_COS)
         return 1.0;
-    double omega = ps_cone_solid_angle(cone->cos_half);
+    double omega = ps_cone_solid_angle(caustic->cos_half);
     switch (L->type) {
     case PS_LIGHT_POINT:
     case PS_LIGHT_SPHERE:
@@ -221,20 +222,21 @@ void ps_light_sample_point(const ps_light_sampler *ls, uint32_t l, double u0, do
     sample_area(ls, light_at(ls, l), l, u0, u1, p, n);
 }
 
-bool ps_light_emit(const ps_light_sampler *ls, uint32_t l, const ps_cone *cone, const double u[4], ps_emission *out)
+bool ps_light_emit(const ps_light_sampler *ls, uint32_t l, const ps_caustic_cone *caustic, const double u[4],
+                   ps_emission *out)
 {
     const ps_light *L = light_at(ls, l);
-    if (cone && cone->cos_half <= FULL_CONE_COS)
-        cone = NULL; /* the whole sphere: the light's own distribution is the better sampler */
+    if (caustic && caustic->cos_half <= FULL_CAUSTIC_CONE_COS)
+        caustic = NULL; /* the whole sphere: the light's own distribution is the better sampler */
     double weight = 1.0;
     ps_vec3 origin, dir, normal = ps_v3(0.0, 0.0, 0.0);
 
     switch (L->type) {
     case PS_LIGHT_POINT:
         origin = L->position;
-        if (cone) {
-            dir = ps_sample_cone(u[2], u[3], cone->axis, cone->cos_half);
-            weight = ps_cone_solid_angle(cone->cos_half) / (4.0 * PS_PI);
+        if (caustic) {
+            dir = ps_sample_cone(u[2], u[3], caustic->axis, caustic->cos_half);
+            weight = ps_cone_solid_angle(caustic->cos_half) / (4.0 * PS_PI);
         } else {
             dir = ps_sample_sphere(u[2], u[3]);
         }
@@ -242,29 +244,30 @@ bool ps_light_emit(const ps_light_sampler *ls, uint32_t l, const ps_cone *cone, 
     case PS_LIGHT_SPOT: {
         origin = L->position;
         double spot_omega = ps_cone_solid_angle(L->cos_angle);
-        if (cone && ps_cone_solid_angle(cone->cos_half) < spot_omega) {
-            /* Sample the narrower cone, reject what the other one excludes. */
-            dir = ps_sample_cone(u[2], u[3], cone->axis, cone->cos_half);
+        if (caustic && ps_cone_solid_angle(caustic->cos_half) < spot_omega) {
+            /* Sample the narrower of the caustic cone and the spot's cone,
+             * reject what the other one excludes. */
+            dir = ps_sample_cone(u[2], u[3], caustic->axis, caustic->cos_half);
             if (ps_v3_dot(dir, L->direction) < L->cos_angle)
                 return false;
-            weight = ps_cone_solid_angle(cone->cos_half) / spot_omega;
+            weight = ps_cone_solid_angle(caustic->cos_half) / spot_omega;
         } else {
             dir = ps_sample_cone(u[2], u[3], L->direction, L->cos_angle);
-            if (cone && ps_v3_dot(dir, cone->axis) < cone->cos_half)
+            if (caustic && ps_v3_dot(dir, caustic->axis) < caustic->cos_half)
                 return false;
         }
         break;
     }
     default: {
         sample_area(ls, L, l, u[0], u[1], &origin, &normal);
-        if (cone) {
-            /* Uniform in the cone, weighted by the Lambertian cosine: power
+        if (caustic) {
+            /* Uniform in the caustic cone, weighted by the Lambertian cosine: power
              * L_e cos A omega = flux * cos * omega / pi, with L_e = flux / (pi A). */
-            dir = ps_sample_cone(u[2], u[3], cone->axis, cone->cos_half);
+            dir = ps_sample_cone(u[2], u[3], caustic->axis, caustic->cos_half);
             double c = ps_v3_dot(dir, normal);
             if (c <= 0.0)
                 return false;
-            weight = c * ps_cone_solid_angle(cone->cos_half) * PS_INV_PI;
+            weight = c * ps_cone_solid_angle(caustic->cos_half) * PS_INV_PI;
         } else {
             dir = ps_sample_cosine(u[2], u[3], normal);
         }

@@ -17,9 +17,9 @@
 #define IRR_CHUNK 256
 #define IRR_MAX_THREADS 256
 
-static const char *const kernel_names[PS_KERNEL_COUNT] = {"box", "cone", "gauss", "epanechnikov"};
+const char *const ps_kernel_names[PS_KERNEL_COUNT + 1] = {"box", "cone", "gauss", "epanechnikov", NULL};
 
-const char *ps_kernel_name(ps_kernel k) { return (unsigned)k < PS_KERNEL_COUNT ? kernel_names[k] : "?"; }
+const char *ps_kernel_name(ps_kernel k) { return (unsigned)k < PS_KERNEL_COUNT ? ps_kernel_names[k] : "?"; }
 
 double ps_kernel_profile(ps_kernel k, double s)
 {

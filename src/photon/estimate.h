@@ -25,7 +25,10 @@ typedef enum ps_kernel {
     PS_KERNEL_COUNT
 } ps_kernel;
 
-const char *ps_kernel_name(ps_kernel k); /* "box", "cone", "gauss", "epanechnikov" */
+/* The kernels' names in enum order, NULL-terminated (options, scripts, stats):
+ * "box", "cone", "gauss", "epanechnikov". */
+extern const char *const ps_kernel_names[PS_KERNEL_COUNT + 1];
+const char *ps_kernel_name(ps_kernel k); /* ps_kernel_names[k], "?" out of range */
 /* The profile g(s) (0 outside [0, 1]) and its disc mean C. */
 double ps_kernel_profile(ps_kernel k, double s);
 double ps_kernel_mean(ps_kernel k);

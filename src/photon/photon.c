@@ -17,7 +17,9 @@ static double oct_levels(int bits) { return (double)((1u << bits) - 2u); }
 #define NORMAL_MASK 0x3fffu
 #define FLAGS_SHIFT 14
 
-const char *ps_map_name(ps_map_kind k) { return k == PS_MAP_CAUSTIC ? "caustic" : "global"; }
+const char *const ps_map_names[PS_MAP_COUNT + 1] = {"caustic", "global", NULL};
+
+const char *ps_map_name(ps_map_kind k) { return (unsigned)k < PS_MAP_COUNT ? ps_map_names[k] : "?"; }
 
 static double clean(double v) { return v > 0.0 && isfinite(v) ? v : (v > 0.0 ? HUGE_VAL : 0.0); }
 

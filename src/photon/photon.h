@@ -44,7 +44,9 @@ typedef enum ps_map_kind {
     PS_MAP_COUNT
 } ps_map_kind;
 
-const char *ps_map_name(ps_map_kind k); /* "caustic", "global" */
+/* The maps' names in enum order, NULL-terminated: "caustic", "global". */
+extern const char *const ps_map_names[PS_MAP_COUNT + 1];
+const char *ps_map_name(ps_map_kind k); /* ps_map_names[k], "?" out of range */
 
 /* power: non-negative watts (negative or NaN channels are stored as 0);
  * dir and normal: unit vectors; dither in [0, 1) (0.5: plain rounding). */

@@ -16,17 +16,17 @@
 #include "photon/emit.h"
 #include "scene/bsdf.h"
 
-/* Emission uses Halton dimensions 1..4 (dimension 0 picks the light/cone). */
+/* Emission uses Halton dimensions 1..4 (dimension 0 picks the light and caustic cone). */
 #define EMIT_DIMS 4
 
-/* One way photons leave: a light, and for caustic photons the cone around one
- * specular object. Photon indices are shared between strata in proportion to
- * `share` (the flux each is expected to carry). */
+/* One way photons leave: a light, and for caustic photons the caustic cone
+ * around one specular object. Photon indices are shared between strata in
+ * proportion to `share` (the flux each is expected to carry). */
 typedef struct stratum {
     uint32_t light;
-    int64_t target; /* caustic: the object the cone is aimed at; -1: none */
-    bool has_cone;
-    ps_cone cone;
+    int64_t target; /* caustic: the object the caustic cone is aimed at; -1: none */
+    bool has_caustic_cone;
+    ps_caustic_cone caustic_cone;
     double share;
     double cdf; /* cumulative share, normalised; the last is 1 */
 } stratum;
@@ -64,62 +64,6 @@ ps_tracer_options ps_tracer_default_options(void)
     return o;
 }
 
-void ps_photon_map_init(ps_photon_map *m, ps_map_kind kind)
-{
-    memset(m, 0, sizeof *m);
-    m->kind = kind;
-}
-
-void ps_photon_map_free(ps_photon_map *m)
-{
-    ps_map_kind kind = m->kind;
-    free(m->photons);
-    free(m->materials);
-    free(m->objects);
-    ps_photon_map_init(m, kind);
-}
-
-static void add_counters(ps_trace_counters *a, const ps_trace_counters *b)
-{
-    a->emitted += b->emitted;
-    a->stored += b->stored;
-    a->rays += b->rays;
-    a->escaped += b->escaped;
-    a->absorbed += b->absorbed;
-    a->discarded += b->discarded;
-    a->truncated += b->truncated;
-    a->empty += b->empty;
-}
-
-/* Room for `need` photons in every array of m. */
-static bool reserve_map(ps_photon_map *m, size_t need)
-{
-    return PS_RESERVE(m->photons, m->cap, need) && PS_RESERVE(m->materials, m->mcap, need) &&
-           PS_RESERVE(m->objects, m->ocap, need);
-}
-
-bool ps_photon_map_append(ps_photon_map *dst, const ps_photon_map *src)
-{
-    if (!reserve_map(dst, dst->count + src->count))
-        return false;
-    if (src->count) {
-        memcpy(dst->photons + dst->count, src->photons, src->count * sizeof *dst->photons);
-        memcpy(dst->materials + dst->count, src->materials, src->count * sizeof *dst->materials);
-        memcpy(dst->objects + dst->count, src->objects, src->count * sizeof *dst->objects);
-    }
-    dst->count += src->count;
-    add_counters(&dst->counters, &src->counters);
-    return true;
-}
-
-ps_rgb ps_photon_map_power(const ps_photon_map *m)
-{
-    ps_rgb sum = ps_rgb_gray(0.0);
-    for (size_t i = 0; i < m->count; i++)
-        sum = ps_rgb_add(sum, ps_photon_power(&m->photons[i]));
-    return sum;
-}
-
 /* ---- the plan: strata and skips ------------------------------------------ */
 
 static ps_status add_skip(ps_tracer *t, const char *pass, const char *fmt, ...)
@@ -138,7 +82,8 @@ static ps_status add_skip(ps_tracer *t, const char *pass, const char *fmt, ...)
     return PS_OK;
 }
 
-static bool add_stratum(map_plan *p, uint32_t light, int64_t target, const ps_cone *cone, double share)
+static bool add_stratum(map_plan *p, uint32_t light, int64_t target, const ps_caustic_cone *caustic_cone,
+                        double share)
 {
     if (!PS_RESERVE(p->strata, p->cap, p->count + 1))
         return false;
@@ -146,9 +91,9 @@ static bool add_stratum(map_plan *p, uint32_t light, int64_t target, const ps_co
     memset(s, 0, sizeof *s);
     s->light = light;
     s->target = target;
-    s->has_cone = cone != NULL;
-    if (cone)
-        s->cone = *cone;
+    s->has_caustic_cone = caustic_cone != NULL;
+    if (caustic_cone)
+        s->caustic_cone = *caustic_cone;
     s->share = share;
     return true;
 }
@@ -171,7 +116,7 @@ static void finish_plan(map_plan *p)
     p->strata[p->count - 1].cdf = 1.0;
 }
 
-/* The sphere around object o that its cone is built on: exact for spheres,
+/* The sphere around object o that its caustic cones are built on: exact for spheres,
  * around the box centre through the farthest vertex for meshes. */
 static void object_sphere(const ps_scene *s, const ps_object *o, ps_vec3 *c, double *r)
 {
@@ -266,22 +211,22 @@ static ps_status plan_maps(ps_tracer *t, ps_error *err)
                 return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
             continue;
         }
-        size_t cones = 0;
+        size_t caustic_cones = 0;
         for (size_t o = 0; o < no; o++) {
             if (!objs[o].specular)
                 continue;
             ps_vec3 c;
             double r;
-            ps_cone cone;
+            ps_caustic_cone caustic_cone;
             object_sphere(s, &objs[o], &c, &r);
-            if (!ps_light_cone(t->lights, l, c, r, &cone))
+            if (!ps_light_caustic_cone(t->lights, l, c, r, &caustic_cone))
                 continue;
-            double share = flux * ps_light_cone_share(t->lights, l, &cone);
-            if (!add_stratum(caustic, l, (int64_t)o, &cone, share))
+            double share = flux * ps_light_caustic_cone_share(t->lights, l, &caustic_cone);
+            if (!add_stratum(caustic, l, (int64_t)o, &caustic_cone, share))
                 return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
-            cones++;
+            caustic_cones++;
         }
-        if (cones == 0)
+        if (caustic_cones == 0)
             SKIP("caustic", "%s light %u (line %d): no specular object inside its emission", ps_light_type_name(lights[l].type),
                  l, lights[l].line);
     }
@@ -434,34 +379,28 @@ uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light,
 
 /* ---- one photon's path --------------------------------------------------- */
 
+/* What one chunk of photon indices stored, with its counters, before it is
+ * joined to the map: a photon map of its own. */
 typedef struct chunk_out {
-    ps_photon *photons;
-    uint16_t *materials; /* parallel to photons */
-    uint32_t *objects;   /* parallel to photons */
-    size_t count, cap, mcap, ocap;
-    ps_trace_counters c;
+    ps_photon_map map;
     bool failed;
 } chunk_out;
 
 static void store(chunk_out *out, const ps_surface *sp, ps_rgb power, ps_vec3 d, ps_vec3 n, double dither)
 {
-    if (!PS_RESERVE(out->photons, out->cap, out->count + 1) ||
-        !PS_RESERVE(out->materials, out->mcap, out->count + 1) ||
-        !PS_RESERVE(out->objects, out->ocap, out->count + 1)) {
+    if (!ps_photon_map_push(&out->map, ps_photon_pack(sp->p, power, d, n, dither), (uint16_t)sp->material,
+                            sp->object)) {
         out->failed = true;
         return;
     }
-    out->materials[out->count] = (uint16_t)sp->material;
-    out->objects[out->count] = sp->object;
-    out->photons[out->count++] = ps_photon_pack(sp->p, power, d, n, dither);
-    out->c.stored++;
+    out->map.counters.stored++;
 }
 
 static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk_out *out)
 {
     const map_plan *plan = &t->plans[kind];
     const ps_world *w = t->world;
-    ps_trace_counters *c = &out->c;
+    ps_trace_counters *c = &out->map.counters;
     c->emitted++;
 
     /* Emission: the stratum and the four emission numbers are Halton
@@ -472,7 +411,8 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
     for (unsigned d = 0; d < EMIT_DIMS; d++)
         u[d] = shift(ps_halton(d + 1, i), plan->rotation[d + 1]);
     ps_emission e;
-    if (!ps_light_emit(t->lights, st->light, st->has_cone ? &st->cone : NULL, u, &e) || plan->scale[k] == 0.0) {
+    if (!ps_light_emit(t->lights, st->light, st->has_caustic_cone ? &st->caustic_cone : NULL, u, &e) ||
+        plan->scale[k] == 0.0) {
         c->empty++;
         return;
     }
@@ -499,9 +439,9 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
         bool specular = ps_material_is_specular(m);
         if (kind == PS_MAP_CAUSTIC && bounce == 0) {
             /* The first-hit test (thesis 4.1.1): a photon aimed at one object
-             * that first meets another is not that cone's to carry; the other
-             * object's own cone carries it. Without it overlapping cones count
-             * the same caustic twice. And a first diffuse hit is no caustic. */
+             * that first meets another is not that caustic cone's to carry; the
+             * other object's own caustic cone carries it. Without it overlapping
+             * caustic cones count the same caustic twice. And a first diffuse hit is no caustic. */
             bool other = st->target >= 0 && t->opt.first_hit_test && sp.object != (uint32_t)st->target;
             if (other || !specular) {
                 c->discarded++;
@@ -615,16 +555,38 @@ static void *worker(void *arg)
             hi = job->first + job->count;
         for (uint64_t i = lo; i < hi && !job->outs[k].failed; i++)
             trace_photon(job->t, job->kind, i, &job->outs[k]);
-        uint64_t stored = atomic_fetch_add(&job->stored, job->outs[k].count) + job->outs[k].count;
+        size_t n = job->outs[k].map.count;
+        uint64_t stored = atomic_fetch_add(&job->stored, n) + n;
         if (job->room && stored > job->room)
             atomic_store(&job->over, true);
         atomic_fetch_add(&job->done, 1);
     }
 }
 
-ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
-                          ps_photon_map *m, ps_error *err)
+struct ps_traced {
+    const char *path; /* the scene's, for messages */
+    ps_map_kind kind;
+    size_t chunks;
+    chunk_out *outs; /* in index order */
+    size_t count;    /* photons of all chunks */
+};
+
+void ps_traced_destroy(ps_traced *r)
 {
+    if (!r)
+        return;
+    for (size_t k = 0; k < r->chunks; k++)
+        ps_photon_map_free(&r->outs[k].map);
+    free(r->outs);
+    free(r);
+}
+
+size_t ps_traced_count(const ps_traced *r) { return r ? r->count : 0; }
+
+ps_status ps_tracer_trace_range(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
+                                size_t stored, ps_traced **out, ps_error *err)
+{
+    *out = NULL;
     const char *path = ps_scene_path(t->scene);
     if (first > total || count > total - first)
         return ps_error_set(err, PS_ERR_RANGE, "%s: photons %llu..%llu lie beyond the map's total %llu", path,
@@ -646,14 +608,24 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
     atomic_init(&job.stored, 0);
     atomic_init(&job.over, false);
     uint64_t max_stored = t->opt.max_stored;
-    if (max_stored && m->count >= max_stored)
+    if (max_stored && stored >= max_stored)
         return ps_error_set(err, PS_ERR_LIMIT,
                             "%s: the %s photon map is full: %llu photons, the most the memory budget allows", path,
-                            ps_map_name(kind), (unsigned long long)m->count);
-    job.room = max_stored ? max_stored - m->count : 0;
-    job.outs = calloc(job.chunks, sizeof *job.outs);
-    if (!job.outs)
-        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory tracing %llu photons", path, (unsigned long long)count);
+                            ps_map_name(kind), (unsigned long long)stored);
+    job.room = max_stored ? max_stored - stored : 0;
+    ps_traced *r = calloc(1, sizeof *r);
+    job.outs = r ? calloc(job.chunks, sizeof *job.outs) : NULL;
+    if (!job.outs) {
+        free(r);
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory tracing %llu photons", path,
+                            (unsigned long long)count);
+    }
+    r->path = path;
+    r->kind = kind;
+    r->chunks = job.chunks;
+    r->outs = job.outs;
+    for (size_t k = 0; k < job.chunks; k++)
+        ps_photon_map_init(&job.outs[k].map, kind);
 
     int threads = t->threads < (int)job.chunks ? t->threads : (int)job.chunks;
     pthread_t tid[PS_TRACER_MAX_THREADS];
@@ -665,9 +637,8 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
     for (int k = 0; k < started; k++)
         pthread_join(tid[k], NULL);
 
-    /* Join the chunks in index order: the array never depends on who traced what. */
     ps_status st = PS_OK;
-    size_t need = m->count, done = atomic_load(&job.done);
+    size_t done = atomic_load(&job.done);
     if (atomic_load(&job.over))
         st = ps_error_set(err, PS_ERR_LIMIT,
                           "%s: the %s photon map would hold more than %llu photons, the most the memory budget allows",
@@ -676,40 +647,49 @@ ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64
         st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.0f %% of the %s photons",
                           100.0 * ((double)first + (double)done * PS_PHOTON_CHUNK) / (double)total, ps_map_name(kind));
     for (size_t k = 0; k < job.chunks && st == PS_OK; k++) {
-        if (job.outs[k].failed)
-            st = PS_ERR_NOMEM;
-        need += job.outs[k].count;
+        if (job.outs[k].failed || job.outs[k].map.count > SIZE_MAX - r->count)
+            st = ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory storing photons", path);
+        else
+            r->count += job.outs[k].map.count;
     }
-    if (st == PS_OK && !reserve_map(m, need))
-        st = PS_ERR_NOMEM;
-    for (size_t k = 0; k < job.chunks; k++) {
-        if (st == PS_OK && job.outs[k].count) {
-            memcpy(m->photons + m->count, job.outs[k].photons, job.outs[k].count * sizeof *m->photons);
-            memcpy(m->materials + m->count, job.outs[k].materials, job.outs[k].count * sizeof *m->materials);
-            memcpy(m->objects + m->count, job.outs[k].objects, job.outs[k].count * sizeof *m->objects);
-            m->count += job.outs[k].count;
-        }
-        if (st == PS_OK)
-            add_counters(&m->counters, &job.outs[k].c);
-        free(job.outs[k].photons);
-        free(job.outs[k].materials);
-        free(job.outs[k].objects);
+    if (st != PS_OK) {
+        ps_traced_destroy(r);
+        return st;
     }
-    free(job.outs);
-    if (st == PS_ERR_NOMEM)
-        return ps_error_set(err, st, "%s: out of memory storing photons", path);
+    *out = r;
+    return PS_OK;
+}
+
+ps_status ps_traced_join(ps_traced *r, ps_photon_map *m, ps_error *err)
+{
+    if (!r)
+        return PS_OK;
+    /* Join the chunks in index order: the array never depends on who traced what.
+     * An empty map takes exactly what was traced: a map traced in one call
+     * (the reference renderer's) then has no unused capacity, and a map that
+     * grows batch by batch (the feed's) doubles from its first batch. */
+    if (r->count > SIZE_MAX - m->count)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory storing photons", r->path);
+    size_t need = m->count + r->count;
+    if (!(m->count == 0 ? ps_photon_map_reserve_exact(m, need) : ps_photon_map_reserve(m, need)))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory storing photons", r->path);
+    for (size_t k = 0; k < r->chunks; k++) {
+        /* Cannot fail: the room is reserved. */
+        (void)ps_photon_map_append(m, &r->outs[k].map);
+        ps_photon_map_free(&r->outs[k].map); /* each chunk goes as soon as it is in */
+    }
+    return PS_OK;
+}
+
+ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
+                          ps_photon_map *m, ps_error *err)
+{
+    ps_traced *r;
+    ps_status st = ps_tracer_trace_range(t, kind, first, count, total, m->count, &r, err);
+    if (st == PS_OK)
+        st = ps_traced_join(r, m, err);
+    ps_traced_destroy(r);
     return st;
 }
 
-void ps_photon_map_write_text(FILE *f, const ps_photon_map *m)
-{
-    const char *name = ps_map_name(m->kind);
-    for (size_t i = 0; i < m->count; i++) {
-        const ps_photon *p = &m->photons[i];
-        ps_rgb c = ps_photon_power(p);
-        ps_vec3 d = ps_photon_dir(p), n = ps_photon_normal(p);
-        /* %.9g round-trips the single-precision position exactly. */
-        fprintf(f, "%s %.9g %.9g %.9g %.9g %.9g %.9g %.6f %.6f %.6f %.6f %.6f %.6f\n", name, p->pos[0], p->pos[1],
-                p->pos[2], c.r, c.g, c.b, d.x, d.y, d.z, n.x, n.y, n.z);
-    }
-}
+

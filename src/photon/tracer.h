@@ -2,7 +2,7 @@
  * lights, follows them through the scene and fills the caustic and global maps.
  *
  * Photon i of a map is a pure function of (scene, seed, map, i) (thesis 4.1.3):
- * which light (and cone) emits it, where and in which direction come from the
+ * which light (and caustic cone) emits it, where and in which direction come from the
  * Halton sequence at index i, Cranley-Patterson rotated by the seed; every
  * later choice comes from a PCG stream made from (seed, map, i). Tracing runs
  * on worker threads in fixed chunks whose results are joined in index order,
@@ -23,6 +23,7 @@
 #include "core/cancel.h"
 #include "core/status.h"
 #include "photon/photon.h"
+#include "photon/photon_map.h"
 #include "photon/world.h"
 
 /* Paths longer than this many bounces end (their photons are counted as
@@ -38,7 +39,7 @@ typedef struct ps_tracer_options {
     uint64_t seed;
     int threads;         /* 0: one per online core */
     bool caustic_cones;  /* aim caustic photons only at specular objects (default true) */
-    bool first_hit_test; /* discard a cone's photon whose first hit is another object
+    bool first_hit_test; /* discard a caustic cone's photon whose first hit is another object
                           * (default true; off only to show the double counting it prevents) */
     bool global_direct;  /* the global map also keeps each path's first diffuse hit, as
                           * Jensen's global map does (default false: the preview draws
@@ -51,15 +52,11 @@ typedef struct ps_tracer_options {
                                    * it was) before the map grows past it */
 } ps_tracer_options;
 
-/* Bytes a stored photon takes in a map: the 20-byte record and the material
- * and object beside it. While a trace's chunks are joined they exist twice. */
-#define PS_PHOTON_MAP_BYTES (sizeof(ps_photon) + sizeof(uint16_t) + sizeof(uint32_t))
-
 /* Online cores, at least 1 and at most PS_TRACER_MAX_THREADS: the default
  * thread count. */
 int ps_online_cores(void);
 
-/* seed 0, all cores, cones and the first-hit test on. */
+/* seed 0, all cores, caustic cones and the first-hit test on. */
 ps_tracer_options ps_tracer_default_options(void);
 
 /* A stage the scene did not need, and why (contract: --stats "skipped"). */
@@ -68,40 +65,6 @@ typedef struct ps_skip {
     char pass[16];
     char reason[PS_SKIP_REASON_MAX];
 } ps_skip;
-
-/* What a trace did; counters add up over calls. */
-typedef struct ps_trace_counters {
-    uint64_t emitted;          /* photon indices traced (including those that carried nothing) */
-    uint64_t stored;           /* photons written to the map */
-    uint64_t rays;             /* rays cast against the scene */
-    uint64_t escaped;          /* paths that left the scene */
-    uint64_t absorbed;         /* paths ended by Russian roulette */
-    uint64_t discarded;        /* caustic photons that were not caustic paths (first-hit test,
-                                * or a diffuse first hit) */
-    uint64_t truncated;        /* paths cut at PS_PHOTON_MAX_BOUNCES */
-    uint64_t empty;            /* emitted samples that carried no power (outside a spot or behind a light) */
-} ps_trace_counters;
-
-/* The photons of one map, in index order, and beside each the material and
- * object of the surface it landed on (the splats need the BRDF there and clip
- * to the object's pixels; the 20-byte record has no room, and the kd-tree
- * does not need them: a query knows its own surface). */
-typedef struct ps_photon_map {
-    ps_map_kind kind;
-    ps_photon *photons;
-    uint16_t *materials;
-    uint32_t *objects;
-    size_t count, cap, mcap, ocap;
-    ps_trace_counters counters;
-} ps_photon_map;
-
-void ps_photon_map_init(ps_photon_map *m, ps_map_kind kind);
-void ps_photon_map_free(ps_photon_map *m); /* and reset to empty */
-/* Appends src's photons (with their materials and objects) and counters to
- * dst; false, with dst unchanged, when out of memory. */
-bool ps_photon_map_append(ps_photon_map *dst, const ps_photon_map *src);
-/* Total power of all photons in the map. */
-ps_rgb ps_photon_map_power(const ps_photon_map *m);
 
 typedef struct ps_tracer ps_tracer;
 
@@ -123,19 +86,36 @@ int ps_tracer_threads(const ps_tracer *t);
 /* Traces photons [first, first + count) of map `kind` and appends those stored
  * to m in index order. `total` is the number of photons the whole map will
  * have emitted (first + count <= total): photon powers are normalised so that
- * the total photons of each light and cone carry exactly its flux. Tracing the
+ * the total photons of each light and caustic cone carry exactly its flux. Tracing the
  * same range in one call or in several gives the same bytes. A disabled map
  * traces nothing. */
 ps_status ps_tracer_trace(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
                           ps_photon_map *m, ps_error *err);
 
-/* How many of photons [0, total) light l emits for map kind (all its cones
+/* ps_tracer_trace in two steps, for a caller whose map is read by another
+ * thread (the preview's feed): trace outside its lock, join under it. Each
+ * photon is copied once, from the chunk that traced it into the map; while
+ * they are joined, the chunks and the map exist at once (PS_PHOTON_PLAN_BYTES
+ * counts each entry twice for this).
+ *
+ * ps_tracer_trace_range traces the range as ps_tracer_trace does into a map
+ * that already holds `stored` photons (the max_stored check counts them), and
+ * on PS_OK gives the result in *out (NULL when nothing was traced: a disabled
+ * map or count 0). On an error nothing is kept. */
+typedef struct ps_traced ps_traced;
+ps_status ps_tracer_trace_range(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
+                                size_t stored, ps_traced **out, ps_error *err);
+/* Photons the traced range stored. */
+size_t ps_traced_count(const ps_traced *r);
+/* Appends the traced photons, in index order, and their counters to m (PS_OK
+ * with nothing to do when r is NULL); PS_ERR_NOMEM, with m unchanged, when m
+ * cannot grow. */
+ps_status ps_traced_join(ps_traced *r, ps_photon_map *m, ps_error *err);
+/* Frees the chunks; accepts NULL. */
+void ps_traced_destroy(ps_traced *r);
+
+/* How many of photons [0, total) light l emits for map kind (all its caustic cones
  * together): the tracer shares photons between lights in proportion to flux. */
 uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light, uint64_t total);
-
-/* Writes every photon of m as one text line (contract, --dump-photons):
- * `map x y z r g b dx dy dz nx ny nz`, power in watts, d the direction of
- * travel (into the surface), n the surface normal on the side it arrived from. */
-void ps_photon_map_write_text(FILE *f, const ps_photon_map *m);
 
 #endif

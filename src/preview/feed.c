@@ -50,23 +50,36 @@ ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const 
 }
 
 /* Traces photons [first, first + count) of map k outside the lock, then
- * appends them under it. */
+ * joins them to the map under it: each photon is copied once, from the
+ * tracer's chunk into the map the drawing thread reads. */
 static ps_status batch(ps_feed *f, int k, uint64_t first, uint64_t count, ps_error *err)
 {
-    ps_photon_map local;
-    ps_photon_map_init(&local, (ps_map_kind)k);
-    ps_status st = ps_tracer_trace(f->tracer, (ps_map_kind)k, first, count, f->cap[k], &local, err);
+    ps_traced *traced;
+    /* Only this thread adds to the maps, so the count can be read without the lock. */
+    ps_status st = ps_tracer_trace_range(f->tracer, (ps_map_kind)k, first, count, f->cap[k], f->maps[k].count,
+                                         &traced, err);
+    if (st == PS_ERR_LIMIT) {
+        /* The map's share of the memory budget (the tracer's max_stored):
+         * end here as at the store limit, the maps as they were before this
+         * batch, still a correct picture of the photons emitted so far. */
+        pthread_mutex_lock(&f->lock);
+        f->store_limited = true;
+        pthread_mutex_unlock(&f->lock);
+        return PS_OK;
+    }
+    if (st != PS_OK)
+        return st;
     pthread_mutex_lock(&f->lock);
-    if (st == PS_OK && (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1) ||
-                        !ps_photon_map_append(&f->maps[k], &local)))
+    if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1) ||
+        ps_traced_join(traced, &f->maps[k], err) != PS_OK)
         st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for %llu more photons",
-                          (unsigned long long)local.count);
+                          (unsigned long long)ps_traced_count(traced));
     if (st == PS_OK) {
         ps_feed_mark m = {f->maps[k].count, f->maps[k].counters.emitted};
         f->marks[k][f->mark_count[k]++] = m;
     }
     pthread_mutex_unlock(&f->lock);
-    ps_photon_map_free(&local);
+    ps_traced_destroy(traced);
     return st;
 }
 
@@ -99,7 +112,8 @@ static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
         more = more || f->next[k] < f->cap[k];
     }
     f->round++;
-    return more && *st == PS_OK;
+    /* Only this thread sets it, so it can be read without the lock. */
+    return more && *st == PS_OK && !f->store_limited;
 }
 
 static void *feed_main(void *arg)

@@ -61,7 +61,8 @@ void ps_feed_unlock(ps_feed *f);
  * (every cap reached, stopped, or failed). */
 const ps_photon_map *ps_feed_maps(const ps_feed *f);
 bool ps_feed_ended(const ps_feed *f);
-/* Under the lock: whether it ended at the store limit, not at the caps. */
+/* Under the lock: whether it ended at the store limit (or at a map's share
+ * of the memory budget, the tracer's max_stored), not at the caps. */
 bool ps_feed_store_limited(const ps_feed *f);
 
 /* Under the lock: where each handed-over batch of map k ended, as (stored

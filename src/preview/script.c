@@ -9,6 +9,8 @@
 
 #include "core/fileio.h"
 #include "core/number.h"
+#include "photon/estimate.h"
+#include "preview/splat.h"
 
 /* The longest action, "T move light I X Y Z", has 7 words; a line may hold
  * more (they are counted, so that "expected N numbers" can be said), but only
@@ -43,15 +45,13 @@ typedef struct choice_list {
     const char *said; /* the list as a message says it */
 } choice_list;
 
-static const char *const SPLAT_NAMES[] = {"points", "triangles", "sprites"};
-static const char *const KERNEL_NAMES[] = {"box", "cone", "gauss", "epanechnikov"};
-static const char *const PRECISION_NAMES[] = {"none", "diffusion", "counter"};
+/* The enums' own name tables, so that a choice is the enum's value. */
 static const char *const PAUSE_NAMES[] = {"off", "on"}; /* so that on = 1 */
 static const char *const LAYER_NAMES[] = {"direct", "caustic", "global"}; /* bit k is LAYER_NAMES[k] */
 
-static const choice_list SPLAT_CHOICES = {SPLAT_NAMES, 3, "points, triangles or sprites"};
-static const choice_list KERNEL_CHOICES = {KERNEL_NAMES, 4, "box, cone, gauss or epanechnikov"};
-static const choice_list PRECISION_CHOICES = {PRECISION_NAMES, 3, "none, diffusion or counter"};
+static const choice_list SPLAT_CHOICES = {ps_splat_mode_names, PS_SPLAT_MODE_COUNT, "points, triangles or sprites"};
+static const choice_list KERNEL_CHOICES = {ps_kernel_names, PS_KERNEL_COUNT, "box, cone, gauss or epanechnikov"};
+static const choice_list PRECISION_CHOICES = {ps_precision_names, PS_PRECISION_COUNT, "none, diffusion or counter"};
 static const choice_list PAUSE_CHOICES = {PAUSE_NAMES, 2, "on or off"};
 
 /* ---- words ------------------------------------------------------------------- */
@@ -85,14 +85,14 @@ static void split_words(parser *p, char *s)
 static ps_status read_number(parser *p, const char *what, const char *w, double *out)
 {
     if (!ps_parse_double(w, out))
-        return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: '%s' is not a finite number", p->name, p->line, what, w);
+        return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: '%s' is not a finite number", what, w);
     return PS_OK;
 }
 
 static ps_status read_positive(parser *p, const char *what, const char *w, double *out)
 {
     if (!ps_parse_double(w, out) || !(*out > 0.0))
-        return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: '%s' must be a number > 0", p->name, p->line, what, w);
+        return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: '%s' must be a number > 0", what, w);
     return PS_OK;
 }
 
@@ -100,8 +100,8 @@ static ps_status read_index(parser *p, const char *what, const char *w, uint32_t
 {
     int64_t v;
     if (!ps_parse_int64(w, &v) || v < 0 || v > (int64_t)UINT32_MAX)
-        return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: index '%s' must be an integer in [0, %lu]", p->name,
-                            p->line, what, w, (unsigned long)UINT32_MAX);
+        return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: index '%s' must be an integer in [0, %lu]",
+                           what, w, (unsigned long)UINT32_MAX);
     *out = (uint32_t)v;
     return PS_OK;
 }
@@ -113,12 +113,12 @@ static ps_status read_choice(parser *p, const char *what, const choice_list *lis
             *out = k;
             return PS_OK;
         }
-    return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: '%s' is not %s", p->name, p->line, what, w, list->said);
+    return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: '%s' is not %s", what, w, list->said);
 }
 
 static ps_status wrong_count(parser *p, const char *what, const char *expected)
 {
-    return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: expected %s", p->name, p->line, what, expected);
+    return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: expected %s", what, expected);
 }
 
 /* ---- actions ----------------------------------------------------------------- */
@@ -129,7 +129,7 @@ static const char *subject(parser *p, const char *action, bool objects_too, ps_s
 {
     const char *expected = objects_too ? "'light' or 'object'" : "'light'";
     if (p->nword < 3) {
-        ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: expected %s", p->name, p->line, action, expected);
+        ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: expected %s", action, expected);
         return NULL;
     }
     const char *w = p->word[2];
@@ -139,7 +139,7 @@ static const char *subject(parser *p, const char *action, bool objects_too, ps_s
         *kind = PS_SCRIPT_MOVE_OBJECT;
         return "object";
     }
-    ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: expected %s, got '%s'", p->name, p->line, action, expected, w);
+    ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: expected %s, got '%s'", action, expected, w);
     return NULL;
 }
 
@@ -160,16 +160,16 @@ static ps_status parse_indexed(parser *p, ps_script_action *a, const char *actio
         return st;
     if (a->kind == PS_SCRIPT_ANGLE) {
         if (!ps_parse_double(arg[1], &a->number) || !(a->number > 0.0 && a->number <= 90.0))
-            return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: '%s' must be a number in (0, 90]", p->name,
-                                p->line, what, arg[1]);
+            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: '%s' must be a number in (0, 90]", what,
+                               arg[1]);
         return PS_OK;
     }
     double v[3];
     for (int k = 0; k < 3; k++) {
         if (a->kind == PS_SCRIPT_POWER) {
             if (!ps_parse_double(arg[1 + k], &v[k]) || !(v[k] >= 0.0))
-                return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: '%s' must be a number >= 0", p->name, p->line,
-                                    what, arg[1 + k]);
+                return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: '%s' must be a number >= 0", what,
+                                   arg[1 + k]);
         } else if ((st = read_number(p, what, arg[1 + k], &v[k])) != PS_OK) {
             return st;
         }
@@ -190,15 +190,15 @@ static ps_status parse_layers(parser *p, ps_script_action *a, char *list)
         if (comma)
             *comma = '\0';
         if (!*item)
-            return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: empty name in the list", p->name, p->line, what);
+            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: empty name in the list", what);
         int k = 0;
         while (k < 3 && strcmp(LAYER_NAMES[k], item) != 0)
             k++;
         if (k == 3)
-            return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: '%s' is not direct, caustic or global", p->name,
-                                p->line, what, item);
+            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: '%s' is not direct, caustic or global",
+                               what, item);
         if (a->layers & (1u << k))
-            return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: '%s' given twice", p->name, p->line, what, item);
+            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: '%s' given twice", what, item);
         a->layers |= 1u << k;
         if (!comma)
             return PS_OK;
@@ -212,13 +212,13 @@ static ps_status parse_set(parser *p, ps_script_action *a)
                                            "tau",   "precision", "exposure", "pause"};
     static const char *const SAID = "splat, layers, kernel, radius, tau, precision, exposure or pause";
     if (p->nword < 3)
-        return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: set: expected a setting (%s)", p->name, p->line, SAID);
+        return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "set: expected a setting (%s)", SAID);
     int k = 0;
     while (k < 8 && strcmp(SETTINGS[k], p->word[2]) != 0)
         k++;
     if (k == 8)
-        return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: set: unknown setting '%s' (expected %s)", p->name, p->line,
-                            p->word[2], SAID);
+        return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "set: unknown setting '%s' (expected %s)",
+                           p->word[2], SAID);
     a->setting = (ps_script_setting)k;
     char what[32];
     snprintf(what, sizeof what, "set %s", SETTINGS[k]);
@@ -264,8 +264,8 @@ static ps_status parse_action(parser *p, ps_script_action *a)
             return wrong_count(p, action, "1 path (without spaces)");
         size_t n = strlen(arg[0]);
         if (n > PS_SCRIPT_PATH_MAX)
-            return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: screenshot: path longer than %d characters", p->name,
-                                p->line, PS_SCRIPT_PATH_MAX);
+            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "screenshot: path longer than %d characters",
+                               PS_SCRIPT_PATH_MAX);
         char *dst = p->pool + p->pool_used;
         memcpy(dst, arg[0], n + 1);
         p->pool_used += n + 1;
@@ -301,15 +301,14 @@ static ps_status parse_action(parser *p, ps_script_action *a)
         if (nargs < 1)
             return wrong_count(p, action, "'done'");
         if (strcmp(arg[0], "done") != 0)
-            return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: wait: expected 'done', got '%s'", p->name, p->line,
-                                arg[0]);
+            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "wait: expected 'done', got '%s'", arg[0]);
         return nargs != 1 ? wrong_count(p, "wait done", "no arguments") : PS_OK;
     }
     if (strcmp(action, "quit") == 0) {
         a->kind = PS_SCRIPT_QUIT;
         return nargs != 0 ? wrong_count(p, action, "no arguments") : PS_OK;
     }
-    return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: unknown action '%s'", p->name, p->line, action);
+    return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "unknown action '%s'", action);
 }
 
 /* One non-blank line: the time, then the action, appended to p->actions. */
@@ -317,18 +316,16 @@ static ps_status parse_line(parser *p)
 {
     double t;
     if (!ps_parse_double(p->word[0], &t) || !(t >= 0.0))
-        return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: time '%s' must be a number >= 0", p->name, p->line,
-                            p->word[0]);
+        return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "time '%s' must be a number >= 0", p->word[0]);
     if (p->nword < 2)
-        return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: missing action after the time", p->name, p->line);
+        return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "missing action after the time");
     if (p->count == PS_SCRIPT_MAX_ACTIONS)
-        return ps_error_set(p->err, PS_ERR_LIMIT, "%s:%d: more than %d actions", p->name, p->line,
-                            PS_SCRIPT_MAX_ACTIONS);
+        return ps_error_at(p->err, PS_ERR_LIMIT, p->name, p->line, "more than %d actions", PS_SCRIPT_MAX_ACTIONS);
     if (p->count == p->cap) {
         size_t cap = p->cap ? p->cap * 2 : 64; /* bounded by PS_SCRIPT_MAX_ACTIONS: no overflow */
         ps_script_action *na = realloc(p->actions, cap * sizeof *na);
         if (!na)
-            return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+            return ps_error_at(p->err, PS_ERR_NOMEM, p->name, p->line, "out of memory");
         p->actions = na;
         p->cap = cap;
     }
@@ -404,7 +401,7 @@ static ps_status parse_text(const char *text, size_t len, const char *name, ps_s
         return ps_error_set(err, PS_ERR_LIMIT, "%s: script larger than %zu bytes", name, PS_SCRIPT_MAX_BYTES);
     int bin = ps_text_nul_line(text, len);
     if (bin)
-        return ps_error_set(err, PS_ERR_PARSE, "%s:%d: binary data (a NUL byte), not a script", name, bin);
+        return ps_error_at(err, PS_ERR_PARSE, name, bin, "binary data (a NUL byte), not a script");
     parser p;
     memset(&p, 0, sizeof p);
     p.name = name;

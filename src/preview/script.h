@@ -95,10 +95,9 @@ typedef struct ps_script_action {
     double number;       /* angle degrees; set radius (caustic), tau, exposure */
     double number2;      /* set radius: the global radius, or 0 when not given */
     ps_script_setting setting; /* set */
-    /* set splat/kernel/precision: the index in the lists above, equal to
-     * ps_splat_mode, ps_kernel and ps_precision (points=0, triangles=1,
-     * sprites=2; box=0, cone=1, gauss=2, epanechnikov=3; none=0, diffusion=1,
-     * counter=2); set pause: 1 on, 0 off. */
+    /* set splat/kernel/precision: the ps_splat_mode, ps_kernel or
+     * ps_precision value, read through their name tables (ps_splat_mode_names,
+     * ps_kernel_names, ps_precision_names); set pause: 1 on, 0 off. */
     int choice;
     unsigned layers;     /* set layers: PS_SCRIPT_LAYER_* bits */
 } ps_script_action;

@@ -531,8 +531,7 @@ void ps_session_get_counts(ps_session *s, ps_session_counts *out)
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         const ps_photon_map *m = &maps[k];
         out->map[k] = m->counters;
-        out->map_bytes += (double)(m->cap * sizeof *m->photons + m->mcap * sizeof *m->materials +
-                                   m->ocap * sizeof *m->objects);
+        out->map_bytes += (double)ps_photon_map_bytes(m);
     }
     out->store_limited = ps_feed_store_limited(s->feed);
     out->ended = ps_feed_ended(s->feed);

@@ -8,11 +8,20 @@
 #include "core/array.h"
 #include "scene/bsdf.h"
 
-static const char *const mode_names[PS_SPLAT_MODE_COUNT] = {"points", "triangles", "sprites"};
-static const char *const precision_names[PS_PRECISION_COUNT] = {"none", "diffusion", "counter"};
+const char *const ps_splat_mode_names[PS_SPLAT_MODE_COUNT + 1] = {"points", "triangles", "sprites", NULL};
+const char *const ps_precision_names[PS_PRECISION_COUNT + 1] = {"none", "diffusion", "counter", NULL};
+const char *const ps_color_depth_names[PS_COLOR_DEPTH_COUNT + 1] = {"8", "float", NULL};
+const char *const ps_radius_schedule_names[PS_RADIUS_SCHEDULE_COUNT + 1] = {"fixed", "progressive", NULL};
 
-const char *ps_splat_mode_name(ps_splat_mode m) { return (unsigned)m < PS_SPLAT_MODE_COUNT ? mode_names[m] : "?"; }
-const char *ps_precision_name(ps_precision p) { return (unsigned)p < PS_PRECISION_COUNT ? precision_names[p] : "?"; }
+const char *ps_splat_mode_name(ps_splat_mode m)
+{
+    return (unsigned)m < PS_SPLAT_MODE_COUNT ? ps_splat_mode_names[m] : "?";
+}
+const char *ps_precision_name(ps_precision p) { return (unsigned)p < PS_PRECISION_COUNT ? ps_precision_names[p] : "?"; }
+const char *ps_color_depth_name(ps_color_depth d)
+{
+    return (unsigned)d < PS_COLOR_DEPTH_COUNT ? ps_color_depth_names[d] : "?";
+}
 
 /* ---- the kernel texture --------------------------------------------------- */
 
@@ -279,7 +288,7 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
 
 const char *ps_radius_schedule_name(ps_radius_schedule s)
 {
-    return s == PS_RADIUS_PROGRESSIVE ? "progressive" : "fixed";
+    return (unsigned)s < PS_RADIUS_SCHEDULE_COUNT ? ps_radius_schedule_names[s] : "?";
 }
 
 double ps_splat_radius_at(ps_radius_schedule s, double r0, uint64_t n0, uint64_t n, double alpha)

@@ -37,8 +37,22 @@ typedef enum ps_precision {
     PS_PRECISION_COUNT
 } ps_precision;
 
+/* The colour buffer splats are summed in: the thesis' 8 bits a channel, or
+ * float (no round-off, so no precision handling). */
+typedef enum ps_color_depth {
+    PS_COLOR_DEPTH_8,
+    PS_COLOR_DEPTH_FLOAT,
+    PS_COLOR_DEPTH_COUNT
+} ps_color_depth;
+
+/* Names in enum order, NULL-terminated (options, scripts, stats), and the
+ * name of one value ("?" out of range). */
+extern const char *const ps_splat_mode_names[PS_SPLAT_MODE_COUNT + 1];   /* points, triangles, sprites */
+extern const char *const ps_precision_names[PS_PRECISION_COUNT + 1];     /* none, diffusion, counter */
+extern const char *const ps_color_depth_names[PS_COLOR_DEPTH_COUNT + 1]; /* 8, float */
 const char *ps_splat_mode_name(ps_splat_mode m);
 const char *ps_precision_name(ps_precision p);
+const char *ps_color_depth_name(ps_color_depth d);
 
 /* The kernel as an alpha texture: size x size texels over the square
  * [-extent, extent]^2 around the unit disc, extent = size / (size - 2), so
@@ -149,6 +163,7 @@ typedef enum ps_radius_schedule {
 /* The most the progressive radius may exceed r0 (few photons, early frames). */
 #define PS_RADIUS_GROWTH_MAX 4.0
 
+extern const char *const ps_radius_schedule_names[PS_RADIUS_SCHEDULE_COUNT + 1]; /* fixed, progressive */
 const char *ps_radius_schedule_name(ps_radius_schedule s);
 /* The radius for n photons emitted (n0 > 0 the reference count, alpha in
  * (0, 1]); n = 0 gives the largest, r0 * PS_RADIUS_GROWTH_MAX. */

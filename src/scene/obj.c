@@ -97,18 +97,16 @@ static ps_status check_numbers(const char *path, int line, char **tok, int ntok,
     int n = ntok - 1;
     if (n < min || n > max) {
         if (min == max)
-            return ps_error_set(err, PS_ERR_PARSE, "%s:%d: '%s' needs %d numbers, got %d", path, line, tok[0], min, n);
-        return ps_error_set(err, PS_ERR_PARSE, "%s:%d: '%s' needs %d to %d numbers, got %d", path, line, tok[0], min,
-                            max, n);
+            return ps_error_at(err, PS_ERR_PARSE, path, line, "'%s' needs %d numbers, got %d", tok[0], min, n);
+        return ps_error_at(err, PS_ERR_PARSE, path, line, "'%s' needs %d to %d numbers, got %d", tok[0], min, max, n);
     }
     for (int k = 1; k < ntok; k++) {
         double v;
         if (!ps_parse_double(tok[k], &v))
-            return ps_error_set(err, PS_ERR_PARSE, "%s:%d: '%s': '%s' is not a finite number", path, line, tok[0],
-                                tok[k]);
+            return ps_error_at(err, PS_ERR_PARSE, path, line, "'%s': '%s' is not a finite number", tok[0], tok[k]);
         if (fabs(v) > OBJ_MAX_MAGNITUDE)
-            return ps_error_set(err, PS_ERR_RANGE, "%s:%d: '%s': '%s' is out of range (magnitude above %g)", path,
-                                line, tok[0], tok[k], OBJ_MAX_MAGNITUDE);
+            return ps_error_at(err, PS_ERR_RANGE, path, line, "'%s': '%s' is out of range (magnitude above %g)", tok[0],
+                               tok[k], OBJ_MAX_MAGNITUDE);
     }
     return PS_OK;
 }
@@ -118,11 +116,11 @@ static ps_status check_index(prescan *ps, int line, const char *text, size_t cou
 {
     int64_t v;
     if (!ps_parse_int64(text, &v) || v == 0)
-        return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: face %s index '%s' is not a non-zero integer", ps->path,
-                            line, what, text);
+        return ps_error_at(ps->err, PS_ERR_PARSE, ps->path, line, "face %s index '%s' is not a non-zero integer", what,
+                           text);
     if ((v > 0 && (uint64_t)v > count) || (v < 0 && (uint64_t)(-v) > count))
-        return ps_error_set(ps->err, PS_ERR_RANGE, "%s:%d: face %s index %s is out of range (%zu defined so far)",
-                            ps->path, line, what, text, count);
+        return ps_error_at(ps->err, PS_ERR_RANGE, ps->path, line,
+                           "face %s index %s is out of range (%zu defined so far)", what, text, count);
     return PS_OK;
 }
 
@@ -130,8 +128,8 @@ static ps_status check_face(prescan *ps, int line, char **tok, int ntok)
 {
     int corners = ntok - 1;
     if (corners > OBJ_MAX_FACE_VERTICES)
-        return ps_error_set(ps->err, PS_ERR_LIMIT, "%s:%d: face has %d vertices, at most %d are supported", ps->path,
-                            line, corners, OBJ_MAX_FACE_VERTICES);
+        return ps_error_at(ps->err, PS_ERR_LIMIT, ps->path, line, "face has %d vertices, at most %d are supported",
+                           corners, OBJ_MAX_FACE_VERTICES);
     for (int k = 1; k < ntok; k++) {
         /* v, v/vt, v//vn or v/vt/vn */
         char *parts[3] = {tok[k], NULL, NULL};
@@ -144,7 +142,7 @@ static ps_status check_face(prescan *ps, int line, char **tok, int ntok)
                 *s2 = '\0';
                 parts[2] = s2 + 1;
                 if (strchr(parts[2], '/'))
-                    return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: malformed face corner", ps->path, line);
+                    return ps_error_at(ps->err, PS_ERR_PARSE, ps->path, line, "malformed face corner");
             }
         }
         ps_status st = check_index(ps, line, parts[0], ps->v, "vertex");
@@ -183,17 +181,17 @@ static ps_status scan_mtl_text(prescan *ps, const char *mpath, const char *text)
         at = next_line(at, buf, sizeof buf, &too_long);
         line++;
         if (too_long)
-            return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: line too long", mpath, line);
+            return ps_error_at(ps->err, PS_ERR_PARSE, mpath, line, "line too long");
         int ntok = split(buf, tok, OBJ_MAX_TOKENS);
         if (ntok < 0)
-            return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: too many values on one line", mpath, line);
+            return ps_error_at(ps->err, PS_ERR_PARSE, mpath, line, "too many values on one line");
         if (ntok == 0 || tok[0][0] == '#')
             continue;
         const char *k = tok[0];
         ps_status st = PS_OK;
         if (strcmp(k, "newmtl") == 0) {
             if (ntok < 2)
-                return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: newmtl without a name", mpath, line);
+                return ps_error_at(ps->err, PS_ERR_PARSE, mpath, line, "newmtl without a name");
             if (!PS_RESERVE(ps->mtls, ps->mtl_cap, ps->mtl_count + 1))
                 return ps_error_set(ps->err, PS_ERR_NOMEM, "%s: out of memory", mpath);
             mtl_info *m = &ps->mtls[ps->mtl_count];
@@ -204,15 +202,14 @@ static ps_status scan_mtl_text(prescan *ps, const char *mpath, const char *text)
             ps->mtl_count++;
         } else if (!strcmp(k, "Kd") || !strcmp(k, "Ks") || !strcmp(k, "Ke") || !strcmp(k, "Ka") || !strcmp(k, "Tf")) {
             if (ntok > 1 && (!strcmp(tok[1], "spectral") || !strcmp(tok[1], "xyz")))
-                return ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: '%s %s' colours are not supported, use r g b", mpath,
-                                    line, k, tok[1]);
+                return ps_error_at(ps->err, PS_ERR_PARSE, mpath, line, "'%s %s' colours are not supported, use r g b",
+                                   k, tok[1]);
             st = check_numbers(mpath, line, tok, ntok, 3, 3, ps->err);
             for (int c = 1; st == PS_OK && c < 4; c++) {
                 double v;
                 ps_parse_double(tok[c], &v);
                 if (v < 0.0)
-                    st = ps_error_set(ps->err, PS_ERR_RANGE, "%s:%d: '%s' components must not be negative", mpath, line,
-                                      k);
+                    st = ps_error_at(ps->err, PS_ERR_RANGE, mpath, line, "'%s' components must not be negative", k);
             }
         } else if (!strcmp(k, "Ns") || !strcmp(k, "Ni") || !strcmp(k, "d") || !strcmp(k, "Tr")) {
             st = check_numbers(mpath, line, tok, ntok, 1, 1, ps->err);
@@ -225,7 +222,7 @@ static ps_status scan_mtl_text(prescan *ps, const char *mpath, const char *text)
         } else if (!strcmp(k, "illum")) {
             int64_t v;
             if (ntok != 2 || !ps_parse_int64(tok[1], &v) || v < 0 || v > 10)
-                st = ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: illum needs one integer from 0 to 10", mpath, line);
+                st = ps_error_at(ps->err, PS_ERR_PARSE, mpath, line, "illum needs one integer from 0 to 10");
         }
         /* Texture maps and other statements are ignored: photosplat has no textures. */
         if (st != PS_OK)
@@ -249,8 +246,8 @@ static ps_status load_mtllib(prescan *ps, int line, char **tok, int ntok)
         if (seen)
             continue;
         if (ps->lib_count == OBJ_MAX_MTLLIBS)
-            return ps_error_set(ps->err, PS_ERR_LIMIT, "%s:%d: more than %d material libraries", ps->path, line,
-                                OBJ_MAX_MTLLIBS);
+            return ps_error_at(ps->err, PS_ERR_LIMIT, ps->path, line, "more than %d material libraries",
+                               OBJ_MAX_MTLLIBS);
         snprintf(ps->libs[ps->lib_count++], sizeof ps->libs[0], "%s", tok[k]);
         snprintf(mpath, sizeof mpath, "%s%s", dir, tok[k]);
         char *text = NULL;
@@ -306,13 +303,13 @@ static ps_status scan_obj(prescan *ps, const char *text)
         at = next_line(at, buf, line_max, &too_long);
         line++;
         if (too_long) {
-            st = ps_error_set(ps->err, PS_ERR_PARSE, "%s:%d: line too long", ps->path, line);
+            st = ps_error_at(ps->err, PS_ERR_PARSE, ps->path, line, "line too long");
             break;
         }
         int ntok = split(buf, tok, OBJ_MAX_FACE_VERTICES + 2);
         if (ntok < 0) {
-            st = ps_error_set(ps->err, PS_ERR_LIMIT, "%s:%d: more than %d values on one line", ps->path, line,
-                              OBJ_MAX_FACE_VERTICES + 1);
+            st = ps_error_at(ps->err, PS_ERR_LIMIT, ps->path, line, "more than %d values on one line",
+                             OBJ_MAX_FACE_VERTICES + 1);
             break;
         }
         if (ntok == 0 || tok[0][0] == '#')

@@ -724,15 +724,16 @@ static ps_status parse_mesh(parser *p)
     ps_error oerr;
     st = ps_obj_load(path, &om, p->warn, &oerr);
     if (st != PS_OK) {
-        /* An OBJ/MTL problem with a line of its own names that line first; one
-         * without (a missing file) is the scene line's problem. */
-        const char *colon = strchr(oerr.msg, ':');
-        bool has_line = colon && colon[1] >= '0' && colon[1] <= '9';
-        for (const char *c = oerr.msg; has_line && c < colon; c++)
-            has_line = *c != ' ';
-        if (has_line)
-            return ps_error_set(p->err, st, "%s (mesh at %s:%d)", oerr.msg, p->name, p->line);
-        return ps_error_set(p->err, st, "%s:%d: mesh: %s", p->name, p->line, oerr.msg);
+        /* An OBJ/MTL problem with a line of its own names that line first (and
+         * the error keeps it); one without (a missing file) is the scene
+         * line's problem. */
+        if (oerr.line > 0) {
+            ps_error_set(p->err, st, "%s (mesh at %s:%d)", oerr.msg, p->name, p->line);
+            if (p->err)
+                p->err->line = oerr.line;
+            return st;
+        }
+        return ps_error_at(p->err, st, p->name, p->line, "mesh: %s", oerr.msg);
     }
 
     /* mats[k + 1]: scene material of OBJ material k; mats[0]: faces with none. */
@@ -1051,6 +1052,9 @@ static ps_status parse_text(parser *p, const char *text, size_t len)
         return ps_error_set(p->err, PS_ERR_PARSE,
                             "%s:%d: the scene has no light (add a light statement, or a mesh with Ke > 0 faces)",
                             p->name, last);
+    /* Valid, but every photon escapes and every pixel is black: say why. */
+    if (p->s->objects.count == 0)
+        ps_warn(p->warn, "%s: scene has no geometry", p->name);
     ps_scene_finish(p->s);
     apply_defaults(p);
     return PS_OK;
