@@ -162,9 +162,9 @@ static void every_action_and_setting(void **state)
 
     const ps_script_action *l = ps_script_at(s, 3);
     assert_int_equal(l->setting, PS_SET_LAYERS);
-    assert_int_equal(l->layers, PS_SCRIPT_LAYER_DIRECT);
+    assert_int_equal(l->layers, PS_LAYER_DIRECT);
     assert_int_equal(ps_script_at(s, 4)->layers, 7);
-    assert_int_equal(ps_script_at(s, 5)->layers, PS_SCRIPT_LAYER_CAUSTIC);
+    assert_int_equal(ps_script_at(s, 5)->layers, PS_LAYER_CAUSTIC);
     for (int k = 0; k < 4; k++) {
         a = ps_script_at(s, (size_t)(6 + k));
         assert_int_equal(a->setting, PS_SET_KERNEL);
@@ -310,7 +310,7 @@ static void comments_and_blank_lines(void **state)
     assert_int_equal(ps_script_at(s, 0)->line, 4);
     assert_string_equal(ps_script_at(s, 1)->path, "shot.png");
     assert_int_equal(ps_script_at(s, 1)->line, 7);
-    assert_int_equal(ps_script_at(s, 2)->layers, PS_SCRIPT_LAYER_DIRECT | PS_SCRIPT_LAYER_GLOBAL);
+    assert_int_equal(ps_script_at(s, 2)->layers, PS_LAYER_DIRECT | PS_LAYER_GLOBAL);
     assert_int_equal(ps_script_at(s, 3)->line, 9);
     assert_near(ps_script_at(s, 3)->pitch, 2, 0);
     ps_script_destroy(s);

@@ -156,23 +156,10 @@ ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_pre
 
 ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_error *err)
 {
-    static const char *const names[3] = {"direct", "caustic", "global"};
-    *out = 0;
-    for (const char *p = text;;) {
-        const char *end = strchr(p, ',');
-        size_t len = end ? (size_t)(end - p) : strlen(p);
-        int found = -1;
-        for (int k = 0; k < 3; k++)
-            if (strlen(names[k]) == len && strncmp(p, names[k], len) == 0)
-                found = k;
-        if (found < 0)
-            return ps_error_set(err, PS_ERR_PARSE, "%s: --layers: '%.*s' is not direct, caustic or global", prog,
-                                (int)len, p);
-        *out |= 1u << found;
-        if (!end)
-            return PS_OK;
-        p = end + 1;
-    }
+    char why[PS_ERROR_MSG_MAX];
+    if (!ps_layers_parse(text, out, why, sizeof why))
+        return ps_error_set(err, PS_ERR_PARSE, "%s: --layers: %s", prog, why);
+    return PS_OK;
 }
 
 /* ps_cli_choice into a typed field: the index is read as an int and stored

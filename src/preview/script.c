@@ -47,7 +47,6 @@ typedef struct choice_list {
 
 /* The enums' own name tables, so that a choice is the enum's value. */
 static const char *const PAUSE_NAMES[] = {"off", "on"}; /* so that on = 1 */
-static const char *const LAYER_NAMES[] = {"direct", "caustic", "global"}; /* bit k is LAYER_NAMES[k] */
 
 static const choice_list SPLAT_CHOICES = {ps_splat_mode_names, PS_SPLAT_MODE_COUNT, "points, triangles or sprites"};
 static const choice_list KERNEL_CHOICES = {ps_kernel_names, PS_KERNEL_COUNT, "box, cone, gauss or epanechnikov"};
@@ -181,29 +180,12 @@ static ps_status parse_indexed(parser *p, ps_script_action *a, const char *actio
     return PS_OK;
 }
 
-static ps_status parse_layers(parser *p, ps_script_action *a, char *list)
+static ps_status parse_layers(parser *p, ps_script_action *a, const char *list)
 {
-    const char *what = "set layers";
-    char *item = list;
-    for (;;) {
-        char *comma = strchr(item, ',');
-        if (comma)
-            *comma = '\0';
-        if (!*item)
-            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: empty name in the list", what);
-        int k = 0;
-        while (k < 3 && strcmp(LAYER_NAMES[k], item) != 0)
-            k++;
-        if (k == 3)
-            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: '%s' is not direct, caustic or global",
-                               what, item);
-        if (a->layers & (1u << k))
-            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: '%s' given twice", what, item);
-        a->layers |= 1u << k;
-        if (!comma)
-            return PS_OK;
-        item = comma + 1;
-    }
+    char why[PS_ERROR_MSG_MAX];
+    if (!ps_layers_parse(list, &a->layers, why, sizeof why))
+        return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "set layers: %s", why);
+    return PS_OK;
 }
 
 static ps_status parse_set(parser *p, ps_script_action *a)

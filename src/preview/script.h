@@ -46,6 +46,7 @@
 
 #include "core/status.h"
 #include "core/vec.h"
+#include "preview/layers.h"
 
 #define PS_SCRIPT_MAX_BYTES ((size_t)1 << 20)
 #define PS_SCRIPT_MAX_ACTIONS 100000
@@ -78,9 +79,6 @@ typedef enum ps_script_setting {
 } ps_script_setting;
 
 /* Bits of ps_script_action.layers. */
-#define PS_SCRIPT_LAYER_DIRECT 1u
-#define PS_SCRIPT_LAYER_CAUSTIC 2u
-#define PS_SCRIPT_LAYER_GLOBAL 4u
 
 /* One action. Fields a kind does not use are zero (path NULL). */
 typedef struct ps_script_action {
@@ -99,7 +97,7 @@ typedef struct ps_script_action {
      * ps_precision value, read through their name tables (ps_splat_mode_names,
      * ps_kernel_names, ps_precision_names); set pause: 1 on, 0 off. */
     int choice;
-    unsigned layers;     /* set layers: PS_SCRIPT_LAYER_* bits */
+    unsigned layers;     /* set layers: PS_LAYER_* bits (preview/layers.h) */
 } ps_script_action;
 
 typedef struct ps_script ps_script;

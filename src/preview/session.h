@@ -35,16 +35,12 @@
 #include "photon/estimate.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
+#include "preview/layers.h"
 #include "preview/lights.h"
 #include "preview/mesh.h"
 #include "preview/splat.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
-
-/* The layers of the preview (thesis eq. 6's terms as it draws them). */
-enum { PS_LAYER_DIRECT = 1, PS_LAYER_CAUSTIC = 2, PS_LAYER_GLOBAL = 4, PS_LAYER_ALL = 7 };
-/* Map k's layer bit. */
-static inline unsigned ps_map_layer(ps_map_kind k) { return k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL; }
 
 /* An incremental refresh splats at most as many photons a map as fit in this
  * share of tau at the rate the last refreshes drew them, so that a refresh
