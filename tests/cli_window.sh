@@ -80,5 +80,14 @@ expect_success "snap picture" "$bin/photosplat-snap" "$scene" "${same[@]}" --col
 rmse=$("$bin/photosplat-compare" "$cli_tmp/same-w.png" "$cli_tmp/same-s.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
 echo "window against photosplat-snap: rmse $rmse"
 awk_true "$rmse < 2.0 / 255" && ok || bad "the window and photosplat-snap differ: rmse $rmse"
+# GL encodes the window's picture (GL_FRAMEBUFFER_SRGB); the CPU encoder it
+# replaced (--composite cpu, bench-window's baseline) gives the same codes
+# but for rounding: rmse under one code.
+printf '1.5 screenshot %s\n1.6 quit\n' "$cli_tmp/same-c.png" >"$cli_tmp/same-c.txt"
+expect_success "window picture, CPU composite" xrun "$win" "$scene" "${same[@]}" --overlay off --composite cpu \
+    --script "$cli_tmp/same-c.txt"
+rmse=$("$bin/photosplat-compare" "$cli_tmp/same-w.png" "$cli_tmp/same-c.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
+echo "GL-encoded against CPU-encoded window: rmse $rmse"
+awk_true "$rmse < 1.0 / 255" && ok || bad "the GL composite differs from the CPU one: rmse $rmse"
 
 cli_summary

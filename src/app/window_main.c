@@ -94,6 +94,9 @@ static const char usage[] =
     "                           radius holding at the scene's photon count)\n"
     "  --radius-alpha A         the progressive schedule's alpha (default 2/3)\n"
     "  --overlay on|off         the text overlay (default on)\n"
+    "  --composite gl|cpu       where the picture is encoded for display: by GL (default),\n"
+    "                           or read back and encoded on the CPU (the old way, for\n"
+    "                           scripts/bench-window.sh to compare)\n"
     "  --help                   this text\n";
 
 static const char help_text[] =
@@ -122,6 +125,7 @@ typedef struct win_options {
     const char *script;
     int overlay;
     int64_t max_photons; /* stored photons of both maps; 0: no bound */
+    int composite;       /* 1: on the GL side (the default); 0: read back and encoded on the CPU */
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM: the session ends */
 } win_options;
 
@@ -184,6 +188,7 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
     ps_preview_options_init(&o->p, true);
     o->overlay = 1;
     o->max_photons = WIN_MAX_PHOTONS_DEFAULT;
+    o->composite = 1;
     ps_status st = PS_OK;
     while (st == PS_OK && ps_cli_next(&cli)) {
         if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "-h")) {
@@ -201,6 +206,9 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
             st = ps_cli_string(&cli, &o->script, err);
         } else if (ps_cli_is(&cli, "--overlay")) {
             st = ps_cli_choice(&cli, on_off, &o->overlay, err);
+        } else if (ps_cli_is(&cli, "--composite")) {
+            static const char *const where[] = {"cpu", "gl", NULL};
+            st = ps_cli_choice(&cli, where, &o->composite, err);
         } else if (ps_cli_is(&cli, "--max-photons")) {
             st = ps_cli_int(&cli, 0, PS_SCENE_MAX_PHOTONS, &o->max_photons, err);
         } else {
@@ -334,7 +342,10 @@ static ps_status refresh(app *a, ps_error *err)
     for (int k = 0; k < PS_MAP_COUNT; k++)
         gains[k] = a->frame.map[k].gain;
     double t_show = ps_now_seconds();
-    ps_gl_layers_show(a->layers, a->frame.direct_gain, gains);
+    if (a->o.composite)
+        ps_gl_layers_show(a->layers, a->frame.direct_gain, gains);
+    else if ((st = ps_gl_layers_show_by_cpu(a->layers, a->frame.direct_gain, gains, err)) != PS_OK)
+        return st;
     ps_gl_finish();
     a->show_sum += ps_now_seconds() - t_show;
     a->show_count++;

@@ -187,3 +187,32 @@ ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const doub
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     return st;
 }
+
+ps_status ps_gl_layers_show_by_cpu(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
+                                   ps_error *err)
+{
+    ps_image img;
+    ps_status st = ps_gl_layers_composite(l, direct_gain, map_gain, &img, err);
+    uint8_t *rgb = st == PS_OK ? malloc(3 * (size_t)l->width * (size_t)l->height) : NULL;
+    if (st == PS_OK && !rgb)
+        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a %dx%d picture", l->width, l->height);
+    if (st == PS_OK) {
+        for (int y = 0; y < l->height; y++) {
+            const float *src = ps_image_at(&img, 0, l->height - 1 - y);
+            uint8_t *dst = rgb + 3 * (size_t)y * (size_t)l->width;
+            for (int i = 0; i < 3 * l->width; i++)
+                dst[i] = ps_tonemap_8bit(src[i], 1.0f);
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glViewport(0, 0, l->width, l->height);
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_STENCIL_TEST);
+        glDisable(GL_BLEND);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glWindowPos2i(0, 0);
+        glDrawPixels(l->width, l->height, GL_RGB, GL_UNSIGNED_BYTE, rgb);
+    }
+    free(rgb);
+    ps_image_destroy(&img);
+    return st;
+}

@@ -128,9 +128,16 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
 /* direct * direct_gain + sum of map * map_gain[map], drawn into the default
  * framebuffer (the window) with the display's encoding applied by GL: each
  * channel clamped to [0, 1] and sRGB-encoded to 8 bits (GL_FRAMEBUFFER_SRGB
- * into an sRGB texture, then copied as it is), the same codes as the PNG
- * encoder's (image.h, ps_tonemap_8bit) within one rounding step. */
+ * into an sRGB texture, then copied as it is): the PNG encoder's codes
+ * (image.h, ps_tonemap_8bit) but for the GL's own rounding (llvmpipe: up to
+ * two codes apart, docs/preview.md). */
 void ps_gl_layers_show(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT]);
+/* The same picture the way the window showed it before the composite moved
+ * to GL: read back as floats, encoded on the CPU (ps_tonemap_8bit) and drawn
+ * with glDrawPixels. Kept as the baseline scripts/bench-window.sh measures
+ * ps_gl_layers_show against (the window's --composite cpu). */
+ps_status ps_gl_layers_show_by_cpu(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
+                                   ps_error *err);
 /* The same composite, linear, read back into out (created here; row 0 the
  * top): for tests. */
 ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
