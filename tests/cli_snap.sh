@@ -82,26 +82,36 @@ frames=$(sed -n 's/.*"frames": \([0-9]*\).*/\1/p' "$cli_tmp/p.json")
 awk_true "$frames >= 2" && ok || bad "progressive mode refreshed $frames times in 0.6 s at tau 0.1"
 grep -q '"first_frame_seconds":' "$cli_tmp/p.json" && ok || bad "no first_frame_seconds"
 
-# The precision stress: a caustic of many faint photons (points, so that each
-# photon is one exact colour), with an exposure that keeps each photon under
-# half a code of the 8-bit buffer. The release build takes 5 million photons;
-# the sanitizer build a tenth, as faint.
+# The precision stress: a caustic of many faint photons, with an exposure
+# that keeps each photon under half a code of the 8-bit buffer, in every
+# splat mode (the accurate splats draw an 8-bit buffer's kernel as a halftone,
+# so that each fragment adds the photon's code or nothing: preview/splat.h).
+# The release build takes 5 million photons; the sanitizer build a tenth, as
+# faint.
 if [[ $bin == *asan* ]]; then n=500000 exposure=0.2; else n=5000000 exposure=2; fi
-stress=("$mirror" --layers caustic --splat points --caustic-photons $n --exposure $exposure)
-expect_success "stress float" "$snap" "${stress[@]}" --color-depth float --hdr "$cli_tmp/f.pfm"
-expect_success "stress none" "$snap" "${stress[@]}" --precision none --hdr "$cli_tmp/n.pfm"
-expect_success "stress diffusion" "$snap" "${stress[@]}" --precision diffusion --hdr "$cli_tmp/e.pfm"
-mf=$(mean_of "$cli_tmp/f.pfm") mn=$(mean_of "$cli_tmp/n.pfm") me=$(mean_of "$cli_tmp/e.pfm")
-echo "precision stress, $n photons: mean radiance float $mf, 8-bit none $mn, 8-bit diffusion $me"
-awk_true "$mf > 0.05" && ok || bad "the float caustic is dark ($mf)"
-awk_true "$mn < 0.1 * $mf" && ok || bad "plain 8-bit kept the caustic ($mn of $mf): the stress is not faint enough"
-awk_true "($me - $mf)^2 < (0.02 * $mf)^2" && ok || bad "error diffusion's mean $me is not within 2 % of the float buffer's $mf"
-# The counter, shooting progressively, stops once a refresh rounds too much away.
-expect_success "stress counter" "$snap" "${stress[@]}" --precision counter --time 60 --tau 0.05 \
-    --hdr "$cli_tmp/c.pfm" --stats "$cli_tmp/c.json"
-expect_match "counter says why" "$cli_out" 'error counter: stopped shooting at [0-9]+ photons'
-grep -q '"counter_stopped": 1,' "$cli_tmp/c.json" && ok || bad "stats do not say the counter stopped"
-emitted=$(sed -n 's/.*"emitted_caustic": \([0-9]*\).*/\1/p' "$cli_tmp/c.json")
-awk_true "$emitted < $n" && ok || bad "the counter let all $emitted photons through"
+for mode in points triangles sprites; do
+    stress=("$mirror" --layers caustic --splat $mode --caustic-photons $n --exposure $exposure)
+    expect_success "stress $mode float" "$snap" "${stress[@]}" --color-depth float --hdr "$cli_tmp/f.pfm"
+    expect_success "stress $mode none" "$snap" "${stress[@]}" --precision none --hdr "$cli_tmp/n.pfm"
+    expect_success "stress $mode diffusion" "$snap" "${stress[@]}" --precision diffusion --hdr "$cli_tmp/e.pfm"
+    mf=$(mean_of "$cli_tmp/f.pfm") mn=$(mean_of "$cli_tmp/n.pfm") me=$(mean_of "$cli_tmp/e.pfm")
+    echo "precision stress, $mode, $n photons: mean radiance float $mf, 8-bit none $mn, 8-bit diffusion $me"
+    awk_true "$mf > 0.05" && ok || bad "$mode: the float caustic is dark ($mf)"
+    awk_true "$mn < 0.1 * $mf" && ok || bad "$mode: plain 8-bit kept the caustic ($mn of $mf): the stress is not faint enough"
+    awk_true "($me - $mf)^2 < (0.02 * $mf)^2" && ok ||
+        bad "$mode: error diffusion's mean $me is not within 2 % of the float buffer's $mf"
+done
+# The counter, shooting progressively, stops once a refresh rounds too much
+# away: with points, and with the textured splats, whose halftone makes what
+# they lose the colour's rounding alone, which the counter counts.
+for mode in points triangles; do
+    stress=("$mirror" --layers caustic --splat $mode --caustic-photons $n --exposure $exposure)
+    expect_success "stress counter $mode" "$snap" "${stress[@]}" --precision counter --time 60 --tau 0.05 \
+        --hdr "$cli_tmp/c.pfm" --stats "$cli_tmp/c.json"
+    expect_match "counter says why ($mode)" "$cli_out" 'error counter: stopped shooting at [0-9]+ photons'
+    grep -q '"counter_stopped": 1,' "$cli_tmp/c.json" && ok || bad "$mode: stats do not say the counter stopped"
+    emitted=$(sed -n 's/.*"emitted_caustic": \([0-9]*\).*/\1/p' "$cli_tmp/c.json")
+    awk_true "$emitted < $n" && ok || bad "$mode: the counter let all $emitted photons through"
+done
 
 cli_summary

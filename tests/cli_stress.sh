@@ -98,17 +98,21 @@ if [ "${STRESS_LONG:-0}" = 1 ]; then
     n=10000000
     mirror=tests/data/good/mirror-caustic.scn
     mean_of() { "$compare" "$1" "$1" | field mean_a; }
-    faint=("$mirror" --layers caustic --splat points --caustic-photons $n --exposure 2)
-    expect_success "1e7 float" "$snap" "${faint[@]}" --color-depth float --hdr "$cli_tmp/f.pfm" --stats "$cli_tmp/f.json"
-    grep -q "\"emitted_caustic\": $n," "$cli_tmp/f.json" && ok || bad "1e7 float: not $n photons emitted"
-    expect_success "1e7 none" "$snap" "${faint[@]}" --precision none --hdr "$cli_tmp/n.pfm"
-    expect_success "1e7 diffusion" "$snap" "${faint[@]}" --precision diffusion --hdr "$cli_tmp/e.pfm"
-    mf=$(mean_of "$cli_tmp/f.pfm") mn=$(mean_of "$cli_tmp/n.pfm") me=$(mean_of "$cli_tmp/e.pfm")
-    echo "10^7 photons: mean radiance float $mf, 8-bit none $mn, 8-bit diffusion $me"
-    for m in "$mf" "$mn" "$me"; do [[ $m =~ ^[0-9.e+-]+$ ]] && ok || bad "1e7: mean '$m' is not a finite number"; done
-    awk_true "$mf > 0.05" && ok || bad "1e7: the float caustic is dark ($mf)"
-    awk_true "$mn < 0.1 * $mf" && ok || bad "1e7: plain 8-bit kept the caustic ($mn of $mf)"
-    awk_true "($me - $mf)^2 < (0.02 * $mf)^2" && ok || bad "1e7: diffusion's mean $me is not within 2 % of $mf"
+    for mode in points triangles sprites; do
+        faint=("$mirror" --layers caustic --splat $mode --caustic-photons $n --exposure 2)
+        expect_success "1e7 $mode float" "$snap" "${faint[@]}" --color-depth float --hdr "$cli_tmp/f.pfm" \
+            --stats "$cli_tmp/f.json"
+        grep -q "\"emitted_caustic\": $n," "$cli_tmp/f.json" && ok || bad "1e7 float: not $n photons emitted"
+        expect_success "1e7 $mode none" "$snap" "${faint[@]}" --precision none --hdr "$cli_tmp/n.pfm"
+        expect_success "1e7 $mode diffusion" "$snap" "${faint[@]}" --precision diffusion --hdr "$cli_tmp/e.pfm"
+        mf=$(mean_of "$cli_tmp/f.pfm") mn=$(mean_of "$cli_tmp/n.pfm") me=$(mean_of "$cli_tmp/e.pfm")
+        echo "10^7 photons, $mode: mean radiance float $mf, 8-bit none $mn, 8-bit diffusion $me"
+        for m in "$mf" "$mn" "$me"; do [[ $m =~ ^[0-9.e+-]+$ ]] && ok || bad "1e7: mean '$m' is not a finite number"; done
+        awk_true "$mf > 0.05" && ok || bad "1e7 $mode: the float caustic is dark ($mf)"
+        awk_true "$mn < 0.1 * $mf" && ok || bad "1e7 $mode: plain 8-bit kept the caustic ($mn of $mf)"
+        awk_true "($me - $mf)^2 < (0.02 * $mf)^2" && ok || bad "1e7 $mode: diffusion's mean $me is not within 2 % of $mf"
+    done
+    faint=("$mirror" --layers caustic --splat triangles --caustic-photons $n --exposure 2)
     expect_success "1e7 counter" "$snap" "${faint[@]}" --precision counter --time 120 --tau 0.05 \
         --hdr "$cli_tmp/c.pfm" --stats "$cli_tmp/c.json"
     expect_match "1e7 counter says why" "$cli_out" 'error counter: stopped shooting at [0-9]+ photons'

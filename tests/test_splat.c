@@ -915,10 +915,97 @@ static void names(void **state)
     assert_string_equal(ps_precision_name(PS_PRECISION_COUNT), "?");
 }
 
+
+/* The 8-bit kernel: a halftone of 0 and 255 only, whose density follows the
+ * smooth kernel's weight ring by ring, with C (the mean weight over the
+ * disc) within 1 % of the smooth texture's. */
+static void halftone_texture(void **state)
+{
+    (void)state;
+    ps_error err;
+    for (int k = 0; k < PS_KERNEL_COUNT; k++) {
+        ps_kernel_texture h, t;
+        assert_int_equal(ps_kernel_texture_make_halftone((ps_kernel)k, PS_KERNEL_HALFTONE_SIZE, &h, &err), PS_OK);
+        assert_int_equal(ps_kernel_texture_make((ps_kernel)k, PS_KERNEL_HALFTONE_SIZE, &t, &err), PS_OK);
+        assert_true(h.halftone);
+        assert_false(t.halftone);
+        size_t n = (size_t)h.size * (size_t)h.size;
+        double ring_on[4] = {0}, ring_weight[4] = {0};
+        for (size_t i = 0; i < n; i++) {
+            assert_true(h.alpha[i] == 0 || h.alpha[i] == 255);
+            int x = (int)(i % (size_t)h.size), y = (int)(i / (size_t)h.size);
+            double u = h.extent * (2.0 * (x + 0.5) / h.size - 1.0), v = h.extent * (2.0 * (y + 0.5) / h.size - 1.0);
+            double r = sqrt(u * u + v * v);
+            if (r >= 1.0)
+                continue;
+            int ring = (int)(4.0 * r);
+            ring_on[ring] += h.alpha[i] / 255.0;
+            ring_weight[ring] += t.alpha[i] / 255.0;
+        }
+        assert_near(h.mean, t.mean, 0.01 * t.mean);
+        for (int ring = 0; ring < 4; ring++)
+            if (ring_weight[ring] > 500.0) /* a ring with weight to count; each texel a Bernoulli draw: */
+                assert_near(ring_on[ring], ring_weight[ring], 4.0 * sqrt(ring_weight[ring])); /* 4 sigma */
+        ps_kernel_texture_free(&h);
+        ps_kernel_texture_free(&t);
+    }
+}
+
+/* Error diffusion runs in screen order (a Z-order curve over the splats'
+ * pixels): the codes sent into any aligned 32 x 32 block of the screen add up
+ * to what its photons asked for within one code, where index order (the
+ * photons in random places) would leave a few codes of noise per block. */
+static void diffusion_in_screen_order(void **state)
+{
+    (void)state;
+    const double L = 255.0;
+    faint_set s;
+    faint_make(&s, 0.3 / L);
+    s.p.mode = PS_SPLAT_POINTS;
+    ps_splat_batch none, diff;
+    ps_splat_batch_init(&none);
+    ps_splat_batch_init(&diff);
+    s.p.precision = PS_PRECISION_NONE;
+    s.p.levels = 255;
+    build(s.ph, s.mat, FAINT_COUNT, &s.p, &none);
+    s.p.precision = PS_PRECISION_DIFFUSION;
+    build(s.ph, s.mat, FAINT_COUNT, &s.p, &diff);
+    assert_int_equal(none.splats, diff.splats);
+    enum { BLOCK = 32, BX = 640 / BLOCK, BY = 480 / BLOCK };
+    static double want[BY][BX], got[BY][BX];
+    memset(want, 0, sizeof want);
+    memset(got, 0, sizeof got);
+    for (size_t i = 0; i < diff.splats; i++) {
+        double x, y;
+        ps_vec3 q = ps_v3(diff.positions[3 * i], diff.positions[3 * i + 1], diff.positions[3 * i + 2]);
+        assert_true(ps_camera_project(&s.p.cam, q, &x, &y));
+        int bx = (int)x / BLOCK, by = (int)y / BLOCK;
+        assert_true(bx >= 0 && bx < BX && by >= 0 && by < BY);
+        want[by][bx] += none.colors[4 * i] * L;
+        got[by][bx] += diff.colors[4 * i] * L;
+    }
+    double worst = 0.0;
+    int blocks = 0;
+    for (int by = 0; by < BY; by++)
+        for (int bx = 0; bx < BX; bx++)
+            if (want[by][bx] > 0.0) {
+                worst = fmax(worst, fabs(got[by][bx] - want[by][bx]));
+                blocks++;
+            }
+    printf("screen-order diffusion: %d blocks, worst %.3f codes off what they asked for\n", blocks, worst);
+    assert_true(blocks > 50);
+    assert_true(worst <= 1.0 + 1e-3);
+    ps_splat_batch_free(&none);
+    ps_splat_batch_free(&diff);
+    faint_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(kernel_texture), cmocka_unit_test(splat_basis),         cmocka_unit_test(triangles), cmocka_unit_test(sprites),
+        cmocka_unit_test(kernel_texture),
+        cmocka_unit_test(halftone_texture),
+        cmocka_unit_test(diffusion_in_screen_order), cmocka_unit_test(splat_basis),         cmocka_unit_test(triangles), cmocka_unit_test(sprites),
         cmocka_unit_test(points),         cmocka_unit_test(glossy),              cmocka_unit_test(back_faces),
         cmocka_unit_test(batches), cmocka_unit_test(groups),        cmocka_unit_test(precision_diffusion), cmocka_unit_test(precision_counter),
         cmocka_unit_test(names), cmocka_unit_test(radius_schedule),

@@ -101,8 +101,11 @@ void ps_gl_upload_kernel(ps_gl_renderer *r, const ps_kernel_texture *k)
     glBindTexture(GL_TEXTURE_2D, r->kernel_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_ALPHA8, k->size, k->size, 0, GL_ALPHA, GL_UNSIGNED_BYTE, k->alpha);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    /* A halftone only works sampled nearest: filtering would blend its 0 and
+     * 255 texels into the fractions that round away (splat.h). */
+    GLint filter = k->halftone ? GL_NEAREST : GL_LINEAR;
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     glBindTexture(GL_TEXTURE_2D, 0);

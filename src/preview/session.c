@@ -105,6 +105,15 @@ static void free_maps(ps_session *s)
     s->tracer = NULL;
 }
 
+/* The kernel texture: smooth for float buffers, a halftone for 8 bits, where
+ * a smooth kernel's fragments round away (splat.h). */
+static ps_status make_kernel(const ps_session_settings *set, ps_kernel k, ps_kernel_texture *out, ps_error *err)
+{
+    if (set->float_buffer)
+        return ps_kernel_texture_make(k, PS_KERNEL_TEXTURE_SIZE, out, err);
+    return ps_kernel_texture_make_halftone(k, PS_KERNEL_HALFTONE_SIZE, out, err);
+}
+
 static ps_status new_tracer(ps_session *s, ps_error *err)
 {
     ps_tracer_options to = ps_tracer_default_options();
@@ -166,7 +175,7 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
     if (st == PS_OK)
         st = new_tracer(s, err);
     if (st == PS_OK)
-        st = ps_kernel_texture_make(set->kernel, PS_KERNEL_TEXTURE_SIZE, &s->kernel, err);
+        st = make_kernel(set, set->kernel, &s->kernel, err);
     if (st == PS_OK)
         st = build_lights(s, err);
     if (st == PS_OK)
@@ -419,7 +428,7 @@ void ps_session_set_splat(ps_session *s, ps_splat_mode mode)
 ps_status ps_session_set_kernel(ps_session *s, ps_kernel kernel, ps_error *err)
 {
     ps_kernel_texture t;
-    ps_status st = ps_kernel_texture_make(kernel, PS_KERNEL_TEXTURE_SIZE, &t, err);
+    ps_status st = make_kernel(&s->set, kernel, &t, err);
     if (st != PS_OK)
         return st;
     ps_kernel_texture_free(&s->kernel);

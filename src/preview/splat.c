@@ -25,7 +25,21 @@ const char *ps_color_depth_name(ps_color_depth d)
 
 /* ---- the kernel texture --------------------------------------------------- */
 
-ps_status ps_kernel_texture_make(ps_kernel k, int size, ps_kernel_texture *out, ps_error *err)
+/* A threshold in [0, 1) for texel (i, j) of a halftone: a fixed integer hash
+ * (Murmur3's finaliser), so that the dither is white noise, with no pattern
+ * of its own for overlapping splats to beat against. */
+static double halftone_threshold(int i, int j)
+{
+    uint32_t h = (uint32_t)i * 0x9E3779B1u ^ (uint32_t)j * 0x85EBCA77u;
+    h ^= h >> 16;
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+    h *= 0xC2B2AE35u;
+    h ^= h >> 16;
+    return (double)(h >> 8) / 16777216.0;
+}
+
+static ps_status make_texture(ps_kernel k, int size, bool halftone, ps_kernel_texture *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
     if (size < 3 || size > 4096) /* extent = size / (size - 2) needs 3 */
@@ -35,13 +49,14 @@ ps_status ps_kernel_texture_make(ps_kernel k, int size, ps_kernel_texture *out, 
         return ps_error_set(err, PS_ERR_NOMEM, "kernel texture: out of memory");
     out->size = size;
     out->extent = (double)size / (double)(size - 2);
+    out->halftone = halftone;
     double sum = 0.0;
     for (int j = 0; j < size; j++)
         for (int i = 0; i < size; i++) {
             /* Texel centres over [-extent, extent]^2, in units of the radius. */
             double x = out->extent * (2.0 * (i + 0.5) / size - 1.0), y = out->extent * (2.0 * (j + 0.5) / size - 1.0);
-            double a = ps_kernel_profile(k, sqrt(x * x + y * y));
-            uint8_t code = (uint8_t)lround(255.0 * fmin(fmax(a, 0.0), 1.0));
+            double a = fmin(fmax(ps_kernel_profile(k, sqrt(x * x + y * y)), 0.0), 1.0);
+            uint8_t code = halftone ? (a > halftone_threshold(i, j) ? 255 : 0) : (uint8_t)lround(255.0 * a);
             out->alpha[(size_t)j * (size_t)size + (size_t)i] = code;
             sum += code / 255.0;
         }
@@ -50,6 +65,16 @@ ps_status ps_kernel_texture_make(ps_kernel k, int size, ps_kernel_texture *out, 
     double texel = 2.0 * out->extent / size;
     out->mean = sum * texel * texel / PS_PI;
     return PS_OK;
+}
+
+ps_status ps_kernel_texture_make(ps_kernel k, int size, ps_kernel_texture *out, ps_error *err)
+{
+    return make_texture(k, size, false, out, err);
+}
+
+ps_status ps_kernel_texture_make_halftone(ps_kernel k, int size, ps_kernel_texture *out, ps_error *err)
+{
+    return make_texture(k, size, true, out, err);
 }
 
 void ps_kernel_texture_free(ps_kernel_texture *t)
@@ -72,6 +97,8 @@ void ps_splat_batch_free(ps_splat_batch *b)
     free(b->colors);
     free(b->texcoords);
     free(b->group);
+    free(b->order);
+    free(b->order_tmp);
     memset(b, 0, sizeof *b);
 }
 
@@ -179,6 +206,64 @@ static double quantise(ps_splat_batch *b, const ps_splat_params *p, int ch, doub
     return c;
 }
 
+/* Where a splat's centre falls on the screen, as a Z-order (Morton) key of
+ * its pixel: interleaved bits of x and y, so that splats near each other on
+ * the screen are near each other in the key's order. */
+static uint32_t spread_bits(uint32_t v)
+{
+    v &= 0xffff;
+    v = (v | (v << 8)) & 0x00ff00ff;
+    v = (v | (v << 4)) & 0x0f0f0f0f;
+    v = (v | (v << 2)) & 0x33333333;
+    v = (v | (v << 1)) & 0x55555555;
+    return v;
+}
+
+static uint32_t z_order(double x, double y)
+{
+    uint32_t ix = x > 0.0 ? (x < 65535.0 ? (uint32_t)x : 65535u) : 0u;
+    uint32_t iy = y > 0.0 ? (y < 65535.0 ? (uint32_t)y : 65535u) : 0u;
+    return spread_bits(ix) | spread_bits(iy) << 1;
+}
+
+/* Error diffusion in screen order. Thesis departure: the thesis carries each
+ * photon's round-off into the next photon in index order, which keeps the
+ * sum but picks the faint photons that get a code at random over the
+ * screen, a noise of its own. Carried along a Z-order curve over the splats'
+ * pixels instead (as Riemersma's dither carries along a Hilbert curve), the
+ * photons that carry a code lie evenly over the screen, and the round-off of
+ * any region of it is under one code. The order is a stable sort of the
+ * batch's splats by their keys (LSD radix on the key, the splat's place as
+ * the tie-break), so the same photons always give the same picture. */
+static void diffuse_in_screen_order(ps_splat_batch *b, const ps_splat_params *p, size_t first_splat, size_t per)
+{
+    size_t n = b->splats - first_splat;
+    uint64_t *a = b->order, *t = b->order_tmp;
+    for (int pass = 0; pass < 4; pass++) { /* the key is the upper 32 bits, 8 at a time */
+        size_t count[257] = {0};
+        int shift = 32 + 8 * pass;
+        for (size_t i = 0; i < n; i++)
+            count[((a[i] >> shift) & 0xff) + 1]++;
+        for (int d = 0; d < 256; d++)
+            count[d + 1] += count[d];
+        for (size_t i = 0; i < n; i++)
+            t[count[(a[i] >> shift) & 0xff]++] = a[i];
+        uint64_t *swap = a;
+        a = t;
+        t = swap;
+    }
+    /* Four passes: the sorted keys are back in b->order. */
+    size_t v0 = b->vertex_count - n * per;
+    for (size_t i = 0; i < n; i++) {
+        size_t v = v0 + (size_t)(a[i] & 0xffffffffu) * per;
+        float *rgba = &b->colors[4 * v];
+        for (int ch = 0; ch < 3; ch++)
+            rgba[ch] = (float)quantise(b, p, ch, rgba[ch]);
+        for (size_t k = 1; k < per; k++)
+            memcpy(&b->colors[4 * (v + k)], rgba, 4 * sizeof *rgba);
+    }
+}
+
 ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
                          ps_splat_batch *b, ps_error *err)
 {
@@ -195,6 +280,9 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
     double disc = 1.0 / (p->kernel_mean * PS_PI * r * r);
     /* Whether the 8-bit handling does anything (hoisted: the loop is hot). */
     bool rounds = p->levels > 0 && p->precision != PS_PRECISION_NONE;
+    bool diffuse = rounds && p->precision == PS_PRECISION_DIFFUSION;
+    if (diffuse && (!PS_RESERVE(b->order, b->cap_order, count) || !PS_RESERVE(b->order_tmp, b->cap_order_tmp, count)))
+        return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
     /* World size of one pixel at unit depth along the view axis. */
     double pixel = 2.0 * cam->tan_half_fov / cam->height;
     for (size_t i = 0; i < count; i++) {
@@ -246,10 +334,16 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
         if (p->mode == PS_SPLAT_SPRITES)
             c = ps_rgb_scale(c, ((dist - lift) / dist) * ((dist - lift) / dist));
         float rgba[4] = {(float)c.r, (float)c.g, (float)c.b, 1.0f};
-        if (rounds) {
+        if (rounds && !diffuse) {
             rgba[0] = (float)quantise(b, p, 0, c.r);
             rgba[1] = (float)quantise(b, p, 1, c.g);
             rgba[2] = (float)quantise(b, p, 2, c.b);
+        } else if (diffuse) {
+            /* Rounded below, in screen order; the exact colour till then. */
+            double px = 0.0, py = 0.0;
+            (void)ps_camera_project(cam, centre, &px, &py);
+            b->order[b->splats - first_splat] =
+                (uint64_t)z_order(px, py) << 32 | (uint64_t)(b->splats - first_splat);
         }
         size_t v = b->vertex_count;
         if (p->mode == PS_SPLAT_TRIANGLES) {
@@ -281,6 +375,8 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
         b->vertex_count += per;
         b->splats++;
     }
+    if (diffuse)
+        diffuse_in_screen_order(b, p, first_splat, per);
     if (p->objects && !group_splats(b, first_splat, per))
         return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory grouping %zu photons", count);
     return PS_OK;
