@@ -180,9 +180,10 @@ static void incremental_refresh_splats_each_photon_once(void **state)
     assert_int_equal(ps_session_stop(s, &err), PS_OK);
     ps_session_destroy(s);
 
-    /* One whole refresh of the same photons: the same splats, scaled by the
-     * exposure (N / n = 1 at the caps). */
+    /* One whole refresh of the same photons (in float: the same smooth
+     * kernel): the same splats, scaled by the exposure (N / n = 1 at the caps). */
     set = settings(scene, false);
+    set.float_buffer = true;
     s = open_session(scene, &set);
     assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
     refresh(s, &cam, &f);
