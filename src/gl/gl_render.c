@@ -279,7 +279,9 @@ static ps_status build_lights(ps_gl_renderer *r, ps_error *err)
     for (size_t l = 0; l < n; l++) {
         const ps_light *L = &lights[l];
         bool ok;
-        if (L->type == PS_LIGHT_POINT) {
+        /* TODO(lead): an IES light drawn as a point of its average intensity
+         * until the preview projects its table (preview/light_profile.h). */
+        if (L->type == PS_LIGHT_POINT || L->type == PS_LIGHT_IES) {
             vlight v = {L->position, {0, 0, 0}, 180.0, 0.0, ps_rgb_scale(L->power, 0.25 * PS_INV_PI), 0, {0}, 0.0};
             ok = push_light(r, &cap, v);
         } else if (L->type == PS_LIGHT_SPOT) {

@@ -63,6 +63,26 @@ static bool visible(worker *wk, const ps_surface *sp, ps_vec3 dir, double dist)
     return !ps_world_occluded(w, r, dist - 2.0 * ps_world_epsilon(w));
 }
 
+/* Radiance at sp towards wo from IES light L (a point luminaire): exact, one
+ * shadow ray; its intensity towards sp is power * candela / flux there. */
+static ps_rgb direct_from_ies(worker *wk, const ps_light *L, const ps_surface *sp, ps_vec3 n, ps_vec3 wo,
+                              const ps_material *m)
+{
+    ps_vec3 to = ps_v3_sub(L->position, sp->p);
+    double d2 = ps_v3_len2(to), d = sqrt(d2);
+    if (!(d > 0.0))
+        return ps_rgb_gray(0.0);
+    ps_vec3 wi = ps_v3_scale(to, 1.0 / d);
+    double cos_x = ps_v3_dot(wi, n);
+    if (cos_x <= 0.0)
+        return ps_rgb_gray(0.0);
+    double density = ps_light_ies_density(wk->job->scene, L, ps_v3_neg(wi)); /* 1/sr */
+    if (!(density > 0.0) || !visible(wk, sp, wi, d))
+        return ps_rgb_gray(0.0);
+    ps_rgb f = ps_bsdf_eval(m, n, ps_v3_neg(wi), wo);
+    return ps_rgb_scale(ps_rgb_mul(f, L->power), density * cos_x / d2);
+}
+
 /* Radiance at sp towards wo from every light, by shadow rays. n: the shading
  * normal on wo's side. */
 static ps_rgb direct_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec3 wo, const ps_material *m, ps_rng *rng)
@@ -71,6 +91,10 @@ static ps_rgb direct_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec3 
     ps_rgb sum = ps_rgb_gray(0.0);
     for (size_t l = 0; l < job->light_count; l++) {
         const ps_light *L = &job->lights[l];
+        if (L->type == PS_LIGHT_IES) {
+            sum = ps_rgb_add(sum, direct_from_ies(wk, L, sp, n, wo, m));
+            continue;
+        }
         if (L->type == PS_LIGHT_POINT || L->type == PS_LIGHT_SPOT) {
             ps_vec3 to = ps_v3_sub(L->position, sp->p);
             double d2 = ps_v3_len2(to), d = sqrt(d2);
