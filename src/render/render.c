@@ -403,12 +403,50 @@ enum { KEY_REFLECT = 1, KEY_REFRACT, KEY_CHOICE, KEY_DIRECT, KEY_GATHER };
 
 static uint64_t child_key(uint64_t key, uint64_t what) { return ps_hash64(key ^ ps_hash64(what)); }
 
+/* ---- illuminance --------------------------------------------------------- */
+
+/* The selected component of the irradiance at the first surface r meets
+ * (render.h, `illuminance`): the split equation's terms for a white
+ * Lambertian surface there, times pi; the caustic term straight from the map. */
+static ps_rgb illuminance_at(worker *wk, ps_ray r, uint64_t key)
+{
+    const render_job *job = wk->job;
+    ps_component want = job->o->component;
+    ps_surface sp;
+    wk->rays++;
+    if (!ps_world_intersect(job->world, r, INFINITY, &sp))
+        return ps_rgb_gray(0.0);
+    ps_material white;
+    memset(&white, 0, sizeof white);
+    white.type = PS_MAT_DIFFUSE;
+    white.albedo = ps_rgb_gray(1.0);
+    bool front = ps_v3_dot(r.d, sp.ng) < 0.0;
+    ps_vec3 n = front ? sp.ns : ps_v3_neg(sp.ns);
+    ps_vec3 wo = ps_v3_neg(r.d);
+    ps_rgb sum = ps_rgb_gray(0.0);
+    if (wants(want, PS_COMPONENT_DIRECT)) {
+        ps_rng rng = ps_rng_make(key, KEY_DIRECT, 0);
+        sum = ps_rgb_add(sum, ps_rgb_scale(direct_light(wk, &sp, n, wo, &white, &rng), PS_PI));
+    }
+    if (wants(want, PS_COMPONENT_CAUSTIC) && job->maps->caustic)
+        sum = ps_rgb_add(sum, ps_photon_irradiance(job->maps->caustic, sp.p, n, &job->o->caustic, wk->scratch));
+    if (wants(want, PS_COMPONENT_INDIRECT)) {
+        ps_rng rng = ps_rng_make(key, KEY_GATHER, 0);
+        sum = ps_rgb_add(sum, ps_rgb_scale(indirect_light(wk, &sp, n, wo, &white, &rng, true), PS_PI));
+    }
+    return sum;
+}
+
+/* ---- eye paths (continued) ------------------------------------------------ */
+
 /* The selected component of the radiance arriving along r. `through`: the
  * path has met a mirror or glass already (so all it sees is specular). */
 static ps_rgb radiance(worker *wk, ps_ray r, int depth, bool through, uint64_t key)
 {
     const render_job *job = wk->job;
     ps_component want = job->o->component;
+    if (job->o->illuminance && depth == 0)
+        return illuminance_at(wk, r, key);
     if (depth > PS_RENDER_MAX_SPECULAR || (through && !wants(want, PS_COMPONENT_SPECULAR)))
         return ps_rgb_gray(0.0);
     ps_surface sp;
