@@ -187,7 +187,7 @@ double ps_ies_sample(const ps_ies *ies, double u0, double u1, double u2, double 
 /* ---- reading ------------------------------------------------------------------ */
 
 typedef struct reader {
-    const char *p, *end;
+    const char *p, *end, *start;
     const char *name;
     int line;
     ps_error *err;
@@ -220,6 +220,12 @@ static bool next_word(reader *r, char *buf, int *line, bool *too_long)
     return true;
 }
 
+/* The file's last line, for problems found at its end. */
+static int end_line(const reader *r)
+{
+    return r->line > 1 && r->p > r->start && r->p[-1] == '\n' ? r->line - 1 : r->line;
+}
+
 /* One number of the data; `what` names it in messages ("the number of vertical angles"). */
 static ps_status read_number(reader *r, const char *what, double *out, int *at)
 {
@@ -227,7 +233,7 @@ static ps_status read_number(reader *r, const char *what, double *out, int *at)
     bool too_long;
     int line = r->line;
     if (!next_word(r, buf, &line, &too_long))
-        return ps_error_set(r->err, PS_ERR_PARSE, "%s:%d: the file ends before %s", r->name, r->line, what);
+        return ps_error_set(r->err, PS_ERR_PARSE, "%s:%d: the file ends before %s", r->name, end_line(r), what);
     if (at)
         *at = line;
     if (too_long)
@@ -261,7 +267,7 @@ static ps_status read_angles(reader *r, const char *what, int n, double lo, doub
         int line;
         ps_status st = read_number(r, what, &out[k], &line);
         if (st == PS_ERR_PARSE && r->p >= r->end)
-            return ps_error_set(r->err, PS_ERR_PARSE, "%s:%d: the file ends after %d of the %d %s", r->name, r->line,
+            return ps_error_set(r->err, PS_ERR_PARSE, "%s:%d: the file ends after %d of the %d %s", r->name, end_line(r),
                                 k, n, what);
         if (st != PS_OK)
             return st;
@@ -524,10 +530,9 @@ static ps_status parse(ps_ies *ies, reader *r)
     }
     int hline = 0;
     st = read_angles(r, "vertical angles", nv, 0.0, 180.0, vdeg);
-    if (st == PS_OK) {
-        hline = r->line;
+    if (st == PS_OK)
         st = read_angles(r, "horizontal angles", nh, 0.0, 360.0, hdeg);
-    }
+    hline = r->line; /* the last horizontal angle's: where the symmetry shows */
     size_t total = (size_t)nv * (size_t)nh;
     for (size_t k = 0; st == PS_OK && k < total; k++) {
         int line;
@@ -535,7 +540,7 @@ static ps_status parse(ps_ies *ies, reader *r)
         bool too_long;
         if (!next_word(r, buf, &line, &too_long)) {
             st = ps_error_set(r->err, PS_ERR_PARSE, "%s:%d: the candela table ends after %zu of its %zu values",
-                              r->name, r->line, k, total);
+                              r->name, end_line(r), k, total);
             break;
         }
         if (too_long || !ps_parse_double(buf, &cd[k])) {
@@ -606,11 +611,11 @@ ps_status ps_ies_parse(const char *text, size_t len, const char *name, ps_ies **
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", name);
     }
     memcpy(ies->name, name, nlen + 1);
-    reader r = {text, text + len, name, 1, err};
+    reader r = {text, text + len, text, name, 1, err};
     ps_status st = parse(ies, &r);
     if (st == PS_OK && !(ies->flux > 0.0))
         st = ps_error_set(err, PS_ERR_RANGE, "%s:%d: the candela table is all zero: the luminaire emits nothing", name,
-                          r.line);
+                          end_line(&r));
     if (st != PS_OK) {
         ps_ies_destroy(ies);
         return st;
