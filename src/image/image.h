@@ -82,6 +82,9 @@ ps_status ps_png_read(const char *path, ps_image *out, ps_error *err);
 /* PFM: "PF\n<w> <h>\n-1.0\n", then rows bottom to top as little-endian 32-bit
  * floats, linear, no exposure (every value written as is, NaN included). */
 ps_status ps_pfm_write(const ps_image *img, const char *path, ps_error *err);
+/* The one-channel form, "Pf": width x height values, rows top first (an
+ * illuminance image in lux). */
+ps_status ps_pfm_write_gray(const float *values, int width, int height, const char *path, ps_error *err);
 /* "PF" (RGB) and "Pf" (gray, replicated to RGB) with any whitespace between
  * header tokens; negative scale means little-endian, positive big-endian, zero
  * is an error. The scale's magnitude is not applied: values are returned as
