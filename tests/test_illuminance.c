@@ -280,6 +280,50 @@ static void closed_room(void **state)
     rig_free(&r);
 }
 
+/* A closed cubic room (side 2, S = 24 m^2) of reflectance 0.5 with 1000 lm
+ * off its centre: the illuminance averaged over all its surfaces is
+ * F / (S (1 - rho)) = 83.33 lx, however unevenly it falls. Six views from the
+ * centre, fov 90, each see one wall whole; a pinhole maps a wall parallel to
+ * its image plane uniformly onto the pixels, so each wall's mean is its
+ * pixels' mean, and the walls are equal. The direct part alone averages F / S. */
+static void closed_box_room(void **state)
+{
+    (void)state;
+    static const char *const views[6] = {"1 0 0 up 0 1 0",  "-1 0 0 up 0 1 0", "0 1 0 up 0 0 1",
+                                         "0 -1 0 up 0 0 1", "0 0 1 up 0 1 0",  "0 0 -1 up 0 1 0"};
+    const char *room = "material wall diffuse albedo 0.5 0.5 0.5\n"
+                       "quad corner -1 -1 -1 edge1 2 0 0 edge2 0 0 2 material wall\n"
+                       "quad corner -1 1 -1 edge1 0 0 2 edge2 2 0 0 material wall\n"
+                       "quad corner -1 -1 -1 edge1 0 2 0 edge2 2 0 0 material wall\n"
+                       "quad corner -1 -1 1 edge1 2 0 0 edge2 0 2 0 material wall\n"
+                       "quad corner -1 -1 -1 edge1 0 0 2 edge2 0 2 0 material wall\n"
+                       "quad corner 1 -1 -1 edge1 0 2 0 edge2 0 0 2 material wall\n"
+                       "light point position 0.3 0.4 -0.2 lumens 1000\n";
+    ps_estimate_options est = {100, 0.3, PS_KERNEL_BOX};
+    double direct = 0, all = 0;
+    for (int v = 0; v < 6; v++) {
+        char text[2048];
+        snprintf(text, sizeof text, "camera eye 0 0 0 target %s fov 90\n%s", views[v], room);
+        rig r = rig_make(text, 0, 40000, &est, true);
+        ps_render_options o = options(12, 12, 4, PS_COMPONENT_DIRECT, &est, 16);
+        ps_image img = render_lux(&r, &o);
+        direct += image_mean(&img) / 6;
+        ps_image_destroy(&img);
+        o = options(12, 12, 4, PS_COMPONENT_ALL, &est, 16);
+        o.cache_spacing = 2;
+        o.cache_rays = 256;
+        img = render_lux(&r, &o);
+        all += image_mean(&img) / 6;
+        ps_image_destroy(&img);
+        rig_free(&r);
+    }
+    double S = 24.0;
+    printf("closed box room: direct %.3f lx (F / S = %.3f), all %.3f lx (F / (S (1 - rho)) = %.3f)\n", direct,
+           1000.0 / S, all, 1000.0 / (S * 0.5));
+    assert_near(direct, 1000.0 / S, 0.01 * 1000.0 / S);
+    assert_near(all, 1000.0 / (S * 0.5), 0.03 * 1000.0 / (S * 0.5));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -287,6 +331,7 @@ int main(void)
         cmocka_unit_test(ies_at_points),
         cmocka_unit_test(disc_on_axis),
         cmocka_unit_test(closed_room),
+        cmocka_unit_test(closed_box_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
