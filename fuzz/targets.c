@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "image/exr_io.h"
 #include "image/image.h"
 #include "scene/ies.h"
 #include "scene/scene.h"
@@ -324,6 +325,11 @@ ps_status ps_fuzz_png(const uint8_t *data, size_t size, ps_error *err)
 ps_status ps_fuzz_pfm(const uint8_t *data, size_t size, ps_error *err)
 {
     return read_image(data, size, "fuzz.pfm", ps_pfm_read, false, err);
+}
+
+ps_status ps_fuzz_exr(const uint8_t *data, size_t size, ps_error *err)
+{
+    return read_image(data, size, "fuzz.exr", ps_exr_read, false, err);
 }
 
 /* Directions probed in an accepted table: a fixed grid, so a finding replays. */

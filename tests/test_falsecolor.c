@@ -192,9 +192,15 @@ static void exr_rgb(void **state)
     assert_int_equal(fread(magic, 1, 4, f), 4);
     fclose(f);
     assert_true(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01);
+    /* ps_image_read (photosplat-compare's reader) tells EXR by its magic. */
+    ps_image_format fmt;
+    ps_image sniffed;
+    assert_int_equal(ps_image_read(path, &sniffed, &fmt, &err), PS_OK);
+    assert_int_equal(fmt, PS_IMAGE_EXR);
+    assert_true(ps_image_at(&sniffed, 5, 7)[2] == ps_image_at(&img, 5, 7)[2]);
+    ps_image_destroy(&sniffed);
     /* A .pfm name is a PFM. */
     assert_int_equal(ps_hdr_write(&img, test_path("rgb.pfm"), &err), PS_OK);
-    ps_image_format fmt;
     ps_image p2;
     assert_int_equal(ps_image_read(test_path("rgb.pfm"), &p2, &fmt, &err), PS_OK);
     assert_int_equal(fmt, PS_IMAGE_PFM);
