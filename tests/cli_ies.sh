@@ -31,6 +31,11 @@ expect_match "stats: lumens" "$(cat "$cli_tmp/s.json")" '"luminous_flux_lm": 120
 expect_success "illuminance as exr, direct only" "$ref" "$scene" "${fast[@]}" --illuminance "$cli_tmp/lux.exr" --component direct
 [ "$(od -An -tx1 -N4 "$cli_tmp/lux.exr" 2>/dev/null | tr -d ' ')" = "762f3101" ] && ok || bad "lux.exr has no OpenEXR magic"
 
+# The same run's radiance as PFM and as EXR (float): photosplat-compare reads both, no difference.
+expect_success "hdr as pfm" "$ref" "$scene" "${fast[@]}" --hdr "$cli_tmp/rad.pfm"
+expect_success "compare exr with pfm" "$bin/photosplat-compare" "$cli_tmp/rad.exr" "$cli_tmp/rad.pfm"
+expect_match "exr equals pfm" "$cli_out" '^rmse=0 relmse=0 '
+
 expect_usage_error "illuminance into a missing folder" "$ref" "$scene" "${fast[@]}" --illuminance /nonexistent/dir/l.pfm
 expect_usage_error "false colour into a missing folder" "$ref" "$scene" "${fast[@]}" --false-color /nonexistent/dir/l.png
 
