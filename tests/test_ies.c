@@ -129,6 +129,20 @@ static void closed_form_flux(void **state)
     ps_ies_destroy(ies);
 }
 
+/* Sizes beyond the limits are refused before anything is allocated. */
+static void limits(void **state)
+{
+    (void)state;
+    const char *many = "IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2000 1000 1 2 0 0 0\n1 1 0\n";
+    const char *angles = "IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 20000 1 1 2 0 0 0\n1 1 0\n";
+    ps_ies *ies;
+    ps_error err;
+    assert_int_equal(ps_ies_parse(many, strlen(many), "m.ies", &ies, &err), PS_ERR_LIMIT);
+    assert_non_null(strstr(err.msg, "m.ies:3: 2000 x 1000 candela values are more than"));
+    assert_int_equal(ps_ies_parse(angles, strlen(angles), "a.ies", &ies, &err), PS_ERR_LIMIT);
+    assert_non_null(strstr(err.msg, "a.ies:3: the number of vertical angles: 20000 is outside"));
+}
+
 /* Every file of tests/data/ies-bad is refused with "file:LINE: FRAGMENT" as
  * its `[_EXPECT] LINE: FRAGMENT` line says; a directory is refused too. */
 static void bad_corpus(void **state)
@@ -439,7 +453,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(good_corpus),       cmocka_unit_test(formats_and_factors),
-        cmocka_unit_test(closed_form_flux),  cmocka_unit_test(bad_corpus),
+        cmocka_unit_test(closed_form_flux),  cmocka_unit_test(bad_corpus), cmocka_unit_test(limits),
         cmocka_unit_test(sampler_matches_table), cmocka_unit_test(photometric_units),
         cmocka_unit_test(ies_light_frame),   cmocka_unit_test(photons_carry_lumens),
         cmocka_unit_test(cone_weighting),

@@ -24,7 +24,7 @@
 /* What is refused with PS_ERR_LIMIT before any allocation. */
 #define PS_IES_MAX_BYTES ((size_t)16 << 20)
 #define PS_IES_MAX_ANGLES 10000   /* vertical or horizontal */
-#define PS_IES_MAX_VALUES 4000000 /* vertical x horizontal */
+#define PS_IES_MAX_VALUES 1000000 /* vertical x horizontal (real files: at most 181 x 361) */
 #define PS_IES_MAX_CANDELA 1e30
 
 typedef struct ps_ies ps_ies;
