@@ -140,11 +140,15 @@ ps_status ps_exr_read(const char *path, ps_image *out, ps_error *err)
     if (rv == EXR_ERR_SUCCESS) {
         w = (int64_t)dw.max.x - dw.min.x + 1;
         h = (int64_t)dw.max.y - dw.min.y + 1;
-        st = ps_image_create((int)(w > 0 && w < (1 << 30) ? w : 0), (int)(h > 0 && h < (1 << 30) ? h : 0), out,
-                             err);
+        /* The data window is the file's word: check it before allocating
+         * (found by fuzzing: a window of 134217978 x 20). */
+        ps_error sub;
+        st = ps_image_check_size(w, h, &sub);
+        if (st == PS_OK)
+            st = ps_image_create((int)w, (int)h, out, &sub);
         if (st != PS_OK) {
             exr_finish(&ctx);
-            return st;
+            return ps_error_set(err, st, "%s: %s", path, sub.msg);
         }
     }
     int32_t lines = 1;
