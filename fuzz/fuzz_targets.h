@@ -35,4 +35,13 @@ ps_status ps_fuzz_png(const uint8_t *data, size_t size, ps_error *err);
 /* ps_pfm_read on data as a file. */
 ps_status ps_fuzz_pfm(const uint8_t *data, size_t size, ps_error *err);
 
+/* ps_exr_read (OpenEXR's C API) on data as a file. */
+ps_status ps_fuzz_exr(const uint8_t *data, size_t size, ps_error *err);
+
+/* ps_ies_parse on data as an LM-63 file called `name`; a table it accepts
+ * must give finite, non-negative candela no larger than its peak in every
+ * direction, a positive finite flux, and samples inside the sphere whose
+ * density is the candela over the flux. */
+ps_status ps_fuzz_ies(const uint8_t *data, size_t size, const char *name, ps_error *err);
+
 #endif

@@ -9,7 +9,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "image/exr_io.h"
 #include "image/image.h"
+#include "scene/ies.h"
 #include "scene/scene.h"
 
 /* Room for a temporary directory, and for it with a file name appended. */
@@ -323,4 +325,45 @@ ps_status ps_fuzz_png(const uint8_t *data, size_t size, ps_error *err)
 ps_status ps_fuzz_pfm(const uint8_t *data, size_t size, ps_error *err)
 {
     return read_image(data, size, "fuzz.pfm", ps_pfm_read, false, err);
+}
+
+ps_status ps_fuzz_exr(const uint8_t *data, size_t size, ps_error *err)
+{
+    return read_image(data, size, "fuzz.exr", ps_exr_read, false, err);
+}
+
+/* Directions probed in an accepted table: a fixed grid, so a finding replays. */
+#define IES_PROBES 24
+
+ps_status ps_fuzz_ies(const uint8_t *data, size_t size, const char *name, ps_error *err)
+{
+    ps_ies *ies = NULL;
+    ps_status st = ps_ies_parse((const char *)data, size, name, &ies, err);
+    if (st != PS_OK) {
+        check_error(st, err, name);
+        if (ies)
+            broken("ies: an error returned a table");
+        return st;
+    }
+    double flux = ps_ies_flux(ies), peak = ps_ies_peak(ies);
+    if (!(flux > 0.0) || !isfinite(flux) || !(peak > 0.0) || !isfinite(peak))
+        broken("ies: accepted with flux %g, peak %g", flux, peak);
+    const double pi = 3.14159265358979323846;
+    for (int i = 0; i <= IES_PROBES; i++)
+        for (int j = 0; j <= IES_PROBES; j++) {
+            double t = pi * i / IES_PROBES, p = 2.0 * pi * j / IES_PROBES - pi;
+            double c = ps_ies_candela(ies, t, p);
+            if (!(c >= 0.0) || !(c <= peak * (1.0 + 1e-9)))
+                broken("ies: candela %g at (%g, %g), peak %g", c, t, p, peak);
+            double u0 = (i + 0.5) / (IES_PROBES + 1), u1 = (j + 0.5) / (IES_PROBES + 1), u2 = (i * 7 + j) % 25 / 25.0;
+            double th, ph, pdf = ps_ies_sample(ies, u0, u1, u2, &th, &ph);
+            if (!(th >= 0.0 && th <= pi) || !isfinite(ph) || !(pdf >= 0.0) || !isfinite(pdf))
+                broken("ies: sample (%g, %g) with density %g", th, ph, pdf);
+        }
+    ps_ies *copy = NULL;
+    if (ps_ies_clone(ies, &copy, err) == PS_OK && ps_ies_flux(copy) != flux)
+        broken("ies: the clone's flux differs");
+    ps_ies_destroy(copy);
+    ps_ies_destroy(ies);
+    return PS_OK;
 }

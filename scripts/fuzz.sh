@@ -3,7 +3,7 @@
 # bounded time; `make fuzz` calls it. See docs/fuzzing.md.
 #
 #   FUZZ_SECONDS=60         seconds per target
-#   FUZZ_TARGETS_RUN="scene obj png pfm"   which targets, in order
+#   FUZZ_TARGETS_RUN="scene obj png pfm ies exr"   which targets, in order
 #   FUZZ_ARGS=""            more libFuzzer flags (e.g. -only_ascii=1)
 #
 # Prints one line per target (executions, findings) and exits 1 when any
@@ -13,7 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 FUZZ_SECONDS=${FUZZ_SECONDS:-60}
-FUZZ_TARGETS_RUN=${FUZZ_TARGETS_RUN:-"scene obj png pfm"}
+FUZZ_TARGETS_RUN=${FUZZ_TARGETS_RUN:-"scene obj png pfm ies exr"}
 FUZZ_ARGS=${FUZZ_ARGS:-}
 JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 # Per input: 10 s is a hang (the readers take milliseconds); 2 GiB of memory
@@ -33,6 +33,8 @@ seeds_of() {
     obj) ls tests/data/good/*.obj fuzz/seeds/obj/* ;;
     png) ls tests/data/golden/*.png fuzz/seeds/png/* ;;
     pfm) ls tests/data/golden/*.pfm fuzz/seeds/pfm/* ;;
+    ies) ls data/ies/*.ies tests/data/ies-good/*.ies tests/data/ies-bad/*.ies ;;
+    exr) ls fuzz/seeds/exr/* ;;
     esac
     # Earlier findings, kept as regression inputs.
     if [ -d "tests/data/fuzz/$1" ]; then find "tests/data/fuzz/$1" -type f; fi
@@ -41,14 +43,15 @@ seeds_of() {
 # each execution stays fast.
 max_len_of() {
     case $1 in
-    scene | obj) echo 16384 ;;
-    png | pfm) echo 65536 ;;
+    scene | obj | ies) echo 16384 ;;
+    png | pfm | exr) echo 65536 ;;
     esac
 }
 dict_of() {
     case $1 in
     scene) echo fuzz/scene.dict ;;
     obj) echo fuzz/obj.dict ;;
+    ies) echo fuzz/ies.dict ;;
     esac
 }
 

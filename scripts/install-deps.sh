@@ -20,6 +20,8 @@ need_cmd pkg-config pkg-config
 need_pc libpng libpng-dev
 need_pc tinyobjloader libtinyobjloader-dev
 need_pc cmocka libcmocka-dev
+# OpenEXR for --hdr FILE.exr (its C API, OpenEXRCore, from 3.1).
+need_pc OpenEXR libopenexr-dev
 # photosplat-snap draws with OSMesa (libosmesa6-dev brings the GL headers too).
 need_pc osmesa libosmesa6-dev
 # The window: GLFW and libGL; its tests run it under a virtual X server.

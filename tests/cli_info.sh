@@ -25,6 +25,7 @@ declare -A lights=(
     [data/scenes/cornell-caustic-area.scn]='^lights +1, total power 100 100 100 W'
     [data/scenes/ring-caustic.scn]='^lights +1, total power 16 16 16 W'
     [data/scenes/design-room.scn]='^lights +2, total power 110 103 94 W'
+    [data/scenes/gallery.scn]='^lights +7, total power 18.393 17.6186 16.6865 W, 12100 lm'
 )
 for scene in data/scenes/*.scn; do
     expect_success "$scene" "$info" "$scene"

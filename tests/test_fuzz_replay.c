@@ -59,6 +59,16 @@ static ps_status run_pfm(const uint8_t *data, size_t size, const char *path, ps_
     return ps_fuzz_pfm(data, size, err);
 }
 
+static ps_status run_exr(const uint8_t *data, size_t size, const char *path, ps_error *err)
+{
+    (void)path;
+    return ps_fuzz_exr(data, size, err);
+}
+static ps_status run_ies(const uint8_t *data, size_t size, const char *path, ps_error *err)
+{
+    return ps_fuzz_ies(data, size, path, err);
+}
+
 static int by_name(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
 
 /* The regular files in dir whose names end in suffix ("" for all), sorted;
@@ -178,6 +188,25 @@ static void seeds_load(void **state)
     assert_true(replay_dir("tests/data/golden", ".png", run_png, PS_OK) >= 1);
     assert_true(replay_dir("fuzz/seeds/pfm", "", run_pfm, PS_OK) >= 3);
     assert_true(replay_dir("tests/data/golden", ".pfm", run_pfm, PS_OK) >= 1);
+    assert_int_equal(replay_dir("fuzz/seeds/exr", "", run_exr, PS_OK), 3);
+    /* The LM-63 target: the bundled and good files load, the bad corpus is
+     * refused (test_ies checks each message's line). */
+    assert_int_equal(replay_dir("data/ies", ".ies", run_ies, PS_OK), 3);
+    assert_int_equal(replay_dir("tests/data/ies-good", ".ies", run_ies, PS_OK), 6);
+    char *names[MAX_FILES];
+    int count = list_files("tests/data/ies-bad", ".ies", names);
+    assert_true(count >= 20);
+    for (int i = 0; i < count; i++) {
+        char path[1024];
+        snprintf(path, sizeof path, "tests/data/ies-bad/%s", names[i]);
+        size_t size;
+        uint8_t *data = read_all(path, &size);
+        ps_error err;
+        if (run_ies(data, size, path, &err) == PS_OK)
+            fail_msg("%s: accepted, but should have been refused", path);
+        free(data);
+        free(names[i]);
+    }
 }
 
 /* A growable text buffer for generated inputs. */
@@ -319,6 +348,16 @@ static void pfm_findings(void **state)
     (void)state;
     replay_findings("pfm", run_pfm);
 }
+static void exr_findings(void **state)
+{
+    (void)state;
+    replay_findings("exr", run_exr);
+}
+static void ies_findings(void **state)
+{
+    (void)state;
+    replay_findings("ies", run_ies);
+}
 
 int main(void)
 {
@@ -336,6 +375,8 @@ int main(void)
         cmocka_unit_test(obj_findings),
         cmocka_unit_test(png_findings),
         cmocka_unit_test(pfm_findings),
+        cmocka_unit_test(ies_findings),
+        cmocka_unit_test(exr_findings),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
     rmdir(scratch);

@@ -1,4 +1,4 @@
-/* compare_main.c: photosplat-compare, error metrics between two images (PNG or PFM). */
+/* compare_main.c: photosplat-compare, error metrics between two images (PNG, PFM or OpenEXR). */
 #include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
@@ -20,7 +20,7 @@ static const char usage[] =
     "  psnr   = 10 log10(1 / mean (a-b)^2) in dB, peak 1.0; inf when identical\n"
     "  mean_a, mean_b = mean value of A, of B\n"
     "\n"
-    "A and B are PNG or PFM files, told apart by their contents, not their names,\n"
+    "A and B are PNG, PFM or OpenEXR files, told apart by their contents, not their names,\n"
     "and must have the same size.\n"
     "Values compared: PFM as stored (linear radiance); PNG as stored, the\n"
     "sRGB-encoded codes scaled to [0,1]. When one image is PNG and the other PFM,\n"

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "app/cli.h"
+#include "scene/ies.h"
 #include "scene/scene.h"
 
 static const char usage[] =
@@ -71,7 +72,8 @@ static void describe(const ps_scene *s)
            count[PS_OBJ_MESH], count[PS_OBJ_QUAD], count[PS_OBJ_SPHERE], ntri, npos, specular);
 
     ps_rgb total = ps_scene_total_power(s);
-    printf("lights     %zu, total power %g %g %g W\n", nlight, total.r, total.g, total.b);
+    printf("lights     %zu, total power %g %g %g W, %g lm\n", nlight, total.r, total.g, total.b,
+           ps_scene_total_lumens(s));
     for (size_t i = 0; i < nlight; i++) {
         const ps_light *l = &lights[i];
         printf("  %-6s", ps_light_type_name(l->type));
@@ -81,6 +83,12 @@ static void describe(const ps_scene *s)
             printf(" half-angle %g deg", l->angle_deg);
         if (l->area > 0.0)
             printf(" area %g m2", l->area);
+        if (l->type == PS_LIGHT_IES) {
+            const ps_ies *ies = ps_scene_ies_profile(s, l->profile);
+            const ps_ies_info *in = ps_ies_get_info(ies);
+            printf(" %s (%s, %d x %d angles, %g lm in the table, peak %g cd)", ps_ies_name(ies), in->format,
+                   in->vertical_count, in->horizontal_count, ps_ies_flux(ies), ps_ies_peak(ies));
+        }
         printf(" (line %d)\n", l->line);
     }
     printf("photons    caustic %lld, global %lld\n", (long long)d->caustic_photons, (long long)d->global_photons);

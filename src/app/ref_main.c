@@ -11,10 +11,13 @@
 #include "app/interrupt.h"
 #include "app/options.h"
 #include "app/stats.h"
+#include "core/fileio.h"
 #include "photon/estimate.h"
 #include "photon/kdtree.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
+#include "image/exr_io.h"
+#include "image/falsecolor.h"
 #include "render/render.h"
 #include "scene/scene.h"
 
@@ -45,7 +48,12 @@ static const char usage[] =
     "\n"
     "options:\n"
     "  -o FILE.png              8-bit PNG, sRGB after exposure\n"
-    "  --hdr FILE.pfm           linear radiance (W sr^-1 m^-2), little-endian PFM\n"
+    "  --hdr FILE.pfm|FILE.exr  linear radiance (W sr^-1 m^-2): little-endian PFM, or OpenEXR\n"
+    "                           (32-bit float, ZIP) when the name ends in .exr\n"
+    "  --illuminance FILE.pfm   one-channel PFM (or .exr) of the illuminance in lux falling on\n"
+    "                           the surface seen in each pixel, whatever its albedo\n"
+    "                           (--component applies)\n"
+    "  --false-color FILE.png   the same as a false-colour picture with a logarithmic legend in lux\n"
     "  --size WxH               image size (default from the scene)\n"
     "  --exposure E             radiance multiplier before encoding (default 1)\n"
     "  --caustic-photons N      photons emitted for the caustic map (default from the scene)\n"
@@ -81,6 +89,7 @@ typedef struct ref_options {
     int component, kernel;
     bool photons_only;
     bool cones, first_hit;
+    const char *out_lux, *out_false; /* --illuminance, --false-color */
     int accel;
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM */
 } ref_options;
@@ -127,6 +136,10 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
             st = ps_cli_choice(&cli, components, &o->component, err);
         } else if (ps_cli_is(&cli, "--kernel")) {
             st = ps_cli_choice(&cli, ps_kernel_names, &o->kernel, err);
+        } else if (ps_cli_is(&cli, "--illuminance")) {
+            st = ps_cli_string(&cli, &o->out_lux, err);
+        } else if (ps_cli_is(&cli, "--false-color")) {
+            st = ps_cli_string(&cli, &o->out_false, err);
         } else if (ps_cli_is(&cli, "--photons-only")) {
             o->photons_only = true;
         } else if (ps_cli_is(&cli, "--caustic-cones")) {
@@ -145,9 +158,10 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
         return st;
     if (!o->c.scene)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-ref: no scene given (see --help)");
-    if (!o->photons_only && !o->c.out_png && !o->c.out_hdr)
+    if (!o->photons_only && !o->c.out_png && !o->c.out_hdr && !o->out_lux && !o->out_false)
         return ps_error_set(err, PS_ERR_PARSE,
-                            "photosplat-ref: nothing to write: give -o FILE.png, --hdr FILE.pfm or --photons-only");
+                            "photosplat-ref: nothing to write: give -o FILE.png, --hdr FILE.pfm, --illuminance "
+                            "FILE.pfm, --false-color FILE.png or --photons-only");
     return PS_OK;
 }
 
@@ -177,6 +191,7 @@ typedef struct ref_run {
     ps_kdtree *trees[PS_MAP_COUNT], *full_tree, *irradiance;
     ps_light_sampler *lights;
     ps_image image;
+    ps_image lux_image; /* --illuminance, --false-color: the irradiance (W m^-2) */
 } ref_run;
 
 static void ref_run_free(ref_run *r)
@@ -190,9 +205,43 @@ static void ref_run_free(ref_run *r)
     ps_kdtree_destroy(r->irradiance);
     ps_light_sampler_destroy(r->lights);
     ps_image_destroy(&r->image);
+    ps_image_destroy(&r->lux_image);
     ps_tracer_destroy(r->full_tracer);
     ps_tracer_destroy(r->tracer);
     ps_world_destroy(r->world);
+}
+
+/* The irradiance image of --illuminance / --false-color: a second pass of
+ * the same options with the first surfaces taken as white Lambertian
+ * (render.h); its rays and time add to the first's. */
+static ps_status render_illuminance(ref_run *r, const ps_render_maps *maps, ps_render_options *ro,
+                                    ps_render_stats *stats, ps_error *err)
+{
+    ps_render_stats more = {0, 0.0, 0.0};
+    ro->illuminance = true;
+    ps_status st = ps_render(r->world, r->lights, maps, ro, &r->lux_image, &more, err);
+    ro->illuminance = false;
+    stats->rays += more.rays;
+    stats->seconds += more.seconds;
+    stats->fraction = more.fraction;
+    return st;
+}
+
+/* --illuminance and --false-color from the irradiance image, in lux. */
+static ps_status write_illuminance(const ref_options *o, const ps_image *irr, ps_error *err)
+{
+    size_t n = (size_t)irr->width * (size_t)irr->height;
+    float *lux = malloc(n * sizeof *lux);
+    if (!lux)
+        return ps_error_set(err, PS_ERR_NOMEM, "photosplat-ref: out of memory for the illuminance image");
+    ps_lux_from_irradiance(irr, lux);
+    ps_status st = PS_OK;
+    if (o->out_lux)
+        st = ps_gray_write(lux, irr->width, irr->height, o->out_lux, err);
+    if (st == PS_OK && o->out_false)
+        st = ps_falsecolor_write(lux, irr->width, irr->height, o->out_false, err);
+    free(lux);
+    return st;
 }
 
 /* What the image needs beyond the two maps: the kd-trees, and for final
@@ -252,8 +301,10 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
         ro.progress_user = &pr;
     }
     ps_render_stats stats = {0, 0.0, 0.0};
-    if (st == PS_OK)
+    if (st == PS_OK && (o->c.out_png || o->c.out_hdr))
         st = ps_render(r->world, r->lights, &maps, &ro, &r->image, &stats, err);
+    if (st == PS_OK && (o->out_lux || o->out_false))
+        st = render_illuminance(r, &maps, &ro, &stats, err);
     rs->rays += stats.rays;
     rs->ray_seconds = rs->trace_seconds + t_prep + stats.seconds;
     ps_stats_add(rs, "maps_seconds", t_prep);
@@ -325,6 +376,7 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
         ps_accel_stats as;
         ps_accel_get_stats(ps_world_accel(r.world), &as);
         ps_stats_add(&rs, "threads", ps_tracer_threads(r.tracer));
+        ps_stats_add(&rs, "luminous_flux_lm", ps_scene_total_lumens(scene));
         ps_stats_add(&rs, "seed", (double)o->c.seed);
         ps_stats_add(&rs, "accel_build_seconds", t_build);
         ps_stats_add(&rs, "accel_nodes", (double)as.nodes);
@@ -340,7 +392,9 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
     if (st == PS_OK && ps_cancelled(o->cancel))
         st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after the whole image, before writing it");
     if (st == PS_OK && !o->photons_only && o->c.out_hdr)
-        st = ps_pfm_write(&r.image, o->c.out_hdr, err);
+        st = ps_hdr_write(&r.image, o->c.out_hdr, err);
+    if (st == PS_OK && !o->photons_only && (o->out_lux || o->out_false))
+        st = write_illuminance(o, &r.lux_image, err);
     if (st == PS_OK && !o->photons_only && o->c.out_png)
         st = ps_png_write(&r.image, o->c.out_png, (float)o->c.exposure, err);
     if (st == PS_OK && o->c.dump)
@@ -358,6 +412,10 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
             printf("wrote %s\n", o->c.out_png);
         if (o->c.out_hdr)
             printf("wrote %s\n", o->c.out_hdr);
+        if (o->out_lux)
+            printf("wrote %s\n", o->out_lux);
+        if (o->out_false)
+            printf("wrote %s\n", o->out_false);
     }
     ref_run_free(&r);
     return st;
@@ -375,7 +433,8 @@ int main(int argc, char **argv)
         fputs(usage, stdout);
         return PS_EXIT_OK;
     }
-    if (ps_check_outputs(&o.c, &err) != PS_OK)
+    if (ps_check_outputs(&o.c, &err) != PS_OK || (o.out_lux && ps_check_output_path(o.out_lux, &err) != PS_OK) ||
+        (o.out_false && ps_check_output_path(o.out_false, &err) != PS_OK))
         return ps_cli_fail(&err);
     o.cancel = ps_interrupt_install();
     ps_scene *scene;

@@ -18,10 +18,12 @@
 #ifndef PS_GL_GL_FONT_H
 #define PS_GL_GL_FONT_H
 
-#define PS_FONT_GLYPH_W 5
-#define PS_FONT_GLYPH_H 7
-#define PS_FONT_CELL_W 6
-#define PS_FONT_CELL_H 9
+#include "image/glyphs.h"
+
+#define PS_FONT_GLYPH_W PS_GLYPH_W
+#define PS_FONT_GLYPH_H PS_GLYPH_H
+#define PS_FONT_CELL_W PS_GLYPH_CELL_W
+#define PS_FONT_CELL_H PS_GLYPH_CELL_H
 
 /* Sets up window-pixel coordinates (origin top-left, y down) for overlay
  * drawing over a width x height viewport at the window's origin, saving the GL

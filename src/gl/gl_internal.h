@@ -17,6 +17,8 @@ struct ps_gl_renderer {
     size_t shadow_lights; /* lights that shadow[] has room for */
     bool shadows_valid;
     GLuint fbo, kernel_tex, spot_tex;
+    GLuint *profile_tex; /* the IES lights' cube maps, as lights->profiles */
+    size_t profile_count;
     double kernel_extent; /* the kernel texture's half side in splat radii */
     double scene_diag;
     /* The size of the eye coordinates GL computes this frame: the eye's

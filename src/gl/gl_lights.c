@@ -71,6 +71,11 @@ void ps_gl_lights_free(ps_gl_renderer *r)
     r->shadow = NULL;
     r->shadow_lights = 0;
     r->shadows_valid = false;
+    if (r->profile_count)
+        glDeleteTextures((GLsizei)r->profile_count, r->profile_tex);
+    free(r->profile_tex);
+    r->profile_tex = NULL;
+    r->profile_count = 0;
     if (r->spot_tex)
         glDeleteTextures(1, &r->spot_tex);
     r->spot_tex = 0;
@@ -91,6 +96,31 @@ ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err)
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the shadow maps of %zu GL lights", n);
     r->shadow_lights = n;
     r->stats.virtual_lights = (unsigned)n;
+    const ps_preview_lights *L = lights_of(r);
+    if (L->profile_count) {
+        r->profile_tex = calloc(L->profile_count, sizeof *r->profile_tex);
+        if (!r->profile_tex)
+            return ps_error_set(err, PS_ERR_NOMEM, "out of memory for %zu IES light tables", L->profile_count);
+        r->profile_count = L->profile_count;
+        glGenTextures((GLsizei)r->profile_count, r->profile_tex);
+        for (size_t i = 0; i < L->profile_count; i++) {
+            const ps_preview_profile *p = &L->profiles[i];
+            glBindTexture(GL_TEXTURE_CUBE_MAP, r->profile_tex[i]);
+            glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
+            for (int f = 0; f < PS_CUBE_FACES; f++)
+                glTexImage2D((GLenum)(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), 0, GL_LUMINANCE16, p->size, p->size, 0,
+                             GL_LUMINANCE, GL_UNSIGNED_SHORT, p->texels + (size_t)f * p->size * p->size);
+            /* Linear within a face and across its edges: the table's
+             * intensity is continuous over directions. */
+            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+        }
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    }
     return PS_OK;
 }
 
@@ -244,6 +274,39 @@ static void begin_spot(const ps_gl_renderer *r, const ps_preview_light *v)
     glEnable(GL_CLIP_PLANE2);
 }
 
+/* On texture unit 1: IES light v's cube table looked up towards p - L,
+ * p the world point being lit (eye-linear texgen while the modelview is the
+ * camera's view sees world coordinates, as the shadow texgen), modulating
+ * the lit colour per pixel. */
+static void begin_profile(const ps_gl_renderer *r, const ps_preview_light *v)
+{
+    const GLenum coords[3] = {GL_S, GL_T, GL_R};
+    const GLenum gens[3] = {GL_TEXTURE_GEN_S, GL_TEXTURE_GEN_T, GL_TEXTURE_GEN_R};
+    const ps_vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    glActiveTexture(GL_TEXTURE1);
+    glEnable(GL_TEXTURE_CUBE_MAP);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, r->profile_tex[v->profile]);
+    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+    for (int i = 0; i < 3; i++) {
+        GLdouble plane[4] = {axes[i].x, axes[i].y, axes[i].z, -ps_v3_dot(axes[i], v->pos)};
+        glTexGeni(coords[i], GL_TEXTURE_GEN_MODE, GL_EYE_LINEAR);
+        glTexGendv(coords[i], GL_EYE_PLANE, plane);
+        glEnable(gens[i]);
+    }
+    glActiveTexture(GL_TEXTURE0);
+}
+
+static void end_profile(void)
+{
+    glActiveTexture(GL_TEXTURE1);
+    glDisable(GL_TEXTURE_GEN_S);
+    glDisable(GL_TEXTURE_GEN_T);
+    glDisable(GL_TEXTURE_GEN_R);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    glDisable(GL_TEXTURE_CUBE_MAP);
+    glActiveTexture(GL_TEXTURE0);
+}
+
 static void end_spot(void)
 {
     glActiveTexture(GL_TEXTURE1);
@@ -297,13 +360,18 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure)
         const ps_preview_light *v = &lights_of(r)->lights[i];
         set_gl_light(v, exposure);
         bool spot = ps_preview_light_is_spot(v) && r->spot_tex;
+        bool profile = v->profile >= 0 && (size_t)v->profile < r->profile_count;
         if (spot)
             begin_spot(r, v);
+        if (profile)
+            begin_profile(r, v);
         if (!r->opt.shadows) {
             ps_gl_draw_mesh(r, true, false);
             r->stats.light_passes++;
             if (spot)
                 end_spot();
+            if (profile)
+                end_profile();
             continue;
         }
         glEnable(GL_TEXTURE_2D);
@@ -338,6 +406,8 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure)
         glDisable(GL_TEXTURE_2D);
         if (spot)
             end_spot();
+        if (profile)
+            end_profile();
     }
     glDisable(GL_LIGHT0);
     glDisable(GL_LIGHTING);

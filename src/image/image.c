@@ -8,6 +8,7 @@
 
 #include "core/fileio.h"
 #include "core/memory.h"
+#include "image/exr_io.h"
 
 /* IEC 61966-2-1 constants. The encode threshold 0.0031308 and the decode
  * threshold 0.04045 are the standard's; they meet at 0.0031308·12.92 =
@@ -140,5 +141,11 @@ ps_status ps_image_read(const char *path, ps_image *out, ps_image_format *format
             *format = PS_IMAGE_PNG;
         return ps_png_read(path, out, err);
     }
-    return ps_error_set(err, PS_ERR_FORMAT, "%s: not a PNG or PFM image", path);
+    /* OpenEXR's magic number, 20000630 little-endian. */
+    if (got >= 4 && head[0] == 0x76 && head[1] == 0x2f && head[2] == 0x31 && head[3] == 0x01) {
+        if (format)
+            *format = PS_IMAGE_EXR;
+        return ps_exr_read(path, out, err);
+    }
+    return ps_error_set(err, PS_ERR_FORMAT, "%s: not a PNG, PFM or OpenEXR image", path);
 }

@@ -82,6 +82,9 @@ ps_status ps_png_read(const char *path, ps_image *out, ps_error *err);
 /* PFM: "PF\n<w> <h>\n-1.0\n", then rows bottom to top as little-endian 32-bit
  * floats, linear, no exposure (every value written as is, NaN included). */
 ps_status ps_pfm_write(const ps_image *img, const char *path, ps_error *err);
+/* The one-channel form, "Pf": width x height values, rows top first (an
+ * illuminance image in lux). */
+ps_status ps_pfm_write_gray(const float *values, int width, int height, const char *path, ps_error *err);
 /* "PF" (RGB) and "Pf" (gray, replicated to RGB) with any whitespace between
  * header tokens; negative scale means little-endian, positive big-endian, zero
  * is an error. The scale's magnitude is not applied: values are returned as
@@ -90,9 +93,9 @@ ps_status ps_pfm_write(const ps_image *img, const char *path, ps_error *err);
 ps_status ps_pfm_read(const char *path, ps_image *out, ps_error *err);
 
 /* Which reader a file needs, told by its first bytes, not its name. */
-typedef enum ps_image_format { PS_IMAGE_PNG, PS_IMAGE_PFM } ps_image_format;
+typedef enum ps_image_format { PS_IMAGE_PNG, PS_IMAGE_PFM, PS_IMAGE_EXR } ps_image_format;
 
-/* Reads a PNG or a PFM, whichever the file's magic says; anything else is
+/* Reads a PNG, a PFM or an OpenEXR file (image/exr_io.h), whichever the file's magic says; anything else is
  * PS_ERR_FORMAT. format (may be NULL) receives which it was. */
 ps_status ps_image_read(const char *path, ps_image *out, ps_image_format *format, ps_error *err);
 

@@ -76,6 +76,32 @@ ps_status ps_pfm_write(const ps_image *img, const char *path, ps_error *err)
     return ps_outfile_commit(f, err);
 }
 
+ps_status ps_pfm_write_gray(const float *values, int width, int height, const char *path, ps_error *err)
+{
+    if (!values || ps_image_check_size(width, height, NULL) != PS_OK)
+        return ps_error_set(err, PS_ERR_RANGE, "%s: no valid image to write", path);
+    size_t row_bytes = (size_t)width * SAMPLE_BYTES;
+    unsigned char *row = malloc(row_bytes);
+    if (!row)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
+    ps_outfile *f = ps_outfile_open(path, err);
+    if (!f) {
+        free(row);
+        return err ? err->status : PS_ERR_IO;
+    }
+    FILE *fp = ps_outfile_stream(f);
+    fprintf(fp, "Pf\n%d %d\n" PFM_WRITE_SCALE "\n", width, height);
+    for (int y = height - 1; y >= 0; y--) {
+        const float *src = values + (size_t)y * (size_t)width;
+        for (size_t i = 0; i < (size_t)width; i++)
+            put_le32(row + i * SAMPLE_BYTES, src[i]);
+        if (fwrite(row, 1, row_bytes, fp) != row_bytes)
+            break;
+    }
+    free(row);
+    return ps_outfile_commit(f, err);
+}
+
 /* Reads one white-space separated header token (`what` names it in messages).
  * The white space character that ends it is consumed: after the scale that is
  * the single separator before the binary data (if the file ends right after the

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "core/sampling.h"
+#include "scene/ies.h"
 
 /* Directions within this of a full sphere are sampled as the light's own
  * distribution: a caustic cone that wide gains nothing and only adds variance. */
@@ -50,6 +51,7 @@ ps_status ps_light_sampler_create(const ps_scene *s, ps_light_sampler **out, ps_
         switch (L->type) {
         case PS_LIGHT_POINT:
         case PS_LIGHT_SPOT:
+        case PS_LIGHT_IES:
             d->center = L->position;
             d->radius = 0.0;
             break;
@@ -163,6 +165,8 @@ double ps_light_caustic_cone_share(const ps_light_sampler *ls, uint32_t l, const
         return fmin(1.0, omega / (4.0 * PS_PI));
     case PS_LIGHT_SPOT:
         return fmin(1.0, omega / ps_cone_solid_angle(L->cos_angle));
+    case PS_LIGHT_IES: /* the table's density along the axis, times the cone */
+        return fmin(1.0, omega * ps_light_ies_density(ls->scene, L, caustic->axis));
     default: /* one-sided Lambertian: about omega / pi near the normal */
         return fmin(1.0, omega * PS_INV_PI);
     }
@@ -222,6 +226,27 @@ void ps_light_sample_point(const ps_light_sampler *ls, uint32_t l, double u0, do
     sample_area(ls, light_at(ls, l), l, u0, u1, p, n);
 }
 
+/* An IES luminaire's photon direction. Without a cone: exactly the file's
+ * distribution (ps_ies_sample inverts its bilinear table), so every photon
+ * carries the same flux, power / N. Inside a caustic cone: uniform there and
+ * weighted by the table's density, weight = density * cone solid angle, whose
+ * mean over the cone is the fraction of the flux it holds. u[0], u[2], u[3]
+ * pick the direction (u[1] is the point on the light: none). */
+static bool emit_ies(const ps_light_sampler *ls, const ps_light *L, const ps_caustic_cone *cone, const double u[4],
+                     ps_vec3 *dir, double *weight)
+{
+    if (cone) {
+        *dir = ps_sample_cone(u[2], u[3], cone->axis, cone->cos_half);
+        *weight = ps_light_ies_density(ls->scene, L, *dir) * ps_cone_solid_angle(cone->cos_half);
+        return *weight > 0.0;
+    }
+    double theta, phi;
+    ps_ies_sample(ps_scene_ies_profile(ls->scene, L->profile), u[0], u[2], u[3], &theta, &phi);
+    *dir = ps_v3_norm(ps_light_ies_direction(L, theta, phi));
+    *weight = 1.0;
+    return true;
+}
+
 bool ps_light_emit(const ps_light_sampler *ls, uint32_t l, const ps_caustic_cone *caustic, const double u[4],
                    ps_emission *out)
 {
@@ -258,6 +283,11 @@ bool ps_light_emit(const ps_light_sampler *ls, uint32_t l, const ps_caustic_cone
         }
         break;
     }
+    case PS_LIGHT_IES:
+        origin = L->position;
+        if (!emit_ies(ls, L, caustic, u, &dir, &weight))
+            return false;
+        break;
     default: {
         sample_area(ls, L, l, u[0], u[1], &origin, &normal);
         if (caustic) {

@@ -6,6 +6,7 @@
  *   quad, disc, mesh (MTL Ke faces)
  *           uniform position, cosine-weighted direction about the emitting side
  *   sphere  uniform position on the sphere, cosine-weighted about the outward normal
+ *   ies     from its position, directions with the density of its candela table exactly
  *
  * Caustic photons are emitted only inside caustic cones (thesis 4.1.1): from
  * the light around a specular object's bounding sphere, that sphere's radius

@@ -98,8 +98,65 @@ static bool push_light(builder *b, ps_preview_light v)
 
 static ps_preview_light point_light(uint32_t light, ps_vec3 pos, ps_rgb intensity)
 {
-    ps_preview_light v = {pos, {0, 0, 0}, 180.0, 0.0, intensity, 0, 0.0, light};
+    ps_preview_light v = {pos, {0, 0, 0}, 180.0, 0.0, intensity, 0, 0.0, light, -1};
     return v;
+}
+
+ps_vec3 ps_cube_texel_direction(int f, int size, int i, int j)
+{
+    /* GL 4.5 8.13: face f's (sc, tc) from the major axis; inverted here. */
+    double sc = 2.0 * (i + 0.5) / size - 1.0, tc = 2.0 * (j + 0.5) / size - 1.0;
+    switch (f) {
+    case 0: return ps_v3(1.0, -tc, -sc);
+    case 1: return ps_v3(-1.0, -tc, sc);
+    case 2: return ps_v3(sc, 1.0, tc);
+    case 3: return ps_v3(sc, -1.0, -tc);
+    case 4: return ps_v3(sc, -tc, 1.0);
+    default: return ps_v3(-sc, -tc, -1.0);
+    }
+}
+
+/* An IES luminaire: a point light of intensity P d_max whose distribution
+ * GL draws from a cube table (lights.h); the shadow cube keeps only the faces
+ * the table lights. A table of all zeros (refused by the parser) or no room
+ * for it leaves the light out, with *ok saying which. */
+static bool add_ies_light(builder *b, uint32_t light, const ps_light *L)
+{
+    ps_preview_lights *l = b->out;
+    const int size = PS_PREVIEW_PROFILE_SIZE;
+    size_t n = (size_t)PS_CUBE_FACES * size * size;
+    double *dens = malloc(n * sizeof *dens);
+    ps_preview_profile *grown = realloc(l->profiles, (l->profile_count + 1) * sizeof *grown);
+    if (grown)
+        l->profiles = grown;
+    uint16_t *texels = malloc(n * sizeof *texels);
+    if (!dens || !grown || !texels) {
+        free(dens), free(texels);
+        return false;
+    }
+    double peak = 0.0;
+    for (int f = 0; f < PS_CUBE_FACES; f++)
+        for (int j = 0; j < size; j++)
+            for (int i = 0; i < size; i++) {
+                size_t k = ((size_t)f * size + (size_t)j) * size + (size_t)i;
+                dens[k] = ps_light_ies_density(b->scene, L, ps_v3_norm(ps_cube_texel_direction(f, size, i, j)));
+                peak = fmax(peak, dens[k]);
+            }
+    unsigned faces = 0;
+    for (size_t k = 0; k < n; k++) {
+        texels[k] = peak > 0.0 ? (uint16_t)lround(65535.0 * dens[k] / peak) : 0;
+        if (texels[k])
+            faces |= 1u << (k / ((size_t)size * size));
+    }
+    free(dens);
+    l->profiles[l->profile_count].size = size;
+    l->profiles[l->profile_count].texels = texels;
+    ps_preview_light v = point_light(light, L->position, ps_rgb_scale(L->power, peak));
+    v.profile = (int)l->profile_count++;
+    if (!push_light(b, v))
+        return false;
+    l->lights[l->count - 1].faces = faces; /* what the table lights, not the whole cube */
+    return true;
 }
 
 /* The virtual point lights of an area light: a grid of strata's centres over
@@ -122,7 +179,7 @@ static bool add_area_light(builder *b, uint32_t light, const ps_light *L)
     for (int j = 0; j < side; j++)
         for (int i = 0; i < side; i++) {
             double u = (i + 0.5) / side, w = (j + 0.5) / side;
-            ps_preview_light v = {{0, 0, 0}, L->direction, 90.0, 1.0, each, 0, 0.0, light};
+            ps_preview_light v = {{0, 0, 0}, L->direction, 90.0, 1.0, each, 0, 0.0, light, -1};
             if (L->type == PS_LIGHT_QUAD) {
                 v.pos = ps_v3_add(L->position, ps_v3_add(ps_v3_scale(L->edge1, u), ps_v3_scale(L->edge2, w)));
             } else if (L->type == PS_LIGHT_DISC) {
@@ -155,6 +212,9 @@ void ps_preview_lights_free(ps_preview_lights *l)
     for (size_t i = 0; i < l->emitter_count; i++)
         ps_trimesh_free(&l->emitters[i].sphere);
     free(l->emitters);
+    for (size_t i = 0; i < l->profile_count; i++)
+        free(l->profiles[i].texels);
+    free(l->profiles);
     free(l->lights);
     memset(l, 0, sizeof *l);
 }
@@ -181,8 +241,10 @@ ps_status ps_preview_lights_build(const ps_scene *s, const ps_preview_mesh *coar
         } else if (L->type == PS_LIGHT_SPOT) {
             double solid = 2.0 * PS_PI * (1.0 - L->cos_angle);
             ps_preview_light v = {L->position, L->direction, L->angle_deg, 0.0, ps_rgb_scale(L->power, 1.0 / solid),
-                                  0, 0.0, (uint32_t)l};
+                                  0, 0.0, (uint32_t)l, -1};
             ok = push_light(&b, v);
+        } else if (L->type == PS_LIGHT_IES) {
+            ok = add_ies_light(&b, (uint32_t)l, L);
         } else {
             ok = add_area_light(&b, (uint32_t)l, L);
         }

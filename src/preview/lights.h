@@ -10,6 +10,8 @@
  *   area   P / (pi * samples) cos(theta)  W/sr for each of the samples
  *   sphere P / (4 pi) at its centre        (outside it a Lambertian sphere
  *                                          lights like a point)
+ *   ies    P d_max, times a cube table of d(w) / d_max drawn per pixel,
+ *          d the file's candela over its flux towards w (scene.h)
  * so that every light's virtual lights emit its flux P in all: pi I for a
  * cosine emitter, 4 pi I for a point. 16 samples keep the irradiance a
  * light's width away within about 1 % of the area integral (a midpoint
@@ -48,7 +50,26 @@ typedef struct ps_preview_light {
     unsigned faces;    /* the shadow-cube faces that can see light (bit f: face f) */
     double shadow_near;/* its shadow cube's near plane: see PS_SHADOW_NEAR_SHARE */
     uint32_t light;    /* the scene light it belongs to */
+    int profile;       /* an IES light's table in ps_preview_lights.profiles, or -1 */
 } ps_preview_light;
+
+/* An IES luminaire's distribution as GL draws it: its relative intensity
+ * over world directions as a cube map, to be looked up per pixel towards
+ * (p - light) with texgen (GL normalises a cube map's direction itself).
+ * Faces in GL's order (+x, -x, +y, -y, +z, -z), each PS_PREVIEW_PROFILE_SIZE
+ * texels a side in GL's cube-map orientation, texel (i, j) at face
+ * coordinates ((i + 0.5) / size, (j + 0.5) / size); values d(w) / d_max in
+ * [0, 1] at 16 bits, so a direction at a hundredth of the peak is still kept
+ * to 1.5 %. */
+#define PS_PREVIEW_PROFILE_SIZE 64
+typedef struct ps_preview_profile {
+    int size;
+    uint16_t *texels; /* 6 * size * size */
+} ps_preview_profile;
+
+/* The world direction of texel (i, j) of cube face f (GL's cube-map rules),
+ * not normalised. */
+ps_vec3 ps_cube_texel_direction(int f, int size, int i, int j);
 
 /* A spot of constant intensity inside a cone narrower than a half-space (not
  * a cosine emitter, whose 90-degree "cone" is its own plane): GL's per-vertex
@@ -74,6 +95,8 @@ typedef struct ps_preview_lights {
     size_t count;
     ps_preview_emitter *emitters;
     size_t emitter_count;
+    ps_preview_profile *profiles;
+    size_t profile_count;
     uint64_t shadow_faces; /* lit faces of all lights: the shadow maps drawn */
 } ps_preview_lights;
 

@@ -63,6 +63,26 @@ static bool visible(worker *wk, const ps_surface *sp, ps_vec3 dir, double dist)
     return !ps_world_occluded(w, r, dist - 2.0 * ps_world_epsilon(w));
 }
 
+/* Radiance at sp towards wo from IES light L (a point luminaire): exact, one
+ * shadow ray; its intensity towards sp is power * candela / flux there. */
+static ps_rgb direct_from_ies(worker *wk, const ps_light *L, const ps_surface *sp, ps_vec3 n, ps_vec3 wo,
+                              const ps_material *m)
+{
+    ps_vec3 to = ps_v3_sub(L->position, sp->p);
+    double d2 = ps_v3_len2(to), d = sqrt(d2);
+    if (!(d > 0.0))
+        return ps_rgb_gray(0.0);
+    ps_vec3 wi = ps_v3_scale(to, 1.0 / d);
+    double cos_x = ps_v3_dot(wi, n);
+    if (cos_x <= 0.0)
+        return ps_rgb_gray(0.0);
+    double density = ps_light_ies_density(wk->job->scene, L, ps_v3_neg(wi)); /* 1/sr */
+    if (!(density > 0.0) || !visible(wk, sp, wi, d))
+        return ps_rgb_gray(0.0);
+    ps_rgb f = ps_bsdf_eval(m, n, ps_v3_neg(wi), wo);
+    return ps_rgb_scale(ps_rgb_mul(f, L->power), density * cos_x / d2);
+}
+
 /* Radiance at sp towards wo from every light, by shadow rays. n: the shading
  * normal on wo's side. */
 static ps_rgb direct_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec3 wo, const ps_material *m, ps_rng *rng)
@@ -71,6 +91,10 @@ static ps_rgb direct_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec3 
     ps_rgb sum = ps_rgb_gray(0.0);
     for (size_t l = 0; l < job->light_count; l++) {
         const ps_light *L = &job->lights[l];
+        if (L->type == PS_LIGHT_IES) {
+            sum = ps_rgb_add(sum, direct_from_ies(wk, L, sp, n, wo, m));
+            continue;
+        }
         if (L->type == PS_LIGHT_POINT || L->type == PS_LIGHT_SPOT) {
             ps_vec3 to = ps_v3_sub(L->position, sp->p);
             double d2 = ps_v3_len2(to), d = sqrt(d2);
@@ -379,12 +403,50 @@ enum { KEY_REFLECT = 1, KEY_REFRACT, KEY_CHOICE, KEY_DIRECT, KEY_GATHER };
 
 static uint64_t child_key(uint64_t key, uint64_t what) { return ps_hash64(key ^ ps_hash64(what)); }
 
+/* ---- illuminance --------------------------------------------------------- */
+
+/* The selected component of the irradiance at the first surface r meets
+ * (render.h, `illuminance`): the split equation's terms for a white
+ * Lambertian surface there, times pi; the caustic term straight from the map. */
+static ps_rgb illuminance_at(worker *wk, ps_ray r, uint64_t key)
+{
+    const render_job *job = wk->job;
+    ps_component want = job->o->component;
+    ps_surface sp;
+    wk->rays++;
+    if (!ps_world_intersect(job->world, r, INFINITY, &sp))
+        return ps_rgb_gray(0.0);
+    ps_material white;
+    memset(&white, 0, sizeof white);
+    white.type = PS_MAT_DIFFUSE;
+    white.albedo = ps_rgb_gray(1.0);
+    bool front = ps_v3_dot(r.d, sp.ng) < 0.0;
+    ps_vec3 n = front ? sp.ns : ps_v3_neg(sp.ns);
+    ps_vec3 wo = ps_v3_neg(r.d);
+    ps_rgb sum = ps_rgb_gray(0.0);
+    if (wants(want, PS_COMPONENT_DIRECT)) {
+        ps_rng rng = ps_rng_make(key, KEY_DIRECT, 0);
+        sum = ps_rgb_add(sum, ps_rgb_scale(direct_light(wk, &sp, n, wo, &white, &rng), PS_PI));
+    }
+    if (wants(want, PS_COMPONENT_CAUSTIC) && job->maps->caustic)
+        sum = ps_rgb_add(sum, ps_photon_irradiance(job->maps->caustic, sp.p, n, &job->o->caustic, wk->scratch));
+    if (wants(want, PS_COMPONENT_INDIRECT)) {
+        ps_rng rng = ps_rng_make(key, KEY_GATHER, 0);
+        sum = ps_rgb_add(sum, ps_rgb_scale(indirect_light(wk, &sp, n, wo, &white, &rng, true), PS_PI));
+    }
+    return sum;
+}
+
+/* ---- eye paths (continued) ------------------------------------------------ */
+
 /* The selected component of the radiance arriving along r. `through`: the
  * path has met a mirror or glass already (so all it sees is specular). */
 static ps_rgb radiance(worker *wk, ps_ray r, int depth, bool through, uint64_t key)
 {
     const render_job *job = wk->job;
     ps_component want = job->o->component;
+    if (job->o->illuminance && depth == 0)
+        return illuminance_at(wk, r, key);
     if (depth > PS_RENDER_MAX_SPECULAR || (through && !wants(want, PS_COMPONENT_SPECULAR)))
         return ps_rgb_gray(0.0);
     ps_surface sp;

@@ -73,6 +73,12 @@ typedef struct ps_render_options {
      * It trades noise for smooth interpolation error and much less time. */
     int cache_spacing;
     int cache_rays;
+    /* Instead of radiance, the irradiance (W/m^2 per channel) arriving at the
+     * surface each eye ray meets first, whatever its material: that surface
+     * is taken as white Lambertian (albedo 1, so E = pi L) and emitters seen
+     * directly are looked through. `component` selects its terms as for
+     * radiance (specular: none). Lux is core/photometry.h's ps_photometric of it. */
+    bool illuminance;
     /* Called now and then from one thread with the fraction done (may be NULL). */
     void (*progress)(void *user, double fraction);
     void *progress_user;

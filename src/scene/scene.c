@@ -1,6 +1,11 @@
 /* scene.c: scene storage, accessors, derived quantities, edits and copies. */
 #include "scene/scene_internal.h"
 
+#include <math.h>
+
+#include "core/photometry.h"
+#include "scene/ies.h"
+
 #include <inttypes.h>
 #include <stdarg.h>
 #include <stdbool.h>
@@ -29,6 +34,9 @@ void ps_scene_destroy(ps_scene *s)
     free(s->objects.items);
     free(s->lights.items);
     free(s->emitters.items);
+    for (size_t k = 0; k < s->profiles.count; k++)
+        ps_ies_destroy(s->profiles.items[k]);
+    free(s->profiles.items);
     free(s);
 }
 
@@ -68,6 +76,33 @@ ps_rgb ps_scene_total_power(const ps_scene *s)
     for (size_t i = 0; i < s->lights.count; i++)
         sum = ps_rgb_add(sum, s->lights.items[i].power);
     return sum;
+}
+
+double ps_scene_total_lumens(const ps_scene *s) { return ps_photometric(ps_scene_total_power(s)); }
+
+const ps_ies *ps_scene_ies_profile(const ps_scene *s, uint32_t profile) { return s->profiles.items[profile]; }
+size_t ps_scene_ies_profile_count(const ps_scene *s) { return s->profiles.count; }
+
+ps_vec3 ps_light_ies_direction(const ps_light *l, double theta, double phi)
+{
+    double st = sin(theta);
+    ps_vec3 side = ps_v3_add(ps_v3_scale(l->axis0, cos(phi)), ps_v3_scale(l->axis90, sin(phi)));
+    return ps_v3_add(ps_v3_scale(l->direction, cos(theta)), ps_v3_scale(side, st));
+}
+
+void ps_light_ies_angles(const ps_light *l, ps_vec3 d, double *theta, double *phi)
+{
+    double z = ps_v3_dot(d, l->direction), x = ps_v3_dot(d, l->axis0), y = ps_v3_dot(d, l->axis90);
+    *theta = atan2(sqrt(x * x + y * y), z);
+    *phi = atan2(y, x);
+}
+
+double ps_light_ies_density(const ps_scene *s, const ps_light *l, ps_vec3 d)
+{
+    const ps_ies *ies = s->profiles.items[l->profile];
+    double theta, phi;
+    ps_light_ies_angles(l, d, &theta, &phi);
+    return ps_ies_candela(ies, theta, phi) / ps_ies_flux(ies);
 }
 
 static ps_aabb light_bounds(const ps_light *l)
@@ -374,7 +409,18 @@ ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err)
     DUP_VEC(objects);
     DUP_VEC(lights);
     DUP_VEC(emitters);
+    DUP_VEC(profiles);
 #undef DUP_VEC
+    /* The tables themselves, so that a clone shares nothing with s; until
+     * each is copied its slot is NULL (destroy frees only copies). */
+    if (!c->profiles.items)
+        c->profiles.count = 0;
+    for (size_t k = 0; k < c->profiles.count; k++)
+        c->profiles.items[k] = NULL;
+    for (size_t k = 0; k < c->profiles.count && ok; k++) {
+        ps_error ignored;
+        ok = ps_ies_clone(s->profiles.items[k], &c->profiles.items[k], &ignored) == PS_OK;
+    }
     if (!ok) {
         ps_scene_destroy(c); /* what was not copied is NULL */
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
@@ -404,6 +450,7 @@ const char *ps_light_type_name(ps_light_type t)
     case PS_LIGHT_SPHERE: return "sphere";
     case PS_LIGHT_DISC: return "disc";
     case PS_LIGHT_MESH: return "mesh";
+    case PS_LIGHT_IES: return "ies";
     }
     return "?";
 }

@@ -97,7 +97,8 @@ typedef enum ps_light_type {
     PS_LIGHT_QUAD,
     PS_LIGHT_SPHERE,
     PS_LIGHT_DISC,
-    PS_LIGHT_MESH /* the faces of one mesh with one emissive MTL material (Ke > 0) */
+    PS_LIGHT_MESH, /* the faces of one mesh with one emissive MTL material (Ke > 0) */
+    PS_LIGHT_IES   /* a point luminaire with an LM-63 candela table (scene/ies.h) */
 } ps_light_type;
 
 typedef struct ps_light {
@@ -114,6 +115,15 @@ typedef struct ps_light {
     ps_rgb radiance;     /* area lights: emitted radiance, power / (pi * area) */
     uint32_t first_emitter, emitter_count; /* mesh: range in ps_scene_emitters */
     uint32_t object;     /* mesh: the object whose faces emit */
+    /* ies: `direction` is the aim (the file's vertical angle 0, the nadir);
+     * axis0 and axis90 are the unit directions of horizontal angles 0 and 90
+     * (spin applied), so that vertical angle theta and horizontal angle phi
+     * point along cos(theta) direction + sin(theta) (cos(phi) axis0 +
+     * sin(phi) axis90). The intensity towards a direction is power times the
+     * file's candela there over the file's total flux (ps_light_ies_density). */
+    uint32_t profile;    /* ies: index of its table, ps_scene_ies_profile */
+    double spin_deg;     /* ies: as given */
+    ps_vec3 axis0, axis90;
 } ps_light;
 
 /* What programs use unless their options say otherwise (statements `image`,
@@ -158,6 +168,21 @@ const uint32_t *ps_scene_emitters(const ps_scene *s, size_t *count);
 
 /* Total emitted flux of all lights, per channel. */
 ps_rgb ps_scene_total_power(const ps_scene *s);
+/* The same in lumens (core/photometry.h: 683 lm/W times its luminance). */
+double ps_scene_total_lumens(const ps_scene *s);
+
+/* The candela table of IES light profile index `profile` (ps_light.profile);
+ * owned by the scene, valid until destroy. */
+const struct ps_ies *ps_scene_ies_profile(const ps_scene *s, uint32_t profile);
+size_t ps_scene_ies_profile_count(const ps_scene *s);
+/* The unit world direction of an IES light's (vertical, horizontal) angles, radians. */
+ps_vec3 ps_light_ies_direction(const ps_light *l, double theta, double phi);
+/* The IES angles of unit world direction d from the light (inverse of the above). */
+void ps_light_ies_angles(const ps_light *l, ps_vec3 d, double *theta, double *phi);
+/* The density over solid angle (1/sr) with which IES light l emits towards
+ * unit direction d: its candela there over its total flux. Its radiant
+ * intensity is power times this. */
+double ps_light_ies_density(const ps_scene *s, const ps_light *l, ps_vec3 d);
 /* Area of triangle t. */
 double ps_scene_triangle_area(const ps_scene *s, uint32_t t);
 /* Unit geometric normal of triangle t (from its winding: (v1-v0) x (v2-v0)). */

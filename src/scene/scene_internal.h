@@ -23,6 +23,7 @@ struct ps_scene {
     PS_VEC(ps_object) objects;
     PS_VEC(ps_light) lights;
     PS_VEC(uint32_t) emitters;
+    PS_VEC(struct ps_ies *) profiles; /* owned: the IES lights' tables */
 };
 
 /* Appends one zeroed item to a PS_VEC, returning it, or NULL when out of memory. */

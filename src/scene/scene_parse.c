@@ -10,6 +10,8 @@
 #include "core/namemap.h"
 #include "core/number.h"
 #include "core/transform.h"
+#include "core/photometry.h"
+#include "scene/ies.h"
 #include "scene/obj.h"
 #include "scene/scene_internal.h"
 
@@ -793,9 +795,142 @@ static ps_status parse_mesh(parser *p)
 
 /* ---- lights ---------------------------------------------------------------------- */
 
+/* Every light type ends its keys with these four: exactly one of power,
+ * lumens or candela (an ies light may give none: its file's candela), and a
+ * colour for the photometric two (docs/scene-format.md). */
+#define PHOTOMETRIC_KEYS {"power", 3, false}, {"lumens", 1, false}, {"candela", 1, false}, {"color", 3, false}
+enum { PHOTOMETRIC_KEY_COUNT = 4 };
+
+/* Sets l->power from the photometric keys kv[0..3] (power, lumens, candela,
+ * color). peak_per_watt: the light's largest intensity per watt of its flux
+ * (W/sr per W), what `candela` is the peak of; own_lumens > 0: what the light
+ * emits when no key says (an ies file's table). */
+static ps_status light_power(parser *p, ps_light *l, const char *stmt, const key_vals *kv, double peak_per_watt,
+                             double own_lumens)
+{
+    int given = kv[0].present + kv[1].present + kv[2].present;
+    if (given > 1)
+        return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: give one of 'power', 'lumens' or 'candela', not %s",
+                            p->name, p->line, stmt, given == 3 ? "all three" : "two");
+    if (given == 0 && !(own_lumens > 0.0))
+        return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: missing 'power' (or 'lumens' or 'candela')", p->name,
+                            p->line, stmt);
+    if (kv[0].present) {
+        if (kv[3].present)
+            return ps_error_set(p->err, PS_ERR_PARSE,
+                                "%s:%d: %s: 'color' goes with 'lumens' or 'candela'; 'power' already gives the colour",
+                                p->name, p->line, stmt);
+        l->power = kv_rgb(&kv[0]);
+        return check_power(p, l->power);
+    }
+    ps_rgb color = kv[3].present ? kv_rgb(&kv[3]) : ps_rgb_gray(1.0);
+    if (color.r < 0 || color.g < 0 || color.b < 0 || !(ps_rgb_luminance(color) > 0.0))
+        return ps_error_set(p->err, PS_ERR_RANGE,
+                            "%s:%d: %s: 'color' must be non-negative with some luminance (0.2126 R + 0.7152 G + "
+                            "0.0722 B > 0)",
+                            p->name, p->line, stmt);
+    double lumens = own_lumens;
+    if (kv[1].present) {
+        lumens = kv[1].v[0];
+        if (lumens < 0.0)
+            return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: %s: 'lumens' must not be negative", p->name, p->line,
+                                stmt);
+    } else if (kv[2].present) {
+        if (kv[2].v[0] < 0.0)
+            return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: %s: 'candela' must not be negative", p->name, p->line,
+                                stmt);
+        /* Peak intensity C cd = peak_per_watt * flux (in lm): flux = C / peak_per_watt. */
+        lumens = kv[2].v[0] / peak_per_watt;
+    }
+    l->power = ps_radiometric(lumens, color);
+    if (!ps_rgb_isfinite(l->power))
+        return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: %s: %g lm is not a finite power", p->name, p->line, stmt,
+                            lumens);
+    return check_power(p, l->power);
+}
+
+/* `light ies FILE position X Y Z [aim X Y Z] [spin DEG] [lumens L | candela C | power R G B] [color R G B]`. */
+static ps_status parse_ies_light(parser *p, ps_light *l)
+{
+    const char *file = next_word(p, "IES file name");
+    if (!file)
+        return PS_ERR_PARSE;
+    static const key_spec spec[] = {{"position", 3, true}, {"aim", 3, false}, {"spin", 1, false}, PHOTOMETRIC_KEYS};
+    key_vals kv[3 + PHOTOMETRIC_KEY_COUNT];
+    ps_status st;
+    if ((st = parse_keys(p, "light ies", spec, 3 + PHOTOMETRIC_KEY_COUNT, kv)) != PS_OK)
+        return st;
+    l->type = PS_LIGHT_IES;
+    l->position = kv_vec3(&kv[0]);
+    ps_vec3 aim = kv[1].present ? kv_vec3(&kv[1]) : ps_v3(0, -1, 0);
+    if ((st = check_direction(p, "aim", aim)) != PS_OK)
+        return st;
+    l->direction = ps_v3_norm(aim);
+    l->spin_deg = kv[2].present ? kv[2].v[0] : 0.0;
+    if (!(fabs(l->spin_deg) <= 360.0 * 1000.0))
+        return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: light ies: 'spin' %g degrees is out of range", p->name,
+                            p->line, l->spin_deg);
+    /* Horizontal angle 0 before spin: world +x made perpendicular to the aim
+     * (world +z when the aim is along x); 90 is axis0 x aim, which for the
+     * default aim straight down is -z: counter-clockwise seen from above, as
+     * LM-63 counts horizontal angles (and Radiance's ies2rad with z up). */
+    ps_vec3 ref = fabs(l->direction.x) > 0.999 ? ps_v3(0, 0, 1) : ps_v3(1, 0, 0);
+    ps_vec3 a0 = ps_v3_norm(ps_v3_sub(ref, ps_v3_scale(l->direction, ps_v3_dot(ref, l->direction))));
+    ps_vec3 a90 = ps_v3_cross(a0, l->direction);
+    double spin = l->spin_deg * (PS_PI / 180.0);
+    l->axis0 = ps_v3_add(ps_v3_scale(a0, cos(spin)), ps_v3_scale(a90, sin(spin)));
+    l->axis90 = ps_v3_cross(l->axis0, l->direction);
+
+    char path[4096];
+    if (file[0] == '/' || !p->base_dir[0])
+        snprintf(path, sizeof path, "%s", file);
+    else
+        snprintf(path, sizeof path, "%s/%s", p->base_dir, file);
+    ps_ies *ies = NULL;
+    ps_error ierr;
+    st = ps_ies_load(path, &ies, &ierr);
+    if (st != PS_OK) {
+        /* As for meshes: a problem on a line of the IES file names that line. */
+        const char *colon = strchr(ierr.msg, ':');
+        bool has_line = colon && colon[1] >= '0' && colon[1] <= '9';
+        for (const char *c = ierr.msg; has_line && c < colon; c++)
+            has_line = *c != ' ';
+        if (has_line)
+            return ps_error_set(p->err, st, "%s (light ies at %s:%d)", ierr.msg, p->name, p->line);
+        return ps_error_set(p->err, st, "%s:%d: light ies: %s", p->name, p->line, ierr.msg);
+    }
+    /* The file's flux as written, with its TILT factor for the aim's tilt
+     * from straight down (the position it was measured in). */
+    double tilt = acos(fmin(1.0, fmax(-1.0, -l->direction.y))) * (180.0 / PS_PI);
+    double own = ps_ies_flux(ies) * ps_ies_tilt_factor(ies, tilt);
+    if (!kv[3].present && !kv[4].present && !kv[5].present && !(own > 0.0)) {
+        ps_ies_destroy(ies);
+        return ps_error_set(p->err, PS_ERR_RANGE,
+                            "%s:%d: light ies: %s emits nothing at this tilt (its TILT factor is 0); give 'lumens'",
+                            p->name, p->line, file);
+    }
+    st = light_power(p, l, "light ies", kv + 3, ps_ies_peak(ies) / ps_ies_flux(ies), own > 0.0 ? own : 1.0);
+    if (st == PS_OK && p->s->profiles.count >= PS_SCENE_MAX_LIGHTS)
+        st = ps_error_set(p->err, PS_ERR_LIMIT, "%s:%d: more than %d IES lights", p->name, p->line,
+                          PS_SCENE_MAX_LIGHTS);
+    if (st == PS_OK) {
+        ps_ies **slot = PS_VEC_PUSH(p->s->profiles);
+        if (!slot)
+            st = ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        else
+            *slot = ies;
+    }
+    if (st != PS_OK) {
+        ps_ies_destroy(ies);
+        return st;
+    }
+    l->profile = (uint32_t)(p->s->profiles.count - 1);
+    return PS_OK;
+}
+
 static ps_status parse_light(parser *p)
 {
-    const char *type = next_word(p, "type (point, spot, quad, sphere or disc)");
+    const char *type = next_word(p, "type (point, spot, quad, sphere, disc or ies)");
     if (!type)
         return PS_ERR_PARSE;
     if (p->s->lights.count >= PS_SCENE_MAX_LIGHTS)
@@ -803,18 +938,22 @@ static ps_status parse_light(parser *p)
     ps_light l;
     memset(&l, 0, sizeof l);
     l.line = p->line;
-    key_vals kv[4];
+    key_vals kv[SCN_MAX_KEYS];
     ps_status st;
+    const key_vals *photo = NULL; /* the four photometric keys */
+    double peak = 0.0;            /* peak intensity per watt of flux, 1/sr */
     if (!strcmp(type, "point")) {
-        static const key_spec spec[] = {{"position", 3, true}, {"power", 3, true}};
-        if ((st = parse_keys(p, "light point", spec, 2, kv)) != PS_OK)
+        static const key_spec spec[] = {{"position", 3, true}, PHOTOMETRIC_KEYS};
+        if ((st = parse_keys(p, "light point", spec, 1 + PHOTOMETRIC_KEY_COUNT, kv)) != PS_OK)
             return st;
         l.type = PS_LIGHT_POINT;
         l.position = kv_vec3(&kv[0]);
-        l.power = kv_rgb(&kv[1]);
+        photo = kv + 1;
+        peak = 1.0 / (4.0 * PS_PI);
     } else if (!strcmp(type, "spot")) {
-        static const key_spec spec[] = {{"position", 3, true}, {"direction", 3, true}, {"angle", 1, true}, {"power", 3, true}};
-        if ((st = parse_keys(p, "light spot", spec, 4, kv)) != PS_OK)
+        static const key_spec spec[] = {{"position", 3, true}, {"direction", 3, true}, {"angle", 1, true},
+                                        PHOTOMETRIC_KEYS};
+        if ((st = parse_keys(p, "light spot", spec, 3 + PHOTOMETRIC_KEY_COUNT, kv)) != PS_OK)
             return st;
         l.type = PS_LIGHT_SPOT;
         l.position = kv_vec3(&kv[0]);
@@ -826,10 +965,12 @@ static ps_status parse_light(parser *p)
             return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: light spot: 'angle' (the half-angle) must be in (0, 90]",
                                 p->name, p->line);
         l.cos_angle = cos(l.angle_deg * (PS_PI / 180.0));
-        l.power = kv_rgb(&kv[3]);
+        photo = kv + 3;
+        peak = 1.0 / (2.0 * PS_PI * (1.0 - l.cos_angle));
     } else if (!strcmp(type, "quad")) {
-        static const key_spec spec[] = {{"corner", 3, true}, {"edge1", 3, true}, {"edge2", 3, true}, {"power", 3, true}};
-        if ((st = parse_keys(p, "light quad", spec, 4, kv)) != PS_OK)
+        static const key_spec spec[] = {{"corner", 3, true}, {"edge1", 3, true}, {"edge2", 3, true},
+                                        PHOTOMETRIC_KEYS};
+        if ((st = parse_keys(p, "light quad", spec, 3 + PHOTOMETRIC_KEY_COUNT, kv)) != PS_OK)
             return st;
         l.type = PS_LIGHT_QUAD;
         l.position = kv_vec3(&kv[0]);
@@ -840,20 +981,23 @@ static ps_status parse_light(parser *p)
         ps_vec3 c = ps_v3_cross(l.edge1, l.edge2);
         l.direction = ps_v3_norm(c);
         l.area = ps_v3_len(c);
-        l.power = kv_rgb(&kv[3]);
+        photo = kv + 3;
+        peak = PS_INV_PI; /* Lambertian: I(normal) = L A = flux / pi */
     } else if (!strcmp(type, "sphere")) {
-        static const key_spec spec[] = {{"center", 3, true}, {"radius", 1, true}, {"power", 3, true}};
-        if ((st = parse_keys(p, "light sphere", spec, 3, kv)) != PS_OK ||
+        static const key_spec spec[] = {{"center", 3, true}, {"radius", 1, true}, PHOTOMETRIC_KEYS};
+        if ((st = parse_keys(p, "light sphere", spec, 2 + PHOTOMETRIC_KEY_COUNT, kv)) != PS_OK ||
             (st = check_positive(p, "radius", kv[1].v[0])) != PS_OK)
             return st;
         l.type = PS_LIGHT_SPHERE;
         l.position = kv_vec3(&kv[0]);
         l.radius = kv[1].v[0];
         l.area = 4.0 * PS_PI * l.radius * l.radius;
-        l.power = kv_rgb(&kv[2]);
+        photo = kv + 2;
+        peak = 1.0 / (4.0 * PS_PI); /* L pi r^2 in every direction, flux 4 pi^2 r^2 L */
     } else if (!strcmp(type, "disc")) {
-        static const key_spec spec[] = {{"center", 3, true}, {"normal", 3, true}, {"radius", 1, true}, {"power", 3, true}};
-        if ((st = parse_keys(p, "light disc", spec, 4, kv)) != PS_OK ||
+        static const key_spec spec[] = {{"center", 3, true}, {"normal", 3, true}, {"radius", 1, true},
+                                        PHOTOMETRIC_KEYS};
+        if ((st = parse_keys(p, "light disc", spec, 3 + PHOTOMETRIC_KEY_COUNT, kv)) != PS_OK ||
             (st = check_direction(p, "normal", kv_vec3(&kv[1]))) != PS_OK ||
             (st = check_positive(p, "radius", kv[2].v[0])) != PS_OK)
             return st;
@@ -862,13 +1006,19 @@ static ps_status parse_light(parser *p)
         l.direction = ps_v3_norm(kv_vec3(&kv[1]));
         l.radius = kv[2].v[0];
         l.area = PS_PI * l.radius * l.radius;
-        l.power = kv_rgb(&kv[3]);
+        photo = kv + 3;
+        peak = PS_INV_PI;
+    } else if (!strcmp(type, "ies")) {
+        if ((st = parse_ies_light(p, &l)) != PS_OK)
+            return st;
     } else {
         return ps_error_set(p->err, PS_ERR_PARSE,
-                            "%s:%d: light: unknown type '%s' (expected point, spot, quad, sphere or disc)", p->name,
-                            p->line, type);
+                            "%s:%d: light: unknown type '%s' (expected point, spot, quad, sphere, disc or ies)",
+                            p->name, p->line, type);
     }
-    if ((st = check_power(p, l.power)) != PS_OK)
+    char stmt[32];
+    snprintf(stmt, sizeof stmt, "light %s", type);
+    if (photo && (st = light_power(p, &l, stmt, photo, peak, 0.0)) != PS_OK)
         return st;
     /* Lambertian area emitters: flux = pi * L * area. A size whose area
      * overflows (a sphere of radius 1e200) would give radiance 0 from an
