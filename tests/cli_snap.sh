@@ -46,6 +46,16 @@ for key in emitted_caustic emitted_global stored_caustic stored_global trace_sec
     grep -q "\"$key\":" "$cli_tmp/s.json" && ok || bad "stats lack $key"
 done
 grep -q '"emitted_caustic": 20000,' "$cli_tmp/s.json" && ok || bad "not 20000 caustic photons"
+grep -q '"luminous_flux_lm": 68300[,.]' "$cli_tmp/s.json" && ok ||
+    bad "stats lack the lights' lumens (100 W a channel: 683 lm/W x Y 100 = 68300 lm)"
+
+# Illuminance: a one-channel PFM of lux and its false-colour picture (the
+# closed forms are test_gl_illuminance's); bad paths refused before any work.
+expect_success "illuminance" "$snap" "$scene" "${small[@]}" --illuminance "$cli_tmp/lux.pfm" \
+    --false-color "$cli_tmp/lux.png"
+[ "$(head -2 "$cli_tmp/lux.pfm" | tr '\n' ' ')" = "Pf 48 48 " ] && ok || bad "lux.pfm is not a one-channel 48x48 PFM"
+[ "$(head -c 8 "$cli_tmp/lux.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a ] && ok || bad "lux.png is not a PNG"
+expect_usage_error "unwritable illuminance" "$snap" "$scene" "${small[@]}" --illuminance /nonexistent/dir/l.pfm
 [ "$(grep -c '^caustic ' "$cli_tmp/s.txt")" = "$(sed -n 's/.*"stored_caustic": \([0-9]*\).*/\1/p' "$cli_tmp/s.json")" ] &&
     ok || bad "the dump and the stats disagree on the caustic photons"
 

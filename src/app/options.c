@@ -2,10 +2,13 @@
 #include "app/options.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "core/memory.h"
+#include "image/exr_io.h"
+#include "image/falsecolor.h"
 
 #include "core/fileio.h"
 #include "photon/estimate.h"
@@ -79,6 +82,23 @@ ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_photon_map_write_text(ps_outfile_stream(out), &maps[k]);
     return ps_outfile_commit(out, err);
+}
+
+ps_status ps_write_illuminance(const char *out_lux, const char *out_false, const ps_image *irr, const char *prog,
+                               ps_error *err)
+{
+    size_t n = (size_t)irr->width * (size_t)irr->height;
+    float *lux = malloc(n * sizeof *lux);
+    if (!lux)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for the illuminance image", prog);
+    ps_lux_from_irradiance(irr, lux);
+    ps_status st = PS_OK;
+    if (out_lux)
+        st = ps_gray_write(lux, irr->width, irr->height, out_lux, err);
+    if (st == PS_OK && out_false)
+        st = ps_falsecolor_write(lux, irr->width, irr->height, out_false, err);
+    free(lux);
+    return st;
 }
 
 ps_status ps_check_outputs(const ps_shared_options *o, ps_error *err)

@@ -9,6 +9,7 @@
 #include "app/cli.h"
 #include "core/clock.h"
 #include "core/status.h"
+#include "image/image.h"
 #include "photon/tracer.h"
 #include "preview/session.h"
 
@@ -62,6 +63,12 @@ bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_
 ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_preview_options *o, const ps_scene *s);
 /* "direct,caustic,global" (any non-empty subset) to PS_LAYER_* bits. */
 ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_error *err);
+
+/* --illuminance (a one-channel PFM or EXR of lux) and --false-color (its
+ * false-colour PNG with a legend) from an irradiance image (W m^-2 per
+ * channel); either path may be NULL. */
+ps_status ps_write_illuminance(const char *out_lux, const char *out_false, const ps_image *irradiance,
+                               const char *prog, ps_error *err);
 
 /* --dump-photons: every photon of both maps, written whole or not at all. */
 ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP_COUNT], ps_error *err);

@@ -29,7 +29,10 @@ static const char usage[] =
     "\n"
     "options:\n"
     "  -o FILE.png              8-bit PNG, sRGB after exposure\n"
-    "  --hdr FILE.pfm           linear radiance (W sr^-1 m^-2), little-endian PFM\n"
+    "  --hdr FILE.pfm           linear radiance (W sr^-1 m^-2), little-endian PFM (.exr: OpenEXR)\n"
+    "  --illuminance FILE.pfm   one-channel PFM (or .exr) of the illuminance in lux falling on\n"
+    "                           the surface each pixel sees, whatever its albedo (--layers apply)\n"
+    "  --false-color FILE.png   the same as a false-colour picture with a labelled lux legend\n"
     "  --size WxH               image size (default from the scene)\n"
     "  --exposure E             radiance multiplier before encoding (default 1)\n"
     "  --caustic-photons N      caustic photons (the cap, in progressive mode)\n"
@@ -72,6 +75,7 @@ typedef struct snap_options {
     ps_preview_options p;
     double time; /* 0: trace the photon counts and draw once */
     const char *hdr_layers;
+    const char *out_lux, *out_false; /* --illuminance, --false-color */
     const char *checkpoint_prefix;
     double checkpoints[SNAP_MAX_CHECKPOINTS]; /* ascending */
     int checkpoint_count;
@@ -99,6 +103,10 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
             continue;
         } else if (ps_cli_is(&cli, "--time")) {
             st = ps_cli_double(&cli, 1e-3, 1e6, &o->time, err);
+        } else if (ps_cli_is(&cli, "--illuminance")) {
+            st = ps_cli_string(&cli, &o->out_lux, err);
+        } else if (ps_cli_is(&cli, "--false-color")) {
+            st = ps_cli_string(&cli, &o->out_false, err);
         } else if (ps_cli_is(&cli, "--hdr-layers")) {
             st = ps_cli_string(&cli, &o->hdr_layers, err);
         } else if (ps_cli_is(&cli, "--checkpoint-prefix")) {
@@ -113,8 +121,10 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
         return st;
     if (!o->c.scene)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: no scene given (see --help)");
-    if (!o->c.out_png && !o->c.out_hdr && !o->hdr_layers && !o->checkpoint_prefix)
-        return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: nothing to write: give -o FILE.png or --hdr FILE.pfm");
+    if (!o->c.out_png && !o->c.out_hdr && !o->hdr_layers && !o->checkpoint_prefix && !o->out_lux && !o->out_false)
+        return ps_error_set(err, PS_ERR_PARSE,
+                            "photosplat-snap: nothing to write: give -o FILE.png, --hdr FILE.pfm, --illuminance "
+                            "FILE.pfm or --false-color FILE.png");
     if ((o->checkpoint_count > 0) != (o->checkpoint_prefix != NULL))
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: --checkpoints and --checkpoint-prefix go together");
     if (o->checkpoint_count > 0 && o->time < o->checkpoints[o->checkpoint_count - 1])
@@ -212,6 +222,41 @@ static ps_status write_outputs(snap_run *s, ps_error *err)
     ps_image_destroy(&img);
     if (st == PS_OK && o->hdr_layers)
         st = write_layers(s, o->hdr_layers, err);
+    return st;
+}
+
+/* --illuminance and --false-color: the same photons drawn once more in the
+ * session's illuminance mode (white Lambertian surfaces, exposure 1) into
+ * float layers whatever the colour buffer, so that each pixel holds E / pi;
+ * then E in lux. Leaves the session and the renderer in that mode. */
+static ps_status write_illuminance(snap_run *s, ps_error *err)
+{
+    const snap_options *o = s->o;
+    ps_status st = ps_session_set_illuminance(s->session, true, err);
+    if (st != PS_OK)
+        return st;
+    ps_gl_renderer_set_materials(s->gl, ps_session_materials(s->session), true);
+    ps_gl_renderer_set_kernel(s->gl, ps_session_kernel(s->session));
+    ps_gl_layers *layers = NULL;
+    st = ps_gl_layers_create(s->cam.width, s->cam.height, true, &layers, err);
+    ps_session_frame f;
+    if (st == PS_OK)
+        st = ps_session_refresh(s->session, &s->cam, &f, err);
+    ps_image irr;
+    memset(&irr, 0, sizeof irr);
+    if (st == PS_OK) {
+        ps_gl_layers_draw(layers, s->gl, &s->cam, &f);
+        double gains[PS_MAP_COUNT] = {f.map[0].gain, f.map[1].gain};
+        st = ps_gl_layers_composite(layers, f.direct_gain, gains, &irr, err);
+    }
+    if (st == PS_OK) {
+        size_t n = 3 * (size_t)irr.width * (size_t)irr.height;
+        for (size_t i = 0; i < n; i++)
+            irr.rgb[i] *= (float)PS_PI; /* white Lambertian: L = E / pi */
+        st = ps_write_illuminance(o->out_lux, o->out_false, &irr, "photosplat-snap", err);
+    }
+    ps_image_destroy(&irr);
+    ps_gl_layers_destroy(layers);
     return st;
 }
 
@@ -382,6 +427,7 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
     ps_stats_add(&rs, "counter_stopped_at_photons", (double)counter_at);
     ps_stats_add(&rs, "counter_threshold", o->p.counter_threshold);
     ps_stats_add(&rs, "radius_progressive", o->p.radius_schedule == PS_RADIUS_PROGRESSIVE ? 1.0 : 0.0);
+    ps_stats_add(&rs, "luminous_flux_lm", ps_scene_total_lumens(ps_session_scene(s->session)));
     if (o->c.stats) {
         ps_status st = ps_stats_write(o->c.stats, &rs, err);
         if (st != PS_OK)
@@ -401,6 +447,10 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
         printf("wrote %s\n", o->c.out_png);
     if (o->c.out_hdr)
         printf("wrote %s\n", o->c.out_hdr);
+    if (o->out_lux)
+        printf("wrote %s\n", o->out_lux);
+    if (o->out_false)
+        printf("wrote %s\n", o->out_false);
     return PS_OK;
 }
 
@@ -440,6 +490,8 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
         st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted before writing the snapshot");
     if (st == PS_OK && (o->c.out_png || o->c.out_hdr || o->hdr_layers))
         st = write_outputs(&s, err);
+    if (st == PS_OK && (o->out_lux || o->out_false))
+        st = write_illuminance(&s, err);
     if (st == PS_OK && o->c.dump)
         st = ps_write_photon_dump(o->c.dump, ps_session_maps(s.session), err);
     if (st == PS_OK)
@@ -481,7 +533,9 @@ int main(int argc, char **argv)
         fputs(usage, stdout);
         return PS_EXIT_OK;
     }
-    if (ps_check_outputs(&o.c, &err) != PS_OK || check_prefixed_outputs(&o, &err) != PS_OK)
+    if (ps_check_outputs(&o.c, &err) != PS_OK || check_prefixed_outputs(&o, &err) != PS_OK ||
+        (o.out_lux && ps_check_output_path(o.out_lux, &err) != PS_OK) ||
+        (o.out_false && ps_check_output_path(o.out_false, &err) != PS_OK))
         return ps_cli_fail(&err);
     o.cancel = ps_interrupt_install();
     ps_scene *scene;

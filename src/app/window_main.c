@@ -896,6 +896,7 @@ static ps_status write_stats(app *a, ps_error *err)
     ps_stats_add(&rs, "photon_map_bytes", counts.map_bytes);
     ps_stats_add(&rs, "max_photons", (double)a->o.max_photons);
     ps_stats_add(&rs, "max_photons_reached", counts.store_limited ? 1.0 : 0.0);
+    ps_stats_add(&rs, "luminous_flux_lm", ps_scene_total_lumens(a->scene));
     return ps_stats_write(a->o.c.stats, &rs, err);
 }
 

@@ -177,6 +177,8 @@ void ps_gl_make_shadow_maps(ps_gl_renderer *r)
 /* Emissive faces (MTL Ke) as their own radiance, front side only. */
 static void draw_emission(const ps_gl_renderer *r, double exposure)
 {
+    if (r->in.hide_emitters)
+        return;
     const ps_preview_mesh *m = r->in.mesh;
     glEnableClientState(GL_VERTEX_ARRAY);
     glVertexPointer(3, GL_FLOAT, 0, m->positions);
@@ -424,6 +426,8 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure)
 
 void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct)
 {
+    if (r->in.hide_emitters)
+        return;
     const ps_preview_lights *lights = lights_of(r);
     glDisable(GL_BLEND);
     glDisable(GL_LIGHTING);

@@ -121,10 +121,12 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
     r->width = cam->width;
     r->height = cam->height;
     glViewport(0, 0, cam->width, cam->height);
-    if (r->opt.float_buffer) {
-        glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
-        glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
-    }
+    /* No clamping on the way, in any buffer: radiance is interpolated and
+     * modulated (shadows, spot discs, IES tables) as it is, and only an 8-bit
+     * buffer's store clamps it, once, as a display would; float targets (the
+     * window's layers, the illuminance pass) keep it all. */
+    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
     glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
     glClearColor(0, 0, 0, 0);
     glClearDepth(1.0);
@@ -212,9 +214,8 @@ ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err)
 
 ps_gl_scene ps_gl_scene_of(const ps_session *s)
 {
-    size_t n;
-    ps_gl_scene in = {ps_session_mesh(s), ps_session_coarse_mesh(s), ps_scene_materials(ps_session_scene(s), &n),
-                      ps_session_lights(s), ps_scene_bounds(ps_session_scene(s))};
+    ps_gl_scene in = {ps_session_mesh(s), ps_session_coarse_mesh(s), ps_session_materials(s), ps_session_lights(s),
+                      ps_scene_bounds(ps_session_scene(s)), ps_session_illuminance(s)};
     return in;
 }
 
@@ -233,6 +234,12 @@ ps_status ps_gl_renderer_set_scene(ps_gl_renderer *r, const ps_gl_scene *in, ps_
 }
 
 void ps_gl_renderer_set_kernel(ps_gl_renderer *r, const ps_kernel_texture *kernel) { ps_gl_upload_kernel(r, kernel); }
+
+void ps_gl_renderer_set_materials(ps_gl_renderer *r, const ps_material *materials, bool hide_emitters)
+{
+    r->in.materials = materials;
+    r->in.hide_emitters = hide_emitters;
+}
 
 ps_status ps_gl_renderer_create(const ps_gl_scene *in, const ps_kernel_texture *kernel, const ps_gl_options *o,
                                 ps_gl_renderer **out, ps_error *err)

@@ -58,9 +58,11 @@ typedef struct ps_gl_scene {
     const ps_material *materials;    /* indexed by the meshes' ranges */
     const ps_preview_lights *lights; /* GL lights and visible emitters */
     ps_aabb bounds;                  /* of geometry and lights: near and far planes */
+    bool hide_emitters;              /* look through emitters (illuminance mode) */
 } ps_gl_scene;
 
-/* A session's meshes, lights and materials as they stand. */
+/* A session's meshes, lights and materials as they stand (its illuminance
+ * mode's white materials and hidden emitters included). */
 ps_gl_scene ps_gl_scene_of(const ps_session *s);
 
 /* The kernel texture is uploaded for the splats. Needs a current context. */
@@ -73,6 +75,9 @@ void ps_gl_renderer_destroy(ps_gl_renderer *r);
 ps_status ps_gl_renderer_set_scene(ps_gl_renderer *r, const ps_gl_scene *in, ps_error *err);
 /* The kernel texture changed (another kernel). */
 void ps_gl_renderer_set_kernel(ps_gl_renderer *r, const ps_kernel_texture *kernel);
+/* Other materials for the same meshes (as many, in the same order), and
+ * whether emitters are looked through; the shadow maps stay. */
+void ps_gl_renderer_set_materials(ps_gl_renderer *r, const ps_material *materials, bool hide_emitters);
 
 /* Starts a frame of width x height: clears, sets the camera, writes depth,
  * and draws the direct layer (GL lights times exposure) or, without it, the

@@ -2,6 +2,7 @@
 #include "preview/session.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,6 +19,8 @@ struct ps_session {
     ps_preview_lights lights;
     ps_kernel_texture kernel;
     ps_splat_batch batch[PS_MAP_COUNT];
+    bool illuminance;      /* white Lambertian, exposure 1, float (ps_session_set_illuminance) */
+    ps_material *white;    /* as many as the scene's, for illuminance mode */
     /* Invariant: drawn[k] photons of map k (a prefix ending at a feed mark,
      * drawn_emitted[k] emitted) are in the layers since the last new view. */
     size_t drawn[PS_MAP_COUNT];
@@ -63,6 +66,10 @@ ps_session_settings ps_session_default_settings(const ps_scene *scene)
 }
 
 static bool incremental(const ps_session *s) { return s->set.incremental && s->set.float_buffer; }
+/* What the splats are drawn in: floats, or an 8-bit buffer's codes. */
+static bool float_splats(const ps_session *s) { return s->set.float_buffer || s->illuminance; }
+/* The exposure splats and lights are drawn with: illuminance is radiometric. */
+static double exposure(const ps_session *s) { return s->illuminance ? 1.0 : s->set.exposure; }
 
 /* The feed runs only while nothing holds it. */
 static void apply_pause(ps_session *s)
@@ -107,9 +114,9 @@ static void free_maps(ps_session *s)
 
 /* The kernel texture: smooth for float buffers, a halftone for 8 bits, where
  * a smooth kernel's fragments round away (splat.h). */
-static ps_status make_kernel(const ps_session_settings *set, ps_kernel k, ps_kernel_texture *out, ps_error *err)
+static ps_status make_kernel(bool float_splats, ps_kernel k, ps_kernel_texture *out, ps_error *err)
 {
-    if (set->float_buffer)
+    if (float_splats)
         return ps_kernel_texture_make(k, PS_KERNEL_TEXTURE_SIZE, out, err);
     return ps_kernel_texture_make_halftone(k, PS_KERNEL_HALFTONE_SIZE, out, err);
 }
@@ -175,7 +182,7 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
     if (st == PS_OK)
         st = new_tracer(s, err);
     if (st == PS_OK)
-        st = make_kernel(set, set->kernel, &s->kernel, err);
+        st = make_kernel(set->float_buffer, set->kernel, &s->kernel, err);
     if (st == PS_OK)
         st = build_lights(s, err);
     if (st == PS_OK)
@@ -200,6 +207,7 @@ void ps_session_destroy(ps_session *s)
     ps_kernel_texture_free(&s->kernel);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_splat_batch_free(&s->batch[k]);
+    free(s->white);
     free(s);
 }
 
@@ -309,8 +317,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         s->view_dirty = false;
     }
     double t0 = ps_now_seconds();
-    size_t nmat;
-    const ps_material *materials = ps_scene_materials(s->scene, &nmat);
+    const ps_material *materials = ps_session_materials(s);
     double wanted = 0.0, lost = 0.0;
     ps_status st = PS_OK;
     ps_feed_lock(s->feed);
@@ -341,10 +348,10 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         p.kernel_extent = s->kernel.extent;
         /* Powers are normalised for the cap N; n have been emitted so far.
          * Incremental layers sum stored powers and the composite scales. */
-        p.scale = inc ? 1.0 : s->set.exposure * (double)s->set.caps[k] / (double)emitted;
+        p.scale = inc ? 1.0 : exposure(s) * (double)s->set.caps[k] / (double)emitted;
         p.point_size = s->set.point_size;
         p.precision = s->set.precision;
-        p.levels = s->set.float_buffer ? 0 : 255;
+        p.levels = float_splats(s) ? 0 : 255;
         p.materials = materials;
         p.objects = s->set.stencil_clip ? m->objects + from : NULL;
         p.cam = *cam;
@@ -362,8 +369,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     if (st != PS_OK)
         return st;
     out->direct = (s->set.layers & PS_LAYER_DIRECT) != 0;
-    out->direct_exposure = inc ? 1.0 : s->set.exposure;
-    out->direct_gain = inc ? s->set.exposure : 1.0;
+    out->direct_exposure = inc ? 1.0 : exposure(s);
+    out->direct_gain = inc ? exposure(s) : 1.0;
     out->splat = s->set.splat;
     out->point_size = s->set.point_size;
     out->round_off = s->round_off;
@@ -373,7 +380,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         l->clear = !inc;
         l->batch = &s->batch[k];
         l->radius = s->splat_radius[k];
-        l->gain = !shown ? 0.0 : inc ? s->set.exposure * (double)s->set.caps[k] / (double)out->emitted[k] : 1.0;
+        l->gain = !shown ? 0.0 : inc ? exposure(s) * (double)s->set.caps[k] / (double)out->emitted[k] : 1.0;
     }
     return PS_OK;
 }
@@ -386,7 +393,7 @@ void ps_session_drawn(ps_session *s, double draw_seconds)
     }
     /* Thesis 5.1: once a refresh loses this much to round-off, more photons
      * only add noise: stop shooting (until the next edit). */
-    if (!s->set.float_buffer && s->set.precision == PS_PRECISION_COUNTER && !s->counter_stopped &&
+    if (!float_splats(s) && s->set.precision == PS_PRECISION_COUNTER && !s->counter_stopped &&
         s->round_off > s->set.counter_threshold) {
         s->counter_stopped = true;
         s->counter_at = s->drawn_emitted[0] + s->drawn_emitted[1];
@@ -428,7 +435,7 @@ void ps_session_set_splat(ps_session *s, ps_splat_mode mode)
 ps_status ps_session_set_kernel(ps_session *s, ps_kernel kernel, ps_error *err)
 {
     ps_kernel_texture t;
-    ps_status st = make_kernel(&s->set, kernel, &t, err);
+    ps_status st = make_kernel(float_splats(s), kernel, &t, err);
     if (st != PS_OK)
         return st;
     ps_kernel_texture_free(&s->kernel);
@@ -461,6 +468,41 @@ void ps_session_set_radius(ps_session *s, ps_map_kind k, double radius)
 }
 
 void ps_session_set_tau(ps_session *s, double tau) { s->set.tau = tau; }
+
+ps_status ps_session_set_illuminance(ps_session *s, bool on, ps_error *err)
+{
+    if (on == s->illuminance)
+        return PS_OK;
+    size_t n;
+    const ps_material *m = ps_scene_materials(s->scene, &n);
+    if (on && !s->white) {
+        s->white = calloc(n ? n : 1, sizeof *s->white);
+        if (!s->white)
+            return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for %zu materials", ps_scene_path(s->scene), n);
+        for (size_t i = 0; i < n; i++) {
+            snprintf(s->white[i].name, sizeof s->white[i].name, "%s", m[i].name);
+            s->white[i].type = PS_MAT_DIFFUSE;
+            s->white[i].albedo = ps_rgb_make(1.0, 1.0, 1.0);
+        }
+    }
+    ps_kernel_texture t;
+    ps_status st = make_kernel(on || s->set.float_buffer, s->set.kernel, &t, err);
+    if (st != PS_OK)
+        return st;
+    ps_kernel_texture_free(&s->kernel);
+    s->kernel = t;
+    s->illuminance = on;
+    s->view_dirty = true;
+    return PS_OK;
+}
+
+bool ps_session_illuminance(const ps_session *s) { return s->illuminance; }
+
+const ps_material *ps_session_materials(const ps_session *s)
+{
+    size_t n;
+    return s->illuminance ? s->white : ps_scene_materials(s->scene, &n);
+}
 
 /* ---- edits --------------------------------------------------------------------------- */
 

@@ -165,6 +165,19 @@ void ps_session_set_exposure(ps_session *s, double exposure);
 void ps_session_set_radius(ps_session *s, ps_map_kind k, double radius);
 void ps_session_set_tau(ps_session *s, double tau);
 
+/* Illuminance mode (for lux: --illuminance, the window's false colour): every
+ * surface drawn as white Lambertian (albedo 1, ps_session_materials), so that
+ * a pixel's radiance is the irradiance E / pi arriving where it looks,
+ * whatever the surface's own material; at exposure 1, in float (no 8-bit
+ * handling, the smooth kernel: re-upload ps_session_kernel), and the emitters
+ * looked through, as the reference renderer's illuminance does. Starts a new
+ * view; the photons stay. */
+ps_status ps_session_set_illuminance(ps_session *s, bool on, ps_error *err);
+bool ps_session_illuminance(const ps_session *s);
+/* The materials splats and GL draw with: the scene's, or in illuminance mode
+ * white Lambertian ones (as many, in the same order). */
+const ps_material *ps_session_materials(const ps_session *s);
+
 /* ---- edits ------------------------------------------------------------------------
  * Each checks its arguments as the scene's edits do (scene.h: an error names
  * the scene line, and leaves everything as it was) and marks what it
