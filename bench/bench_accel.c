@@ -145,7 +145,7 @@ static int measure(const char *name, const bench_scene *s, const ps_ray *rays, r
     /* Step 1: build the octree (forced: AUTO would pick brute force for the default scene). */
     ps_accel_input in = {s->positions, s->position_count, s->indices, s->triangle_count,
                          s->centers,   s->radii,          s->sphere_count};
-    ps_accel_options opt = {PS_ACCEL_OCTREE, 0, 0};
+    ps_accel_options opt = {PS_ACCEL_OCTREE, 0, 0, false};
     ps_accel *a = NULL;
     ps_error err;
     if (ps_accel_build(&in, &opt, &a, &err) != PS_OK) {

@@ -51,6 +51,7 @@ typedef struct ps_accel_options {
     ps_accel_kind kind; /* AUTO: brute force below PS_ACCEL_BRUTE_MAX_PRIMS primitives (tiny scenes), else octree */
     int max_depth;      /* 0: default (PS_OCTREE_DEFAULT_MAX_DEPTH); clamped to PS_OCTREE_MAX_DEPTH_LIMIT */
     int leaf_prims;     /* 0: default (PS_OCTREE_DEFAULT_LEAF_PRIMS): a node with at most this many primitives is a leaf */
+    bool no_simd;       /* true: the scalar traversal even where the processor has AVX2 (same results; tests, bench) */
 } ps_accel_options;     /* zero-initialised = all defaults */
 
 /* Geometry to build over; arrays are only read during build (the accel copies what it needs).
@@ -88,6 +89,24 @@ bool ps_accel_intersect(const ps_accel *a, ps_ray r, double tmin, double tmax, p
 bool ps_accel_occluded(const ps_accel *a, ps_ray r, double tmin, double tmax);
 /* The oracle: tests every primitive (same primitive tests, no tree). */
 bool ps_accel_intersect_brute(const ps_accel *a, ps_ray r, double tmin, double tmax, ps_hit *hit);
+
+/* The nearest point of the geometry to a point: of the hittable primitives
+ * (triangles with area, spheres with a radius: their surfaces). */
+typedef struct ps_nearest {
+    double distance; /* |point - p| */
+    uint32_t prim;   /* primitive id as in ps_hit; equally near ones go to the lower id */
+    ps_vec3 point;   /* the nearest point on that primitive */
+} ps_nearest;
+/* The primitive nearest to p within max_dist (inclusive; INFINITY: any); false
+ * when none is (or p is not finite, or max_dist is NaN or negative). Through
+ * the octree, visiting only cells nearer than the best so far; the same answer
+ * as ps_accel_nearest_brute, bit for bit. Const, thread-safe like the ray queries.
+ * (What a light's shadow cube needs for its near plane: nothing is nearer.) */
+bool ps_accel_nearest(const ps_accel *a, ps_vec3 p, double max_dist, ps_nearest *out);
+/* The oracle: every primitive (same distance arithmetic). */
+bool ps_accel_nearest_brute(const ps_accel *a, ps_vec3 p, double max_dist, ps_nearest *out);
+/* Shorthand: the distance from p to the nearest primitive; INFINITY when there is none. */
+double ps_accel_nearest_distance(const ps_accel *a, ps_vec3 p);
 
 /* Self-intersection offset for rays leaving a surface: PS_RAY_EPSILON_REL times the scene's extent
  * (ps_aabb_extent of all geometry; at least PS_RAY_EPSILON_MIN). Scales with the scene: a scene

@@ -53,6 +53,7 @@ typedef struct accel_node {
 
 struct ps_accel {
     ps_accel_kind kind;
+    bool simd; /* traverse with ps_accel_octree_trace_avx2 (the processor has AVX2, no_simd not asked) */
     /* Hittable primitives. Triangles are stored in the order the octree's
      * leaves first reference them (depth first), so a leaf's triangles mostly
      * sit together in memory; tri_ids maps back to the input's numbering.
@@ -72,6 +73,7 @@ struct ps_accel {
     size_t ref_count;
     ps_vec3 root_lo;
     double root_side;
+    double cell_pad; /* the padding of the build's overlap tests: a primitive within it of a cell is filed there */
     /* What the API reports. */
     ps_aabb bounds;
     double epsilon;
@@ -110,7 +112,7 @@ static inline double accel_pow2(int e)
 /* Fills r from a ray; false when the ray can hit nothing (non-finite origin,
  * or a direction that is zero, NaN or infinite). The sphere test's fields
  * (a square root and a division) are filled only when spheres is true. */
-static inline bool accel_ray_prepare(ps_ray ray, accel_ray *r, bool spheres)
+static PS_ALWAYS_INLINE bool accel_ray_prepare(ps_ray ray, accel_ray *r, bool spheres)
 {
     if (!ps_v3_isfinite(ray.o) || !ps_v3_isfinite(ray.d))
         return false;
@@ -247,5 +249,9 @@ static inline bool accel_hit_better(double t, uint32_t id, const ps_hit *best, b
 ps_status ps_accel_octree_build(ps_accel *a, int max_depth, int leaf_prims, ps_error *err);
 /* Octree query: nearest hit (any == false) or any hit (any == true). */
 bool ps_accel_octree_trace(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any);
+/* The same query with AVX2 vectors (octree_trace_avx2.c), bit-identical
+ * results; only where ps_accel_cpu_has_avx2() (elsewhere it is the scalar one). */
+bool ps_accel_octree_trace_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any);
+bool ps_accel_cpu_has_avx2(void);
 
 #endif
