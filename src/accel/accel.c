@@ -138,7 +138,7 @@ ps_status ps_accel_build(const ps_accel_input *in, const ps_accel_options *opt, 
     if (kind == PS_ACCEL_AUTO)
         kind = in->triangle_count + in->sphere_count < PS_ACCEL_BRUTE_MAX_PRIMS ? PS_ACCEL_BRUTE : PS_ACCEL_OCTREE;
     a->kind = kind;
-    a->simd = kind == PS_ACCEL_OCTREE && !o.no_simd && ps_accel_cpu_has_avx2();
+    a->simd = !o.no_simd && ps_accel_cpu_has_avx2();
     if (kind == PS_ACCEL_OCTREE) {
         st = ps_accel_octree_build(a, max_depth, leaf_prims, err);
         if (st != PS_OK) {
@@ -258,8 +258,10 @@ static bool query(const ps_accel *a, ps_ray ray, double tmin, double tmax, ps_hi
     /* NaN limits fail this comparison too. */
     if (!a || !(tmin < tmax) || !accel_ray_prepare(ray, &r, a->sphere_count > 0))
         return false;
-    if (force_brute || a->kind != PS_ACCEL_OCTREE)
+    if (force_brute)
         return brute_dispatch(a, &r, tmin, tmax, hit, any);
+    if (a->kind != PS_ACCEL_OCTREE)
+        return a->simd ? ps_accel_brute_avx2(a, &r, tmin, tmax, hit, any) : brute_dispatch(a, &r, tmin, tmax, hit, any);
     if (a->simd)
         return ps_accel_octree_trace_avx2(a, &r, tmin, tmax, hit, any);
     return ps_accel_octree_trace(a, &r, tmin, tmax, hit, any);

@@ -53,7 +53,7 @@ typedef struct accel_node {
 
 struct ps_accel {
     ps_accel_kind kind;
-    bool simd; /* traverse with ps_accel_octree_trace_avx2 (the processor has AVX2, no_simd not asked) */
+    bool simd; /* query with the AVX2 code (octree_trace_avx2.c): the processor has it, no_simd not asked */
     /* Hittable primitives. Triangles are stored in the order the octree's
      * leaves first reference them (depth first), so a leaf's triangles mostly
      * sit together in memory; tri_ids maps back to the input's numbering.
@@ -252,6 +252,8 @@ bool ps_accel_octree_trace(const ps_accel *a, const accel_ray *r, double tmin, d
 /* The same query with AVX2 vectors (octree_trace_avx2.c), bit-identical
  * results; only where ps_accel_cpu_has_avx2() (elsewhere it is the scalar one). */
 bool ps_accel_octree_trace_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any);
+/* A brute-force accelerator's query with AVX2 (triangles four at a time), same answers. */
+bool ps_accel_brute_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any);
 bool ps_accel_cpu_has_avx2(void);
 
 #endif

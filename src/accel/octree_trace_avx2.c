@@ -18,7 +18,9 @@
  *   contract), so every lane's t, b1 and b2 are bit-identical to
  *   accel_tri_hit's, and the octree still agrees exactly with the oracle.
  *
- * Spheres, rare in leaves, use the scalar test. */
+ * Spheres, rare in leaves, use the scalar test. A brute-force accelerator
+ * (the tiny scenes PS_ACCEL_AUTO leaves without a tree) tests its triangles
+ * four at a time here too; ps_accel_intersect_brute, the oracle, stays scalar. */
 #if defined(__GNUC__) && defined(__x86_64__)
 #pragma GCC target("avx2")
 #include <float.h>
@@ -77,15 +79,14 @@ typedef struct ray4 {
     __m256d ox, oy, oz, sx, sy, sz;
 } ray4;
 
-/* Up to four triangles (refs[0..n), n in 1..4) against the ray: the lanes
- * that hit, as bits, with t, b1, b2 per lane. Step for step accel_tri_hit. */
-static PS_ALWAYS_INLINE unsigned tri_hit4(const ps_accel *a, const uint32_t *refs, unsigned n, const ray4 *q, int kx,
-                                          int ky, int kz, double t[4], double b1[4], double b2[4])
+/* Up to four triangles (t0..t3, the first n of them real, n in 1..4; the
+ * others repeat one of them) against the ray: the lanes that hit, as bits,
+ * with t, b1, b2 per lane. Step for step accel_tri_hit. */
+static PS_ALWAYS_INLINE unsigned tri_hit4(const accel_tri *t0, const accel_tri *t1, const accel_tri *t2,
+                                          const accel_tri *t3, unsigned n, const ray4 *q, int kx, int ky, int kz,
+                                          double t[4], double b1[4], double b2[4])
 {
-    const double *p0 = a->tris[refs[0]].v;
-    const double *p1 = a->tris[refs[n > 1 ? 1 : 0]].v;
-    const double *p2 = a->tris[refs[n > 2 ? 2 : 0]].v;
-    const double *p3 = a->tris[refs[n > 3 ? 3 : 0]].v;
+    const double *p0 = t0->v, *p1 = t1->v, *p2 = t2->v, *p3 = t3->v;
     /* Step 0: the coordinates, one vector each: V[vertex][axis]. */
     __m256d V[3][3];
     TRANSPOSE4(_mm256_loadu_pd(p0), _mm256_loadu_pd(p1), _mm256_loadu_pd(p2), _mm256_loadu_pd(p3), V[0][0], V[0][1],
@@ -184,7 +185,9 @@ static PS_ALWAYS_INLINE bool trace(const ps_accel *a, const accel_ray *r, double
             for (uint32_t k = 0; k < ntri; k += 4) {
                 double t[4], b1[4], b2[4];
                 unsigned n = ntri - k < 4 ? ntri - k : 4;
-                unsigned mask = tri_hit4(a, refs + k, n, &q, kx, ky, kz, t, b1, b2);
+                const uint32_t *rk = refs + k;
+                unsigned mask = tri_hit4(&a->tris[rk[0]], &a->tris[rk[n > 1 ? 1 : 0]], &a->tris[rk[n > 2 ? 2 : 0]],
+                                         &a->tris[rk[n > 3 ? 3 : 0]], n, &q, kx, ky, kz, t, b1, b2);
                 while (mask) {
                     unsigned j = (unsigned)__builtin_ctz(mask);
                     mask &= mask - 1;
@@ -274,6 +277,60 @@ static PS_ALWAYS_INLINE bool trace(const ps_accel *a, const accel_ray *r, double
     return found;
 }
 
+/* Every primitive, the triangles four at a time: the query of a brute-force
+ * accelerator (tiny scenes) where the processor has AVX2. The same answers
+ * as accel.c's loop, which stays the oracle. */
+static PS_ALWAYS_INLINE bool brute(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit,
+                                   bool any, int kx, int ky, int kz)
+{
+    ray4 q = {_mm256_set1_pd(r->o[0]), _mm256_set1_pd(r->o[1]), _mm256_set1_pd(r->o[2]),
+              _mm256_set1_pd(r->sx),   _mm256_set1_pd(r->sy),   _mm256_set1_pd(r->sz)};
+    ps_hit best = {tmax, UINT32_MAX, 0.0, 0.0};
+    bool found = false;
+    const accel_tri *tris = a->tris;
+    for (uint32_t k = 0; k < a->tri_count; k += 4) {
+        double t[4], b1[4], b2[4];
+        unsigned n = a->tri_count - k < 4 ? a->tri_count - k : 4;
+        unsigned mask = tri_hit4(&tris[k], &tris[k + (n > 1 ? 1 : 0)], &tris[k + (n > 2 ? 2 : 0)], &tris[k + (n > 3 ? 3 : 0)],
+                                 n, &q, kx, ky, kz, t, b1, b2);
+        while (mask) {
+            unsigned j = (unsigned)__builtin_ctz(mask);
+            mask &= mask - 1;
+            uint32_t id = a->tri_ids[k + j];
+            if (!accel_hit_better(t[j], id, &best, found, tmin))
+                continue;
+            if (any)
+                return true;
+            best = (ps_hit){t[j], id, b1[j], b2[j]};
+            found = true;
+        }
+    }
+    for (uint32_t k = 0; k < a->sphere_count; k++) {
+        double t = accel_sphere_hit(&a->spheres[k], r, tmin);
+        if (!accel_hit_better(t, a->sphere_ids[k], &best, found, tmin))
+            continue;
+        if (any)
+            return true;
+        best = (ps_hit){t, a->sphere_ids[k], 0.0, 0.0};
+        found = true;
+    }
+    if (found && !any)
+        *hit = best;
+    return found;
+}
+
+bool ps_accel_brute_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any)
+{
+    switch (r->kz) {
+    case 0:
+        return any ? brute(a, r, tmin, tmax, hit, true, 1, 2, 0) : brute(a, r, tmin, tmax, hit, false, 1, 2, 0);
+    case 1:
+        return any ? brute(a, r, tmin, tmax, hit, true, 2, 0, 1) : brute(a, r, tmin, tmax, hit, false, 2, 0, 1);
+    default:
+        return any ? brute(a, r, tmin, tmax, hit, true, 0, 1, 2) : brute(a, r, tmin, tmax, hit, false, 0, 1, 2);
+    }
+}
+
 bool ps_accel_octree_trace_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any)
 {
     if (a->node_count == 0)
@@ -295,6 +352,12 @@ bool ps_accel_cpu_has_avx2(void)
 }
 #else
 #include "accel/accel_internal.h"
+
+bool ps_accel_brute_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any)
+{
+    (void)a, (void)r, (void)tmin, (void)tmax, (void)hit, (void)any;
+    return false; /* never called: a->simd is false without AVX2 */
+}
 
 bool ps_accel_octree_trace_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any)
 {
