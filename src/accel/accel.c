@@ -139,6 +139,7 @@ ps_status ps_accel_build(const ps_accel_input *in, const ps_accel_options *opt, 
         kind = in->triangle_count + in->sphere_count < PS_ACCEL_BRUTE_MAX_PRIMS ? PS_ACCEL_BRUTE : PS_ACCEL_OCTREE;
     a->kind = kind;
     a->simd = !o.no_simd && ps_accel_cpu_has_avx2();
+    a->prefetch_leaves = (size_t)a->tri_count * sizeof *a->tris > ACCEL_PREFETCH_BYTES;
     if (kind == PS_ACCEL_OCTREE) {
         st = ps_accel_octree_build(a, max_depth, leaf_prims, err);
         if (st != PS_OK) {

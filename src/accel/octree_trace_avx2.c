@@ -132,29 +132,30 @@ static PS_ALWAYS_INLINE unsigned tri_hit4(const accel_tri *t0, const accel_tri *
 static PS_ALWAYS_INLINE bool trace(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit,
                                    bool any, int kx, int ky, int kz)
 {
-    /* Step 1: mirror mask, inverse direction, the root's parameters (as the
-     * scalar traversal computes them), and the ray's vectors. */
-    unsigned mirror = 0;
-    double t0s[4], t1s[4];
-    double root_lo[3] = {a->root_lo.x, a->root_lo.y, a->root_lo.z};
-    for (int i = 0; i < 3; i++) {
-        double mag = fabs(r->ds[i]);
-        mag = mag > DIR_ZERO ? mag : DIR_ZERO;
-        double ds = copysign(mag, r->ds[i]), inv = 1.0 / ds;
-        bool neg = signbit(ds) != 0;
-        mirror |= (unsigned)neg << (2 - i);
-        double lo = root_lo[i], hi = root_lo[i] + a->root_side;
-        t0s[i] = ((neg ? hi : lo) - r->o[i]) * inv;
-        t1s[i] = ((neg ? lo : hi) - r->o[i]) * inv;
-    }
+    /* Step 1: mirror mask, inverse direction and the root's parameters, as
+     * the scalar traversal computes them, lane by lane: |ds| raised to
+     * DIR_ZERO keeping its sign, its inverse, and for a negative component the
+     * planes swapped. Lane 3 (the padding) holds tmin in T0 and +inf in T1:
+     * T0's largest lane is then the clipped entry and T1's padding is never
+     * the smallest; tmin is kept finite there so that the padding's midplane,
+     * (tmin + inf) / 2, is inf rather than NaN. */
     double ts = r->tscale;
     double tmin_s = tmin * ts, best_s = tmax * ts;
-    /* The padding lane: T0's holds tmin (so that its largest lane is the
-     * clipped entry), T1's +inf (never the smallest); tmin is kept finite
-     * there so that the midplane lane, (tmin + inf) / 2, is inf, not NaN. */
-    t0s[3] = tmin_s > -DBL_MAX ? tmin_s : -DBL_MAX;
-    t1s[3] = INFINITY;
-    __m256d T0 = _mm256_loadu_pd(t0s), T1 = _mm256_loadu_pd(t1s);
+    const __m256d sign_bit = _mm256_set1_pd(-0.0);
+    __m256d ds = _mm256_set_pd(1.0, r->ds[2], r->ds[1], r->ds[0]);
+    __m256d mag = _mm256_max_pd(_mm256_andnot_pd(sign_bit, ds), _mm256_set1_pd(DIR_ZERO));
+    ds = _mm256_or_pd(mag, _mm256_and_pd(sign_bit, ds));
+    __m256d inv = _mm256_div_pd(_mm256_set1_pd(1.0), ds);
+    __m256d negative = _mm256_cmp_pd(ds, _mm256_setzero_pd(), _CMP_LT_OQ); /* |ds| >= DIR_ZERO: never -0 */
+    unsigned neg_bits = (unsigned)_mm256_movemask_pd(negative);
+    unsigned mirror = (neg_bits & 1u) << 2 | (neg_bits & 2u) | (neg_bits >> 2 & 1u);
+    __m256d lo = _mm256_set_pd(0.0, a->root_lo.z, a->root_lo.y, a->root_lo.x);
+    __m256d hi = _mm256_add_pd(lo, _mm256_set1_pd(a->root_side));
+    __m256d org = _mm256_set_pd(0.0, r->o[2], r->o[1], r->o[0]);
+    __m256d T0 = _mm256_mul_pd(_mm256_sub_pd(_mm256_blendv_pd(lo, hi, negative), org), inv);
+    __m256d T1 = _mm256_mul_pd(_mm256_sub_pd(_mm256_blendv_pd(hi, lo, negative), org), inv);
+    T0 = _mm256_blend_pd(T0, _mm256_set1_pd(tmin_s > -DBL_MAX ? tmin_s : -DBL_MAX), 8);
+    T1 = _mm256_blend_pd(T1, _mm256_set1_pd(INFINITY), 8);
     /* Step 2: clip to [tmin, tmax]. */
     if (hmax4(T0) > best_s || hmin4(T1) < tmin_s)
         return false;
@@ -177,11 +178,14 @@ static PS_ALWAYS_INLINE bool trace(const ps_accel *a, const accel_ray *r, double
             uint32_t count = node.count, ntri = count;
             while (ntri > 0 && refs[ntri - 1] >= a->tri_count)
                 ntri--;
-            for (uint32_t k = 0; k < ntri; k++) {
-                const char *p = (const char *)&a->tris[refs[k]];
-                PS_PREFETCH(p);
-                PS_PREFETCH(p + sizeof(accel_tri) - 1);
-            }
+            /* Ask for all the leaf's triangles before testing any, so that
+             * their misses overlap; only worth it when they may miss. */
+            if (a->prefetch_leaves)
+                for (uint32_t k = 0; k < ntri; k++) {
+                    const char *p = (const char *)&a->tris[refs[k]];
+                    PS_PREFETCH(p);
+                    PS_PREFETCH(p + sizeof(accel_tri) - 1);
+                }
             for (uint32_t k = 0; k < ntri; k += 4) {
                 double t[4], b1[4], b2[4];
                 unsigned n = ntri - k < 4 ? ntri - k : 4;
