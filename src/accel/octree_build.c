@@ -435,10 +435,16 @@ ps_status ps_accel_octree_build(ps_accel *a, int max_depth, int leaf_prims, ps_e
     }
     memcpy(a->nodes, b.nodes, sizeof *b.nodes * b.node_count);
     a->node_count = b.node_count;
-    uint32_t *trimmed = realloc(b.refs, sizeof *b.refs * (b.ref_count ? b.ref_count : 1));
-    a->refs = trimmed ? trimmed : b.refs; /* growth left up to half unused */
+    /* The references move to their own array (growth left up to half of
+     * b.refs unused), in large pages like the nodes. */
+    a->refs = alloc_traversed(sizeof *b.refs * (b.ref_count ? b.ref_count : 1));
+    if (!a->refs) {
+        st = no_memory(err);
+        goto done;
+    }
+    if (b.ref_count)
+        memcpy(a->refs, b.refs, sizeof *b.refs * b.ref_count);
     a->ref_count = b.ref_count;
-    b.refs = NULL;
     st = reorder_triangles(a, err);
     /* Nodes 1..7 only pad the root's block. */
     a->stats.nodes = b.node_count > ACCEL_NODE_BLOCK ? b.node_count - (ACCEL_NODE_BLOCK - 1) : 1;
