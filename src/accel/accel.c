@@ -19,6 +19,17 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* Outside octree_trace_avx2.c, whose code must not run before this says yes. */
+bool ps_accel_cpu_has_avx2(void)
+{
+#if defined(__GNUC__) && defined(__x86_64__)
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2");
+#else
+    return false;
+#endif
+}
+
 static bool triangle_degenerate(const accel_tri *t)
 {
     ps_vec3 p0 = ps_v3(t->v[0], t->v[1], t->v[2]);

@@ -22,11 +22,15 @@
  * (the tiny scenes PS_ACCEL_AUTO leaves without a tree) tests its triangles
  * four at a time here too; ps_accel_intersect_brute, the oracle, stays scalar. */
 #if defined(__GNUC__) && defined(__x86_64__)
-#pragma GCC target("avx2")
 #include <float.h>
 #include <immintrin.h>
 
 #include "accel/accel_internal.h"
+
+/* Every function here is compiled for AVX2 (per function, so that the rest of
+ * the program runs anywhere, and the same with GCC and clang); AVX2 does not
+ * imply FMA, so no multiply-add is fused. */
+#define AVX2 __attribute__((target("avx2")))
 
 /* As in octree_trace.c: zero direction components raised to this. */
 #define DIR_ZERO 1e-100
@@ -51,13 +55,13 @@ typedef struct trav_item {
     uint32_t node;
 } trav_item;
 
-static inline double hmax4(__m256d v)
+static inline AVX2 double hmax4(__m256d v)
 {
     __m128d m = _mm_max_pd(_mm256_castpd256_pd128(v), _mm256_extractf128_pd(v, 1));
     return _mm_cvtsd_f64(_mm_max_sd(m, _mm_unpackhi_pd(m, m)));
 }
 
-static inline double hmin4(__m256d v)
+static inline AVX2 double hmin4(__m256d v)
 {
     __m128d m = _mm_min_pd(_mm256_castpd256_pd128(v), _mm256_extractf128_pd(v, 1));
     return _mm_cvtsd_f64(_mm_min_sd(m, _mm_unpackhi_pd(m, m)));
@@ -82,7 +86,7 @@ typedef struct ray4 {
 /* Up to four triangles (t0..t3, the first n of them real, n in 1..4; the
  * others repeat one of them) against the ray: the lanes that hit, as bits,
  * with t, b1, b2 per lane. Step for step accel_tri_hit. */
-static PS_ALWAYS_INLINE unsigned tri_hit4(const accel_tri *t0, const accel_tri *t1, const accel_tri *t2,
+static PS_ALWAYS_INLINE AVX2 unsigned tri_hit4(const accel_tri *t0, const accel_tri *t1, const accel_tri *t2,
                                           const accel_tri *t3, unsigned n, const ray4 *q, int kx, int ky, int kz,
                                           double t[4], double b1[4], double b2[4])
 {
@@ -129,7 +133,7 @@ static PS_ALWAYS_INLINE unsigned tri_hit4(const accel_tri *t0, const accel_tri *
     return mask;
 }
 
-static PS_ALWAYS_INLINE bool trace(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit,
+static PS_ALWAYS_INLINE AVX2 bool trace(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit,
                                    bool any, int kx, int ky, int kz)
 {
     /* Step 1: mirror mask, inverse direction and the root's parameters, as
@@ -284,7 +288,7 @@ static PS_ALWAYS_INLINE bool trace(const ps_accel *a, const accel_ray *r, double
 /* Every primitive, the triangles four at a time: the query of a brute-force
  * accelerator (tiny scenes) where the processor has AVX2. The same answers
  * as accel.c's loop, which stays the oracle. */
-static PS_ALWAYS_INLINE bool brute(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit,
+static PS_ALWAYS_INLINE AVX2 bool brute(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit,
                                    bool any, int kx, int ky, int kz)
 {
     ray4 q = {_mm256_set1_pd(r->o[0]), _mm256_set1_pd(r->o[1]), _mm256_set1_pd(r->o[2]),
@@ -323,7 +327,7 @@ static PS_ALWAYS_INLINE bool brute(const ps_accel *a, const accel_ray *r, double
     return found;
 }
 
-bool ps_accel_brute_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any)
+AVX2 bool ps_accel_brute_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any)
 {
     switch (r->kz) {
     case 0:
@@ -335,7 +339,8 @@ bool ps_accel_brute_avx2(const ps_accel *a, const accel_ray *r, double tmin, dou
     }
 }
 
-bool ps_accel_octree_trace_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit, bool any)
+AVX2 bool ps_accel_octree_trace_avx2(const ps_accel *a, const accel_ray *r, double tmin, double tmax, ps_hit *hit,
+                                     bool any)
 {
     if (a->node_count == 0)
         return false;
@@ -347,12 +352,6 @@ bool ps_accel_octree_trace_avx2(const ps_accel *a, const accel_ray *r, double tm
     default:
         return any ? trace(a, r, tmin, tmax, hit, true, 0, 1, 2) : trace(a, r, tmin, tmax, hit, false, 0, 1, 2);
     }
-}
-
-bool ps_accel_cpu_has_avx2(void)
-{
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2");
 }
 #else
 #include "accel/accel_internal.h"
@@ -367,6 +366,4 @@ bool ps_accel_octree_trace_avx2(const ps_accel *a, const accel_ray *r, double tm
 {
     return ps_accel_octree_trace(a, r, tmin, tmax, hit, any);
 }
-
-bool ps_accel_cpu_has_avx2(void) { return false; }
 #endif
