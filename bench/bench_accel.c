@@ -8,7 +8,9 @@
  * Every ray is also checked: octree against brute force (must agree exactly),
  * the AVX2 traversal against the scalar one (the same primitive), and octree
  * against Embree (hit/miss and primitive; Embree works in single precision,
- * so a few rays grazing an edge may pick the neighbour). Compare ratios, not
+ * so a few rays grazing an edge may pick the neighbour). It also times the
+ * nearest-geometry query (ps_accel_nearest) against its brute-force oracle,
+ * checking that both answer alike. Compare ratios, not
  * absolute numbers: these machines are shared and noisy, which is why the
  * octree and Embree run in alternating chunks of the same rays. */
 #include <pthread.h>
@@ -48,6 +50,9 @@ static double thread_cpu_now(void)
 /* Builds are timed as the best of this many (wall clock, both): a build that
  * lost the processor to another program for a while says nothing. */
 #define BUILDS 3
+/* ps_accel_nearest queries from the first ray origins, and how many of them the oracle checks. */
+#define NEAREST_QUERIES 20000
+#define NEAREST_BRUTE 200
 /* Brute force is timed only up to this many primitives (it is O(n) per ray). */
 #define BRUTE_MAX_PRIMS 10000
 /* Ray origins: inside and around the closed box [-1, 1]^3, so some rays start
@@ -64,6 +69,8 @@ typedef struct row {
     double embree_build_s, embree_rps;
     double octree_rps2, embree_rps2;          /* rays per second, THREADS threads */
     double agree_scalar;                      /* AVX2 against scalar traversal, fraction of rays */
+    double nearest_us, nearest_brute_us;      /* ps_accel_nearest: microseconds a query, octree and oracle */
+    double agree_nearest;                     /* octree against oracle, fraction of the oracle's points */
     double agree_hit, agree_prim;   /* octree vs Embree, fractions of rays */
     double agree_brute;             /* octree vs brute force, fraction of the brute rays */
 } row;
@@ -371,6 +378,24 @@ static int measure(const char *name, const bench_scene *s, const ps_ray *rays, r
         r->agree_brute = (double)same / (double)nb;
     }
 
+    /* Step 4: the nearest-geometry query from the ray origins, and its oracle on a few. */
+    double t0 = thread_cpu_now(), sink = 0.0;
+    for (size_t i = 0; i < NEAREST_QUERIES; i++)
+        sink += ps_accel_nearest_distance(a, rays[i].o);
+    r->nearest_us = 1e6 * (thread_cpu_now() - t0) / NEAREST_QUERIES;
+    size_t same = 0;
+    t0 = thread_cpu_now();
+    for (size_t i = 0; i < NEAREST_BRUTE; i++) {
+        ps_nearest n1, n2;
+        bool f1 = ps_accel_nearest_brute(a, rays[i].o, INFINITY, &n2);
+        bool f2 = ps_accel_nearest(a, rays[i].o, INFINITY, &n1);
+        same += f1 == f2 && (!f1 || (n1.prim == n2.prim && n1.distance == n2.distance));
+    }
+    r->nearest_brute_us = 1e6 * (thread_cpu_now() - t0) / NEAREST_BRUTE - r->nearest_us;
+    r->agree_nearest = (double)same / NEAREST_BRUTE;
+    if (!(sink >= 0.0))
+        fprintf(stderr, "bench_accel: %s: a nearest distance is not a number\n", name);
+
     free(prim);
     free(sprim);
     free(eprim);
@@ -408,6 +433,11 @@ static void print_rows(const row *rows, int n)
                r->octree_rps / 1e6, r->scalar_rps / 1e6, brute, emb, ratio, oct2, emb2, ratio2, r->mbytes,
                r->agree_brute, r->agree_scalar, ap);
     }
+    printf("\nnearest geometry (ps_accel_nearest from the ray origins, microseconds a query, one thread):\n");
+    printf("%-11s %8s %10s %10s %9s\n", "scene", "triangl", "octree_us", "brute_us", "agree");
+    for (int i = 0; i < n; i++)
+        printf("%-11s %8zu %10.3f %10.1f %9.5f\n", rows[i].name, rows[i].triangles, rows[i].nearest_us,
+               rows[i].nearest_brute_us, rows[i].agree_nearest);
     printf("\nb_rat: octree build time / Embree's (best of %d, wall clock; Embree builds on every core, the octree "
            "on one)\n"
            "ratio: octree / Embree rays per second on one thread (per second of the thread's processor time)\n"
@@ -522,6 +552,10 @@ int main(int argc, char **argv)
         if (rows[i].agree_brute < 1.0) {
             fprintf(stderr, "bench_accel: %s: octree and brute force disagree on %.4f%% of rays\n", rows[i].name,
                     100.0 * (1.0 - rows[i].agree_brute));
+            status = 1;
+        } else if (rows[i].agree_nearest < 1.0) {
+            fprintf(stderr, "bench_accel: %s: nearest geometry: octree and brute force disagree on %.4f%% of points\n",
+                    rows[i].name, 100.0 * (1.0 - rows[i].agree_nearest));
             status = 1;
         } else if (rows[i].agree_scalar < 1.0) {
             fprintf(stderr, "bench_accel: %s: AVX2 and scalar traversal disagree on %.4f%% of rays\n", rows[i].name,
