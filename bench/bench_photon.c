@@ -197,11 +197,11 @@ int main(void)
     char csv[4096];
     int used = snprintf(csv, sizeof csv,
                         "csv,scene,triangles,paths_per_s_1t,paths_per_s_total,paths_per_s_per_core,"
-                        "paths_per_cpu_s,cores,us_per_photon_1t,rays_per_photon\n"
+                        "paths_per_cpu_s,cores,cpu_us_per_photon_1t,rays_per_photon\n"
                         "csv,cornell-caustic,%zu,%.0f,%.0f,%.0f,%.0f,%d,%.4f,%.3f\n",
                         base1.triangles, photons / base1.seconds, photons / baseN.seconds,
                         photons / baseN.seconds / cores, photons / baseN.cpu_best, cores,
-                        1e6 * base1.seconds / photons, base1.rays_per_photon);
+                        1e6 * base1.cpu_best / photons, base1.rays_per_photon);
     for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++) {
         char obj[256], text[1024], name[64];
         snprintf(obj, sizeof obj, "%s/blob%ld.obj", dir, sizes[k]);
