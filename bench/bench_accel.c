@@ -13,6 +13,7 @@
  * checking that both answer alike. Compare ratios, not
  * absolute numbers: these machines are shared and noisy, which is why the
  * octree and Embree run in alternating chunks of the same rays. */
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -548,6 +549,20 @@ int main(int argc, char **argv)
         fflush(stdout);
     }
     print_rows(rows, n);
+    /* The goals, from this run's ratios (the blobs only). */
+    double worst1 = INFINITY, worst2 = INFINITY, worst_build = 0.0;
+    for (int i = 0; i < n; i++) {
+        if (strncmp(rows[i].name, "blob", 4) != 0 || rows[i].embree_rps <= 0)
+            continue;
+        worst1 = fmin(worst1, rows[i].octree_rps / rows[i].embree_rps);
+        if (rows[i].embree_rps2 > 0)
+            worst2 = fmin(worst2, rows[i].octree_rps2 / rows[i].embree_rps2);
+        worst_build = fmax(worst_build, rows[i].build_s / rows[i].embree_build_s);
+    }
+    if (isfinite(worst1))
+        printf("\ngoals: octree / Embree on the blobs at worst %.2f on one thread, %.2f on %d (goal: >= 0.5); build "
+               "at worst %.2fx Embree's (goal: <= 1.5)\n",
+               worst1, worst2, THREADS, worst_build);
     for (int i = 0; i < n; i++)
         if (rows[i].agree_brute < 1.0) {
             fprintf(stderr, "bench_accel: %s: octree and brute force disagree on %.4f%% of rays\n", rows[i].name,
