@@ -159,6 +159,7 @@ ps_status ps_accel_build(const ps_accel_input *in, const ps_accel_options *opt, 
         }
     }
     a->stats.kind = kind;
+    a->stats.simd = a->simd;
     a->stats.bytes = sizeof *a + a->tri_count * (sizeof *a->tris + sizeof *a->tri_ids) +
                      a->sphere_count * (sizeof *a->spheres + sizeof *a->sphere_ids) +
                      a->node_count * sizeof *a->nodes + a->ref_count * sizeof *a->refs;

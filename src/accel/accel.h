@@ -10,6 +10,10 @@
  * Ties (two primitives hit at exactly the same t) go to the lower primitive
  * id, so the octree and the oracle always return the same primitive.
  *
+ * Where the processor has AVX2 the queries run vector code (octree_trace_avx2.c)
+ * that performs the scalar tests' operations lane by lane: the same bits, so
+ * the octree, the vector code and the oracle all agree exactly.
+ *
  * A built ps_accel is immutable: every query is const, allocates nothing and
  * may run on any number of threads at once. */
 #ifndef PS_ACCEL_ACCEL_H
@@ -120,6 +124,7 @@ size_t ps_accel_triangle_count(const ps_accel *a);
 
 typedef struct ps_accel_stats {
     ps_accel_kind kind; /* what was built (OCTREE or BRUTE) */
+    bool simd;          /* queries run the AVX2 code */
     size_t nodes, leaves, prim_refs, max_depth_reached, bytes;
     double build_seconds;
 } ps_accel_stats;
