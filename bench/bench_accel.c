@@ -46,6 +46,7 @@ static double thread_cpu_now(void)
 #define RAYS 1000000
 #define CHUNK 50000 /* rays per turn when octree and Embree alternate */
 #define THREADS 2   /* the second measurement: this many threads share each chunk */
+#define CHUNK_TRIES 3 /* ... each chunk this many times, the quickest counting */
 #define BRUTE_TESTS 20000000.0
 #define BRUTE_MIN_RAYS 1000
 /* Builds are timed as the best of this many (wall clock, both): a build that
@@ -322,18 +323,26 @@ static int measure(const char *name, const bench_scene *s, const ps_ray *rays, r
     bool threads_ok = true;
     for (size_t begin = 0; begin < RAYS && threads_ok; begin += CHUNK) {
         size_t end = begin + CHUNK < RAYS ? begin + CHUNK : RAYS;
-        double t = trace_threads(oproto, begin, end);
-        threads_ok = t >= 0.0;
-        octree2_s += t;
+        /* Each chunk CHUNK_TRIES times in turn, the quickest counting: the
+         * wall clock of two threads on a shared machine is otherwise mostly
+         * a measure of who else ran. */
+        double best_o = INFINITY, best_e = INFINITY;
+        for (int k = 0; k < CHUNK_TRIES && threads_ok; k++) {
+            double t = trace_threads(oproto, begin, end);
+            threads_ok = t >= 0.0;
+            best_o = fmin(best_o, t);
 #ifdef PS_HAVE_EMBREE
-        trace_range eproto = oproto;
-        eproto.a = NULL;
-        eproto.scene = scene;
-        eproto.triangles = s->triangle_count;
-        t = trace_threads(eproto, begin, end);
-        threads_ok = threads_ok && t >= 0.0;
-        embree2_s += t;
+            trace_range eproto = oproto;
+            eproto.a = NULL;
+            eproto.scene = scene;
+            eproto.triangles = s->triangle_count;
+            t = trace_threads(eproto, begin, end);
+            threads_ok = threads_ok && t >= 0.0;
+            best_e = fmin(best_e, t);
 #endif
+        }
+        octree2_s += best_o;
+        embree2_s += best_e;
     }
     if (threads_ok) {
         r->octree_rps2 = RAYS / octree2_s;
@@ -442,8 +451,8 @@ static void print_rows(const row *rows, int n)
     printf("\nb_rat: octree build time / Embree's (best of %d, wall clock; Embree builds on every core, the octree "
            "on one)\n"
            "ratio: octree / Embree rays per second on one thread (per second of the thread's processor time)\n"
-           "ratio2: the same on %d threads (wall clock)\n",
-           BUILDS, THREADS);
+           "ratio2: the same on %d threads (wall clock, each chunk the quickest of %d)\n",
+           BUILDS, THREADS, CHUNK_TRIES);
     printf("\ncsv:\nscene,triangles,spheres,build_s,nodes,refs_per_prim,mbytes,octree_rays_per_s,scalar_rays_per_s,"
            "brute_rays_per_s,embree_build_s,embree_rays_per_s,octree_over_embree,octree_rays_per_s_%dt,"
            "embree_rays_per_s_%dt,octree_over_embree_%dt,build_over_embree,agree_hit,agree_prim,agree_brute,"
