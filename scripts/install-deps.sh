@@ -3,7 +3,7 @@
 # what is already there (checked with pkg-config or the command itself).
 # Called by `make test` and `make run`; needs root or sudo only when something
 # is missing. With --bench, also what `make bench` needs (gnuplot for the
-# photosplat-bench plots); with --fuzz, what `make fuzz` needs (clang and
+# photosplat-bench plots, Embree 3 for bench_accel's baseline); with --fuzz, what `make fuzz` needs (clang and
 # its libFuzzer runtime).
 set -euo pipefail
 
@@ -36,6 +36,8 @@ need_cmd xauth xauth
 case "${1:-}" in
 --bench)
     need_cmd gnuplot gnuplot-nox
+    # Embree 3: bench_accel's baseline (bench only; Debian's package ships no .pc file).
+    [ -e /usr/include/embree3/rtcore.h ] || missing+=(libembree-dev)
     ;;
 --fuzz)
     # clang and its libFuzzer runtime (libclang_rt.fuzzer, in libclang-rt-14-dev).

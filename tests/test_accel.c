@@ -1,7 +1,9 @@
 /* test_accel.c: the ray accelerator: the octree against the brute-force
  * oracle (same primitive, same t) on random and adversarial rays,
  * watertightness on closed meshes, analytic sphere distances at three scales,
- * degenerate inputs, scale invariance and scene building. */
+ * degenerate inputs, scale invariance and scene building; the AVX2 traversal
+ * against the scalar one (bit for bit); the nearest-geometry query against
+ * closed forms and its own oracle. */
 #include "test.h"
 
 #include <float.h>
@@ -89,15 +91,20 @@ static ps_accel_input soup_input(const soup *s)
     return in;
 }
 
-static ps_accel *build(const soup *s, ps_accel_kind kind, int max_depth, int leaf_prims)
+static ps_accel *build_with(const soup *s, ps_accel_kind kind, int max_depth, int leaf_prims, bool no_simd)
 {
     ps_accel_input in = soup_input(s);
-    ps_accel_options opt = {kind, max_depth, leaf_prims};
+    ps_accel_options opt = {kind, max_depth, leaf_prims, no_simd};
     ps_accel *a = NULL;
     ps_error err;
     if (ps_accel_build(&in, &opt, &a, &err) != PS_OK)
         fail_msg("build: %s", err.msg);
     return a;
+}
+
+static ps_accel *build(const soup *s, ps_accel_kind kind, int max_depth, int leaf_prims)
+{
+    return build_with(s, kind, max_depth, leaf_prims, false);
 }
 
 static ps_vec3 soup_tri_vertex(const soup *s, size_t t, int k) { return s->pos[s->idx[3 * t + (size_t)k]]; }
@@ -559,7 +566,7 @@ static void empty_and_invalid_input(void **state)
     ps_accel *a = NULL;
     ps_error err;
     for (int kind = PS_ACCEL_AUTO; kind <= PS_ACCEL_BRUTE; kind++) {
-        ps_accel_options opt = {(ps_accel_kind)kind, 0, 0};
+        ps_accel_options opt = {(ps_accel_kind)kind, 0, 0, false};
         assert_int_equal(ps_accel_build(&in, &opt, &a, &err), PS_OK);
         ps_hit h;
         assert_false(ps_accel_intersect(a, (ps_ray){ps_v3(0, 0, 0), ps_v3(1, 0, 0)}, 0, INFINITY, &h));
@@ -590,7 +597,7 @@ static void empty_and_invalid_input(void **state)
     assert_int_equal(ps_accel_build(&in, NULL, &a, &err), PS_ERR_RANGE);
     in = (ps_accel_input){NULL, 0, NULL, 1, NULL, NULL, 0};
     assert_int_equal(ps_accel_build(&in, NULL, &a, &err), PS_ERR_RANGE);
-    ps_accel_options opt = {PS_ACCEL_OCTREE, -1, 0};
+    ps_accel_options opt = {PS_ACCEL_OCTREE, -1, 0, false};
     in = (ps_accel_input){pos, 3, idx, 1, NULL, NULL, 0};
     assert_int_equal(ps_accel_build(&in, &opt, &a, &err), PS_ERR_RANGE);
 }
@@ -849,7 +856,7 @@ static void forced_octree_on_default_scene(void **state)
         fail_msg("scene: %s", err.msg);
     ps_accel *brute_acc = NULL, *tree = NULL, *fine = NULL;
     assert_int_equal(ps_accel_build_scene(sc, NULL, &brute_acc, NULL, &err), PS_OK);
-    ps_accel_options opt = {PS_ACCEL_OCTREE, 0, 0};
+    ps_accel_options opt = {PS_ACCEL_OCTREE, 0, 0, false};
     assert_int_equal(ps_accel_build_scene(sc, &opt, &tree, NULL, &err), PS_OK);
     opt.leaf_prims = 1;
     assert_int_equal(ps_accel_build_scene(sc, &opt, &fine, NULL, &err), PS_OK);
@@ -882,6 +889,191 @@ static void forced_octree_on_default_scene(void **state)
     ps_scene_destroy(sc);
 }
 
+
+/* ---- SIMD traversal --------------------------------------------------------------- */
+
+static bool same_hit_bits(const ps_hit *h1, const ps_hit *h2)
+{
+    return h1->prim == h2->prim && memcmp(&h1->t, &h2->t, sizeof h1->t) == 0 &&
+           memcmp(&h1->b1, &h2->b1, sizeof h1->b1) == 0 && memcmp(&h1->b2, &h2->b2, sizeof h1->b2) == 0;
+}
+
+/* a and b answer every ray with the same bits; returns the hits. */
+static size_t same_bits_on_rays(const ps_accel *a, const ps_accel *b, const ray_case *rays, size_t n)
+{
+    size_t hits = 0;
+    for (size_t i = 0; i < n; i++) {
+        ps_hit h1 = {0}, h2 = {0};
+        const ray_case *c = &rays[i];
+        bool f1 = ps_accel_intersect(a, c->r, c->tmin, c->tmax, &h1);
+        bool f2 = ps_accel_intersect(b, c->r, c->tmin, c->tmax, &h2);
+        if (f1 != f2 || (f1 && !same_hit_bits(&h1, &h2)))
+            fail_msg("ray %zu: avx2 %d prim %u t %.17g b %.17g %.17g, scalar %d prim %u t %.17g b %.17g %.17g", i, f1,
+                     (unsigned)h1.prim, h1.t, h1.b1, h1.b2, f2, (unsigned)h2.prim, h2.t, h2.b1, h2.b2);
+        assert_true(ps_accel_occluded(a, c->r, c->tmin, c->tmax) == f2);
+        hits += f1;
+    }
+    return hits;
+}
+
+/* The AVX2 traversal (where the processor has it) against the scalar one on
+ * test 1's rays and the default scene's: the very same bits (t, prim,
+ * barycentrics), since each vector lane makes the scalar test's operations. */
+static void simd_matches_scalar_bit_for_bit(void **state)
+{
+    (void)state;
+    ps_rng rng = ps_rng_make(1, PS_STREAM_TEST, 0);
+    soup s;
+    make_soup(&s, &rng);
+    ps_accel *probe = build(&s, PS_ACCEL_OCTREE, 0, 0);
+    add_plane_triangles(&s, probe);
+    ps_accel_destroy(probe);
+    ps_accel *vec = build_with(&s, PS_ACCEL_OCTREE, 0, 0, false);
+    ps_accel *sca = build_with(&s, PS_ACCEL_OCTREE, 0, 0, true);
+    assert_false(sca->simd);
+    if (!vec->simd) {
+        ps_accel_destroy(vec);
+        ps_accel_destroy(sca);
+        soup_free(&s);
+        skip(); /* no AVX2 here: the scalar traversal is the only one */
+    }
+    /* Same tree either way: only the traversal differs. */
+    assert_int_equal(vec->node_count, sca->node_count);
+    assert_int_equal(vec->ref_count, sca->ref_count);
+    /* Every leaf lists its triangles before its spheres (the AVX2 leaf loop relies on it). */
+    for (size_t k = 0; k < vec->node_count; k++) {
+        accel_node nd = vec->nodes[k];
+        if (nd.count & ACCEL_NODE_INTERIOR)
+            continue;
+        for (uint32_t j = 1; j < nd.count; j++)
+            assert_false(vec->refs[nd.index + j - 1] >= vec->tri_count && vec->refs[nd.index + j] < vec->tri_count);
+    }
+    ray_case *rays = malloc(sizeof *rays * RAY_COUNT);
+    size_t n = make_rays(&s, vec, &rng, rays);
+    assert_true(same_bits_on_rays(vec, sca, rays, n) > n / 3);
+    /* A brute-force accelerator's query (AVX2) against its scalar oracle, on a part of the rays. */
+    ps_accel *bvec = build_with(&s, PS_ACCEL_BRUTE, 0, 0, false);
+    assert_true(bvec->simd);
+    for (size_t i = 0; i < n; i += 20) {
+        ps_hit h1 = {0}, h2 = {0};
+        const ray_case *c = &rays[i];
+        bool f1 = ps_accel_intersect(bvec, c->r, c->tmin, c->tmax, &h1);
+        bool f2 = ps_accel_intersect_brute(bvec, c->r, c->tmin, c->tmax, &h2);
+        if (f1 != f2 || (f1 && !same_hit_bits(&h1, &h2)))
+            fail_msg("ray %zu: brute avx2 %d prim %u t %.17g, scalar %d prim %u t %.17g", i, f1, (unsigned)h1.prim, h1.t,
+                     f2, (unsigned)h2.prim, h2.t);
+        assert_true(ps_accel_occluded(bvec, c->r, c->tmin, c->tmax) == f2);
+    }
+    free(rays);
+    ps_accel_destroy(bvec);
+    ps_accel_destroy(vec);
+    ps_accel_destroy(sca);
+    soup_free(&s);
+}
+
+/* ---- nearest geometry ------------------------------------------------------------- */
+
+/* Closed forms on one triangle and one sphere: the face, an edge, a vertex;
+ * outside and inside the sphere; max_dist inclusive. */
+static void nearest_closed_forms(void **state)
+{
+    (void)state;
+    soup s;
+    memset(&s, 0, sizeof s);
+    /* The triangle (0,0,0) (2,0,0) (0,2,0) in z = 0; the sphere r = 1 at (10, 0, 0). */
+    soup_tri_p(&s, ps_v3(0, 0, 0), ps_v3(2, 0, 0), ps_v3(0, 2, 0));
+    soup_sphere(&s, ps_v3(10, 0, 0), 1.0);
+    for (int kind = PS_ACCEL_OCTREE; kind <= PS_ACCEL_BRUTE; kind++) {
+        ps_accel *a = build(&s, (ps_accel_kind)kind, 0, 0);
+        ps_nearest n;
+        /* Above the face: straight down. */
+        assert_true(ps_accel_nearest(a, ps_v3(0.5, 0.5, 3.0), INFINITY, &n));
+        assert_int_equal(n.prim, 0);
+        assert_true(n.distance == 3.0 && n.point.x == 0.5 && n.point.y == 0.5 && n.point.z == 0.0);
+        /* Beyond the hypotenuse x + y = 2: to its midpoint (1, 1, 0). */
+        assert_true(ps_accel_nearest(a, ps_v3(2, 2, 0), INFINITY, &n));
+        assert_near(n.distance, sqrt(2.0), 1e-15);
+        assert_near(n.point.x, 1.0, 1e-15);
+        assert_near(n.point.y, 1.0, 1e-15);
+        /* Beyond the vertex at the origin. */
+        assert_true(ps_accel_nearest(a, ps_v3(-3, -4, 0), INFINITY, &n));
+        assert_true(n.distance == 5.0 && n.point.x == 0.0 && n.point.y == 0.0);
+        /* Near the sphere, outside and inside: | |p - c| - r |. */
+        assert_true(ps_accel_nearest(a, ps_v3(10, 3, 0), INFINITY, &n));
+        assert_int_equal(n.prim, 1);
+        assert_true(n.distance == 2.0 && n.point.y == 1.0);
+        assert_true(ps_accel_nearest(a, ps_v3(10.25, 0, 0), INFINITY, &n));
+        assert_int_equal(n.prim, 1);
+        assert_true(n.distance == 0.75);
+        assert_true(ps_accel_nearest_distance(a, ps_v3(10, 0, 0)) == 1.0); /* the centre */
+        /* On the geometry: 0. */
+        assert_true(ps_accel_nearest_distance(a, ps_v3(1, 0.5, 0)) == 0.0);
+        /* max_dist: inclusive, and nothing beyond it. */
+        assert_true(ps_accel_nearest(a, ps_v3(0.5, 0.5, 3.0), 3.0, &n) && n.distance == 3.0);
+        assert_false(ps_accel_nearest(a, ps_v3(0.5, 0.5, 3.0), 2.999, &n));
+        assert_false(ps_accel_nearest(a, ps_v3(NAN, 0, 0), INFINITY, &n));
+        assert_false(ps_accel_nearest(a, ps_v3(0, 0, 0), -1.0, &n));
+        ps_accel_destroy(a);
+    }
+    /* No geometry: nothing is near. */
+    soup empty;
+    memset(&empty, 0, sizeof empty);
+    ps_accel *a = build(&empty, PS_ACCEL_OCTREE, 0, 0);
+    assert_true(ps_accel_nearest_distance(a, ps_v3(0, 0, 0)) == INFINITY);
+    ps_accel_destroy(a);
+    soup_free(&s);
+}
+
+/* The octree's nearest against the oracle's on test 1's soup: points inside,
+ * around and far outside it, on vertices and just off them, with and without
+ * a max_dist: the same primitive, distance and point, bit for bit. */
+static void nearest_matches_brute_force(void **state)
+{
+    (void)state;
+    ps_rng rng = ps_rng_make(9, PS_STREAM_TEST, 0);
+    soup s;
+    make_soup(&s, &rng);
+    ps_accel *a = build(&s, PS_ACCEL_OCTREE, 0, 0);
+    ps_accel *fine = build(&s, PS_ACCEL_OCTREE, 0, 1);
+    size_t zero = 0;
+    for (int i = 0; i < 6000; i++) {
+        ps_vec3 p;
+        double max_dist = INFINITY;
+        switch (i % 5) {
+        case 0: p = rand_box(&rng, -1.2, 1.2); break;
+        case 1: p = rand_box(&rng, -40, 40); break;
+        case 2: p = s.pos[s.idx[ps_rng_below(&rng, (uint32_t)(3 * s.ntri))]]; break;
+        case 3:
+            p = ps_v3_madd(s.pos[s.idx[ps_rng_below(&rng, (uint32_t)(3 * s.ntri))]], rand_dir(&rng), 1e-6);
+            break;
+        default:
+            p = rand_box(&rng, -1.2, 1.2);
+            max_dist = uni(&rng, 0.0, 0.1);
+            break;
+        }
+        ps_nearest n1, n2, n3;
+        bool f1 = ps_accel_nearest(a, p, max_dist, &n1), f2 = ps_accel_nearest_brute(a, p, max_dist, &n2);
+        bool f3 = ps_accel_nearest(fine, p, max_dist, &n3);
+        if (f1 != f2 || (f1 && (n1.prim != n2.prim || n1.distance != n2.distance || n1.point.x != n2.point.x ||
+                                n1.point.y != n2.point.y || n1.point.z != n2.point.z)))
+            fail_msg("point %d (%.17g %.17g %.17g): octree %d prim %u d %.17g, brute %d prim %u d %.17g", i, p.x, p.y,
+                     p.z, f1, (unsigned)n1.prim, n1.distance, f2, (unsigned)n2.prim, n2.distance);
+        assert_true(f3 == f1 && (!f1 || (n3.prim == n1.prim && n3.distance == n1.distance)));
+        if (i % 5 != 4)
+            assert_true(f1);
+        if (f1) {
+            assert_true(n1.distance <= max_dist);
+            /* The point lies that far from p. */
+            assert_near(ps_v3_len(ps_v3_sub(n1.point, p)), n1.distance, 1e-12 * (1.0 + n1.distance));
+            zero += n1.distance == 0.0;
+        }
+    }
+    assert_true(zero >= 1000); /* the points on vertices */
+    ps_accel_destroy(a);
+    ps_accel_destroy(fine);
+    soup_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -895,6 +1087,9 @@ int main(void)
         cmocka_unit_test(scale_invariance),
         cmocka_unit_test(build_scene_maps_spheres),
         cmocka_unit_test(forced_octree_on_default_scene),
+        cmocka_unit_test(simd_matches_scalar_bit_for_bit),
+        cmocka_unit_test(nearest_closed_forms),
+        cmocka_unit_test(nearest_matches_brute_force),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

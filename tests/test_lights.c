@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "preview/lights.h"
+#include "photon/world.h"
 #include "preview/mesh.h"
 #include "scene/scene.h"
 
@@ -29,7 +30,7 @@ static lit lit_make(const char *text)
     mo.max_edge = HUGE_VAL;
     if (ps_preview_mesh_build(l.scene, &mo, &l.coarse, &err) != PS_OK)
         fail_msg("mesh: %s", err.msg);
-    if (ps_preview_lights_build(l.scene, &l.coarse, PS_SHADOW_SIZE_DEFAULT, &l.lights, &err) != PS_OK)
+    if (ps_preview_lights_build(l.scene, NULL, &l.coarse, PS_SHADOW_SIZE_DEFAULT, &l.lights, &err) != PS_OK)
         fail_msg("lights: %s", err.msg);
     return l;
 }
@@ -166,6 +167,33 @@ static void near_plane_without_geometry(void **state)
     lit_free(&l);
 }
 
+/* Near planes from the ray accelerator: the exact sphere's distance, at most
+ * its tessellation's (which lies inside it), the same as brute force for flat
+ * geometry. */
+static void near_plane_from_the_accelerator(void **state)
+{
+    (void)state;
+    lit l = lit_make(WHITE FLOOR "sphere center 0 0.5 0 radius 0.3 material white\n"
+                                 "light point position 0 1.5 0 power 1 1 1\n"
+                                 "light point position 1.5 0.6 0.9 power 1 1 1\n");
+    ps_world *w;
+    ps_error err;
+    assert_int_equal(ps_world_create(l.scene, NULL, &w, &err), PS_OK);
+    ps_preview_lights fast;
+    assert_int_equal(ps_preview_lights_build(l.scene, ps_world_accel(w), &l.coarse, 0, &fast, &err), PS_OK);
+    /* Over the sphere: 1.5 - (0.5 + 0.3) = 0.7 to its top. */
+    assert_near(fast.lights[0].shadow_near, PS_SHADOW_NEAR_SHARE * 0.7, 1e-9);
+    assert_true(fast.lights[0].shadow_near <= l.lights.lights[0].shadow_near + 1e-6); /* float vertices */
+    assert_true(l.lights.lights[0].shadow_near - fast.lights[0].shadow_near < 0.01);
+    /* Past the floor's edge (x = 1), 0.6 above it: its edge, sqrt(0.5^2 + 0.6^2)
+     * away, nearer than the sphere, either way. */
+    assert_near(fast.lights[1].shadow_near, PS_SHADOW_NEAR_SHARE * sqrt(0.61), 1e-9);
+    assert_near(l.lights.lights[1].shadow_near, PS_SHADOW_NEAR_SHARE * sqrt(0.61), 1e-6);
+    ps_preview_lights_free(&fast);
+    ps_world_destroy(w);
+    lit_free(&l);
+}
+
 /* The brute-force distance against hand-worked points of one triangle. */
 static void mesh_distance(void **state)
 {
@@ -195,7 +223,7 @@ static void shadow_maps_planned_against_the_budget(void **state)
     assert_int_equal(ps_preview_mesh_build(scene, &mo, &coarse, &err), PS_OK);
     ps_preview_lights l;
     /* Six faces of 2^20 texels a side, 4 bytes each: 2^43 bytes. */
-    assert_int_equal(ps_preview_lights_build(scene, &coarse, 1 << 20, &l, &err), PS_ERR_LIMIT);
+    assert_int_equal(ps_preview_lights_build(scene, NULL, &coarse, 1 << 20, &l, &err), PS_ERR_LIMIT);
     assert_non_null(strstr(err.msg, "big.scn"));
     assert_non_null(strstr(err.msg, "shadow maps"));
     assert_int_equal(l.count, 0);
@@ -213,6 +241,7 @@ int main(void)
         cmocka_unit_test(area_light_is_sixteen_cosine_emitters),
         cmocka_unit_test(disc_and_sphere_lights),
         cmocka_unit_test(near_plane_without_geometry),
+        cmocka_unit_test(near_plane_from_the_accelerator),
         cmocka_unit_test(mesh_distance),
         cmocka_unit_test(shadow_maps_planned_against_the_budget),
     };

@@ -19,6 +19,17 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* Outside octree_trace_avx2.c, whose code must not run before this says yes. */
+bool ps_accel_cpu_has_avx2(void)
+{
+#if defined(__GNUC__) && defined(__x86_64__)
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2");
+#else
+    return false;
+#endif
+}
+
 static bool triangle_degenerate(const accel_tri *t)
 {
     ps_vec3 p0 = ps_v3(t->v[0], t->v[1], t->v[2]);
@@ -109,7 +120,7 @@ ps_status ps_accel_build(const ps_accel_input *in, const ps_accel_options *opt, 
 {
     double start = now_seconds();
     *out = NULL;
-    ps_accel_options o = {PS_ACCEL_AUTO, 0, 0};
+    ps_accel_options o = {PS_ACCEL_AUTO, 0, 0, false};
     if (opt)
         o = *opt;
     if (!in)
@@ -138,6 +149,8 @@ ps_status ps_accel_build(const ps_accel_input *in, const ps_accel_options *opt, 
     if (kind == PS_ACCEL_AUTO)
         kind = in->triangle_count + in->sphere_count < PS_ACCEL_BRUTE_MAX_PRIMS ? PS_ACCEL_BRUTE : PS_ACCEL_OCTREE;
     a->kind = kind;
+    a->simd = !o.no_simd && ps_accel_cpu_has_avx2();
+    a->prefetch_leaves = (size_t)a->tri_count * sizeof *a->tris > ACCEL_PREFETCH_BYTES;
     if (kind == PS_ACCEL_OCTREE) {
         st = ps_accel_octree_build(a, max_depth, leaf_prims, err);
         if (st != PS_OK) {
@@ -146,6 +159,7 @@ ps_status ps_accel_build(const ps_accel_input *in, const ps_accel_options *opt, 
         }
     }
     a->stats.kind = kind;
+    a->stats.simd = a->simd;
     a->stats.bytes = sizeof *a + a->tri_count * (sizeof *a->tris + sizeof *a->tri_ids) +
                      a->sphere_count * (sizeof *a->spheres + sizeof *a->sphere_ids) +
                      a->node_count * sizeof *a->nodes + a->ref_count * sizeof *a->refs;
@@ -257,8 +271,12 @@ static bool query(const ps_accel *a, ps_ray ray, double tmin, double tmax, ps_hi
     /* NaN limits fail this comparison too. */
     if (!a || !(tmin < tmax) || !accel_ray_prepare(ray, &r, a->sphere_count > 0))
         return false;
-    if (force_brute || a->kind != PS_ACCEL_OCTREE)
+    if (force_brute)
         return brute_dispatch(a, &r, tmin, tmax, hit, any);
+    if (a->kind != PS_ACCEL_OCTREE)
+        return a->simd ? ps_accel_brute_avx2(a, &r, tmin, tmax, hit, any) : brute_dispatch(a, &r, tmin, tmax, hit, any);
+    if (a->simd)
+        return ps_accel_octree_trace_avx2(a, &r, tmin, tmax, hit, any);
     return ps_accel_octree_trace(a, &r, tmin, tmax, hit, any);
 }
 

@@ -10,6 +10,10 @@
  * Ties (two primitives hit at exactly the same t) go to the lower primitive
  * id, so the octree and the oracle always return the same primitive.
  *
+ * Where the processor has AVX2 the queries run vector code (octree_trace_avx2.c)
+ * that performs the scalar tests' operations lane by lane: the same bits, so
+ * the octree, the vector code and the oracle all agree exactly.
+ *
  * A built ps_accel is immutable: every query is const, allocates nothing and
  * may run on any number of threads at once. */
 #ifndef PS_ACCEL_ACCEL_H
@@ -51,6 +55,7 @@ typedef struct ps_accel_options {
     ps_accel_kind kind; /* AUTO: brute force below PS_ACCEL_BRUTE_MAX_PRIMS primitives (tiny scenes), else octree */
     int max_depth;      /* 0: default (PS_OCTREE_DEFAULT_MAX_DEPTH); clamped to PS_OCTREE_MAX_DEPTH_LIMIT */
     int leaf_prims;     /* 0: default (PS_OCTREE_DEFAULT_LEAF_PRIMS): a node with at most this many primitives is a leaf */
+    bool no_simd;       /* true: the scalar traversal even where the processor has AVX2 (same results; tests, bench) */
 } ps_accel_options;     /* zero-initialised = all defaults */
 
 /* Geometry to build over; arrays are only read during build (the accel copies what it needs).
@@ -89,6 +94,24 @@ bool ps_accel_occluded(const ps_accel *a, ps_ray r, double tmin, double tmax);
 /* The oracle: tests every primitive (same primitive tests, no tree). */
 bool ps_accel_intersect_brute(const ps_accel *a, ps_ray r, double tmin, double tmax, ps_hit *hit);
 
+/* The nearest point of the geometry to a point: of the hittable primitives
+ * (triangles with area, spheres with a radius: their surfaces). */
+typedef struct ps_nearest {
+    double distance; /* |point - p| */
+    uint32_t prim;   /* primitive id as in ps_hit; equally near ones go to the lower id */
+    ps_vec3 point;   /* the nearest point on that primitive */
+} ps_nearest;
+/* The primitive nearest to p within max_dist (inclusive; INFINITY: any); false
+ * when none is (or p is not finite, or max_dist is NaN or negative). Through
+ * the octree, visiting only cells nearer than the best so far; the same answer
+ * as ps_accel_nearest_brute, bit for bit. Const, thread-safe like the ray queries.
+ * (What a light's shadow cube needs for its near plane: nothing is nearer.) */
+bool ps_accel_nearest(const ps_accel *a, ps_vec3 p, double max_dist, ps_nearest *out);
+/* The oracle: every primitive (same distance arithmetic). */
+bool ps_accel_nearest_brute(const ps_accel *a, ps_vec3 p, double max_dist, ps_nearest *out);
+/* Shorthand: the distance from p to the nearest primitive; INFINITY when there is none. */
+double ps_accel_nearest_distance(const ps_accel *a, ps_vec3 p);
+
 /* Self-intersection offset for rays leaving a surface: PS_RAY_EPSILON_REL times the scene's extent
  * (ps_aabb_extent of all geometry; at least PS_RAY_EPSILON_MIN). Scales with the scene: a scene
  * scaled by 1e-3 or 1e3 gets an epsilon scaled the same way. */
@@ -101,6 +124,7 @@ size_t ps_accel_triangle_count(const ps_accel *a);
 
 typedef struct ps_accel_stats {
     ps_accel_kind kind; /* what was built (OCTREE or BRUTE) */
+    bool simd;          /* queries run the AVX2 code */
     size_t nodes, leaves, prim_refs, max_depth_reached, bytes;
     double build_seconds;
 } ps_accel_stats;

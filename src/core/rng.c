@@ -51,9 +51,15 @@ unsigned ps_halton_prime(unsigned dim)
     return primes[dim];
 }
 
-double ps_radical_inverse(unsigned base, uint64_t index)
+/* The radical inverse's loop, inlined into each case of ps_radical_inverse
+ * so that for the first primes (the photon emission's Halton dimensions) the
+ * division by the base is one by a constant, which the compiler turns into a
+ * multiplication: the same integers, so the same result, several times faster. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline double radical_inverse(unsigned base, uint64_t index)
 {
-    assert(base >= 2);
     /* Accumulate the reversed digits as an integer and scale once at the end,
      * which is exact. Stop before the integer would overflow: the digits left
      * then lie below double precision of the result anyway. */
@@ -71,4 +77,18 @@ double ps_radical_inverse(unsigned base, uint64_t index)
     double v = (double)reversed * inv_base_n;
     /* Rounding can reach 1.0 for huge indices; the sequence promises [0, 1). */
     return v < 1.0 ? v : 0x1.fffffffffffffp-1;
+}
+
+double ps_radical_inverse(unsigned base, uint64_t index)
+{
+    assert(base >= 2);
+    switch (base) {
+    case 2: return radical_inverse(2, index);
+    case 3: return radical_inverse(3, index);
+    case 5: return radical_inverse(5, index);
+    case 7: return radical_inverse(7, index);
+    case 11: return radical_inverse(11, index);
+    case 13: return radical_inverse(13, index);
+    default: return radical_inverse(base, index);
+    }
 }

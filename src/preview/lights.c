@@ -225,8 +225,8 @@ static ps_status fail(ps_preview_lights *out, const ps_scene *s, ps_error *err)
     return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for GL lights", ps_scene_path(s));
 }
 
-ps_status ps_preview_lights_build(const ps_scene *s, const ps_preview_mesh *coarse, int shadow_size,
-                                  ps_preview_lights *out, ps_error *err)
+ps_status ps_preview_lights_build(const ps_scene *s, const ps_accel *accel, const ps_preview_mesh *coarse,
+                                  int shadow_size, ps_preview_lights *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
     builder b = {s, out, 0};
@@ -278,7 +278,8 @@ ps_status ps_preview_lights_build(const ps_scene *s, const ps_preview_mesh *coar
         diag = 1.0;
     double floor_near = fmax(PS_SHADOW_NEAR_FRACTION * diag, 1e-300);
     for (size_t i = 0; i < out->count; i++) {
-        double z = PS_SHADOW_NEAR_SHARE * ps_preview_mesh_distance(coarse, out->lights[i].pos);
+        ps_vec3 p = out->lights[i].pos;
+        double z = PS_SHADOW_NEAR_SHARE * (accel ? ps_accel_nearest_distance(accel, p) : ps_preview_mesh_distance(coarse, p));
         out->lights[i].shadow_near = isfinite(z) ? fmax(z, floor_near) : floor_near; /* no geometry at all */
     }
     out->emitters = emitters ? calloc(emitters, sizeof *out->emitters) : NULL;

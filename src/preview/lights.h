@@ -28,6 +28,7 @@
 #include <stdint.h>
 
 #include "core/status.h"
+#include "accel/accel.h"
 #include "core/vec.h"
 #include "preview/mesh.h"
 #include "scene/scene.h"
@@ -116,12 +117,15 @@ typedef struct ps_preview_lights {
 #define PS_SHADOW_TEXEL_BYTES 4
 #define PS_SPHERE_TRIANGLE_BYTES (24 + 3 * 4)
 
-/* The GL lights and emitters of scene s; `coarse` (its depth-only mesh) gives
- * the near planes. shadow_size: the shadow maps' side in texels, 0 for none;
+/* The GL lights and emitters of scene s. The near planes come from accel (the
+ * scene's ray accelerator, ps_accel_nearest_distance: exact spheres, which
+ * lie nearer than their tessellation, so nothing the depth pass draws is
+ * clipped) or, given NULL, from brute force over `coarse` (its depth-only
+ * mesh). shadow_size: the shadow maps' side in texels, 0 for none;
  * their memory and the sphere meshes' are planned against the budget first
  * (PS_ERR_LIMIT names the scene). out is overwritten; on error it is empty. */
-ps_status ps_preview_lights_build(const ps_scene *s, const ps_preview_mesh *coarse, int shadow_size,
-                                  ps_preview_lights *out, ps_error *err);
+ps_status ps_preview_lights_build(const ps_scene *s, const ps_accel *accel, const ps_preview_mesh *coarse,
+                                  int shadow_size, ps_preview_lights *out, ps_error *err);
 void ps_preview_lights_free(ps_preview_lights *l); /* and zero it; accepts a zeroed one */
 
 /* Which shadow-cube faces can receive light from v: a face is left out only

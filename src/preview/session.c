@@ -101,7 +101,7 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
 static ps_status build_lights(ps_session *s, ps_error *err)
 {
     ps_preview_lights_free(&s->lights);
-    return ps_preview_lights_build(s->scene, &s->coarse, s->set.shadow_size, &s->lights, err);
+    return ps_preview_lights_build(s->scene, ps_world_accel(s->world), &s->coarse, s->set.shadow_size, &s->lights, err);
 }
 
 static void free_maps(ps_session *s)
