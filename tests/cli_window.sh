@@ -90,4 +90,22 @@ rmse=$("$bin/photosplat-compare" "$cli_tmp/same-w.png" "$cli_tmp/same-c.png" | s
 echo "GL-encoded against CPU-encoded window: rmse $rmse"
 awk_true "$rmse < 1.0 / 255" && ok || bad "the GL composite differs from the CPU one: rmse $rmse"
 
+# Illuminance in false colour (key F; a script's set false-color): a picture of
+# its own (the lux in it are test_gl_illuminance's), and off again the normal
+# picture comes back, the photons kept.
+cat >"$cli_tmp/fc.txt" <<SCRIPT
+1.2 screenshot $cli_tmp/fc-before.png
+1.3 set false-color on
+1.6 screenshot $cli_tmp/fc-on.png
+1.7 set false-color off
+2.0 screenshot $cli_tmp/fc-off.png
+2.1 quit
+SCRIPT
+expect_success "false colour" xrun "$win" "$scene" "${same[@]}" --overlay off --script "$cli_tmp/fc.txt"
+on=$("$bin/photosplat-compare" "$cli_tmp/fc-on.png" "$cli_tmp/fc-before.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
+off=$("$bin/photosplat-compare" "$cli_tmp/fc-off.png" "$cli_tmp/fc-before.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
+echo "false colour against the picture: rmse $on; off again: $off"
+awk_true "$on > 0.1" && ok || bad "false colour did not change the picture (rmse $on)"
+awk_true "$off < 2.0 / 255" && ok || bad "false colour off did not give the picture back (rmse $off)"
+
 cli_summary

@@ -21,6 +21,7 @@
 #include "gl/gl_font.h"
 #include "gl/gl_render.h"
 #include "gl/platform.h"
+#include "image/falsecolor.h"
 #include "image/image.h"
 #include "preview/script.h"
 #include "preview/session.h"
@@ -117,6 +118,7 @@ static const char help_text[] =
     "  T / Shift+T      tau up / down\n"
     "  E / Shift+E      exposure up / down\n"
     "  Space            pause tracing    V  overlay    P  screenshot\n"
+    "  F                illuminance in false colour (lux under the cursor)\n"
     "  H                this help        Q  quit";
 
 typedef struct win_options {
@@ -155,6 +157,13 @@ typedef struct app {
     double edit_time, edit_latency_max, edit_latency_sum;
     uint64_t edit_latency_count;
     bool awaiting_edit_frame;
+    /* Illuminance in false colour (key F): the last refresh's lux, a pixel
+     * each (row 0 the top), the cursor that reads it, and the 8-bit picture. */
+    bool false_color;
+    float *lux;
+    uint8_t *rgb;
+    double cursor_x, cursor_y;
+    ps_lux_scale lux_scale;
     double show_sum; /* the composite shown, all refreshes */
     uint64_t show_count;
     /* The script. */
@@ -315,6 +324,15 @@ static void draw_overlay(app *a)
         if (n > 0 && (size_t)n < sizeof text)
             n += snprintf(text + n, sizeof text - (size_t)n, "\n");
     }
+    if (a->false_color && a->lux && n > 0 && (size_t)n < sizeof text) {
+        int cx = (int)a->cursor_x, cy = (int)a->cursor_y;
+        if (cx >= 0 && cx < a->width && cy >= 0 && cy < a->height)
+            n += snprintf(text + n, sizeof text - (size_t)n, "illuminance: %.4g lx under the cursor (scale %.3g to %.3g lx)\n",
+                          a->lux[(size_t)cy * (size_t)a->width + (size_t)cx], a->lux_scale.lo, a->lux_scale.hi);
+        else
+            n += snprintf(text + n, sizeof text - (size_t)n, "illuminance: %.3g to %.3g lx (F: off)\n", a->lux_scale.lo,
+                          a->lux_scale.hi);
+    }
     if (a->message[0] && ps_now_seconds() - a->message_time > MESSAGE_SECONDS)
         a->message[0] = '\0';
     if (a->message[0] && n > 0 && (size_t)n < sizeof text)
@@ -322,6 +340,62 @@ static void draw_overlay(app *a)
     ps_gl_overlay_begin(a->width, a->height);
     ps_gl_overlay_panel(a->help ? help_text : text);
     ps_gl_overlay_end();
+}
+
+/* The false-colour picture of the illuminance (the session in illuminance
+ * mode: layers of E / pi), read back, in lux, and drawn with its legend over
+ * the window's right edge. */
+static ps_status show_false_color(app *a, const double gains[PS_MAP_COUNT], ps_error *err)
+{
+    size_t n = (size_t)a->width * (size_t)a->height;
+    if (!a->lux)
+        a->lux = malloc(n * sizeof *a->lux);
+    if (!a->rgb)
+        a->rgb = malloc(3 * n);
+    if (!a->lux || !a->rgb)
+        return ps_error_set(err, PS_ERR_NOMEM, "photosplat: out of memory for the illuminance picture");
+    ps_image irr;
+    ps_status st = ps_gl_layers_composite(a->layers, a->frame.direct_gain, gains, &irr, err);
+    if (st != PS_OK)
+        return st;
+    for (size_t i = 0; i < 3 * n; i++)
+        irr.rgb[i] *= (float)PS_PI; /* white Lambertian: L = E / pi */
+    ps_lux_from_irradiance(&irr, a->lux);
+    ps_image_destroy(&irr);
+    a->lux_scale = ps_lux_scale_auto(a->lux, n);
+    ps_image fc;
+    st = ps_falsecolor_image(a->lux, a->width, a->height, a->lux_scale, &fc, err);
+    if (st != PS_OK)
+        return st;
+    /* The picture's columns, then the legend (fc.width - width wide) over
+     * the right edge, rows flipped for GL. */
+    int legend = fc.width - a->width, split = a->width > legend ? a->width - legend : 0;
+    for (int y = 0; y < a->height; y++) {
+        uint8_t *dst = a->rgb + 3 * (size_t)(a->height - 1 - y) * (size_t)a->width;
+        for (int x = 0; x < a->width; x++) {
+            const float *src = ps_image_at(&fc, x < split ? x : x + legend, y);
+            for (int c = 0; c < 3; c++)
+                dst[3 * x + c] = ps_tonemap_8bit(src[c], 1.0f);
+        }
+    }
+    ps_image_destroy(&fc);
+    ps_gl_show_rgb8(a->width, a->height, a->rgb);
+    return PS_OK;
+}
+
+/* Illuminance in false colour on or off (key F): the session draws white
+ * Lambertian surfaces at exposure 1, the renderer follows. */
+static void set_false_color(app *a, bool on)
+{
+    ps_error err;
+    if (ps_session_set_illuminance(a->session, on, &err) != PS_OK) {
+        say(a, err.msg);
+        return;
+    }
+    ps_gl_renderer_set_materials(a->gl, ps_session_materials(a->session), on);
+    ps_gl_renderer_set_kernel(a->gl, ps_session_kernel(a->session));
+    a->false_color = on;
+    a->redraw = true;
 }
 
 /* One refresh: the session's splats drawn into the layers (a new view first
@@ -342,7 +416,10 @@ static ps_status refresh(app *a, ps_error *err)
     for (int k = 0; k < PS_MAP_COUNT; k++)
         gains[k] = a->frame.map[k].gain;
     double t_show = ps_now_seconds();
-    if (a->o.composite)
+    if (a->false_color) {
+        if ((st = show_false_color(a, gains, err)) != PS_OK)
+            return st;
+    } else if (a->o.composite)
         ps_gl_layers_show(a->layers, a->frame.direct_gain, gains);
     else if ((st = ps_gl_layers_show_by_cpu(a->layers, a->frame.direct_gain, gains, err)) != PS_OK)
         return st;
@@ -597,6 +674,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_Q: a->quit = true; break;
     case GLFW_KEY_H: a->help = !a->help, a->redraw = true; break;
     case GLFW_KEY_V: a->overlay = !a->overlay, a->redraw = true; break;
+    case GLFW_KEY_F: set_false_color(a, !a->false_color); break;
     case GLFW_KEY_SPACE: ps_session_set_paused(a->session, !ps_session_paused(a->session)); break;
     case GLFW_KEY_S:
         ps_session_set_splat(a->session, (ps_splat_mode)((set->splat + 1) % PS_SPLAT_MODE_COUNT));
@@ -670,6 +748,10 @@ static void on_cursor(GLFWwindow *w, double x, double y)
 {
     app *a = app_of(w);
     double dx = x - a->drag_x, dy = y - a->drag_y;
+    a->cursor_x = x;
+    a->cursor_y = y;
+    if (a->false_color)
+        a->redraw = a->redraw || a->overlay; /* the lux under the cursor */
     if (a->drag == DRAG_ORBIT)
         orbit(a, dx * ORBIT_DEG_PER_PIXEL, dy * ORBIT_DEG_PER_PIXEL);
     else if (a->drag == DRAG_PAN)
@@ -752,6 +834,7 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
         case PS_SET_PRECISION: ps_session_set_precision(s, (ps_precision)act->choice); return PS_OK;
         case PS_SET_EXPOSURE: ps_session_set_exposure(s, act->number); return PS_OK;
         case PS_SET_PAUSE: ps_session_set_paused(s, act->choice != 0); return PS_OK;
+        case PS_SET_FALSE_COLOR: set_false_color(a, act->choice != 0); return PS_OK;
         }
         return PS_OK;
     }
@@ -947,6 +1030,8 @@ int main(int argc, char **argv)
     ps_gl_layers_destroy(a.layers);
     ps_gl_renderer_destroy(a.gl);
     ps_platform_close(a.platform);
+    free(a.lux);
+    free(a.rgb);
     ps_script_destroy(a.script);
     ps_scene_destroy(a.scene);
     if (st == PS_OK)

@@ -188,6 +188,18 @@ ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const doub
     return st;
 }
 
+void ps_gl_show_rgb8(int width, int height, const uint8_t *rgb)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, width, height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_BLEND);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glWindowPos2i(0, 0);
+    glDrawPixels(width, height, GL_RGB, GL_UNSIGNED_BYTE, rgb);
+}
+
 ps_status ps_gl_layers_show_by_cpu(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
                                    ps_error *err)
 {
@@ -203,14 +215,7 @@ ps_status ps_gl_layers_show_by_cpu(ps_gl_layers *l, double direct_gain, const do
             for (int i = 0; i < 3 * l->width; i++)
                 dst[i] = ps_tonemap_8bit(src[i], 1.0f);
         }
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        glViewport(0, 0, l->width, l->height);
-        glDisable(GL_DEPTH_TEST);
-        glDisable(GL_STENCIL_TEST);
-        glDisable(GL_BLEND);
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        glWindowPos2i(0, 0);
-        glDrawPixels(l->width, l->height, GL_RGB, GL_UNSIGNED_BYTE, rgb);
+        ps_gl_show_rgb8(l->width, l->height, rgb);
     }
     free(rgb);
     ps_image_destroy(&img);

@@ -143,6 +143,9 @@ void ps_gl_layers_show(ps_gl_layers *l, double direct_gain, const double map_gai
  * ps_gl_layers_show against (the window's --composite cpu). */
 ps_status ps_gl_layers_show_by_cpu(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
                                    ps_error *err);
+/* An 8-bit RGB picture (rows bottom-up, as GL's) drawn into the default
+ * framebuffer as it is: the window's false-colour mode. */
+void ps_gl_show_rgb8(int width, int height, const uint8_t *rgb);
 /* The same composite, linear, read back into out (created here; row 0 the
  * top): for tests. */
 ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],

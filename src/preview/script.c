@@ -190,15 +190,16 @@ static ps_status parse_layers(parser *p, ps_script_action *a, const char *list)
 
 static ps_status parse_set(parser *p, ps_script_action *a)
 {
-    static const char *const SETTINGS[] = {"splat", "layers", "kernel", "radius",
-                                           "tau",   "precision", "exposure", "pause"};
-    static const char *const SAID = "splat, layers, kernel, radius, tau, precision, exposure or pause";
+    static const char *const SETTINGS[] = {"splat",     "layers",   "kernel", "radius",     "tau",
+                                           "precision", "exposure", "pause",  "false-color"};
+    enum { SETTING_COUNT = sizeof SETTINGS / sizeof SETTINGS[0] };
+    static const char *const SAID = "splat, layers, kernel, radius, tau, precision, exposure, pause or false-color";
     if (p->nword < 3)
         return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "set: expected a setting (%s)", SAID);
     int k = 0;
-    while (k < 8 && strcmp(SETTINGS[k], p->word[2]) != 0)
+    while (k < SETTING_COUNT && strcmp(SETTINGS[k], p->word[2]) != 0)
         k++;
-    if (k == 8)
+    if (k == SETTING_COUNT)
         return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "set: unknown setting '%s' (expected %s)",
                            p->word[2], SAID);
     a->setting = (ps_script_setting)k;
@@ -211,7 +212,8 @@ static ps_status parse_set(parser *p, ps_script_action *a)
     case PS_SET_SPLAT: choices = &SPLAT_CHOICES; break;
     case PS_SET_KERNEL: choices = &KERNEL_CHOICES; break;
     case PS_SET_PRECISION: choices = &PRECISION_CHOICES; break;
-    case PS_SET_PAUSE: choices = &PAUSE_CHOICES; break;
+    case PS_SET_PAUSE:
+    case PS_SET_FALSE_COLOR: choices = &PAUSE_CHOICES; break;
     case PS_SET_LAYERS:
         if (nargs != 1)
             return wrong_count(p, what, "one comma list of direct, caustic, global");
