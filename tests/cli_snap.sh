@@ -55,6 +55,9 @@ expect_success "illuminance" "$snap" "$scene" "${small[@]}" --illuminance "$cli_
     --false-color "$cli_tmp/lux.png"
 [ "$(head -2 "$cli_tmp/lux.pfm" | tr '\n' ' ')" = "Pf 48 48 " ] && ok || bad "lux.pfm is not a one-channel 48x48 PFM"
 [ "$(head -c 8 "$cli_tmp/lux.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a ] && ok || bad "lux.png is not a PNG"
+expect_success "OpenEXR" "$snap" "$scene" "${small[@]}" --hdr "$cli_tmp/s.exr"
+[ "$(head -c 4 "$cli_tmp/s.exr" | od -An -tx1 | tr -d ' ')" = 762f3101 ] && ok || bad "s.exr is not OpenEXR"
+[[ $("$bin/photosplat-compare" "$cli_tmp/s.exr" "$cli_tmp/s.pfm") == rmse=0\ * ]] && ok || bad "the EXR is not the PFM's picture"
 expect_usage_error "unwritable illuminance" "$snap" "$scene" "${small[@]}" --illuminance /nonexistent/dir/l.pfm
 [ "$(grep -c '^caustic ' "$cli_tmp/s.txt")" = "$(sed -n 's/.*"stored_caustic": \([0-9]*\).*/\1/p' "$cli_tmp/s.json")" ] &&
     ok || bad "the dump and the stats disagree on the caustic photons"

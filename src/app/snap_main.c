@@ -14,6 +14,7 @@
 #include "app/stats.h"
 #include "core/fileio.h"
 #include "gl/gl_render.h"
+#include "image/exr_io.h"
 #include "gl/platform.h"
 #include "preview/session.h"
 #include "scene/scene.h"
@@ -217,7 +218,7 @@ static ps_status write_outputs(snap_run *s, ps_error *err)
         st = ps_png_write(&img, o->c.out_png, 1.0f, err);
     if (st == PS_OK && o->c.out_hdr) {
         to_radiance(s, &img);
-        st = ps_pfm_write(&img, o->c.out_hdr, err);
+        st = ps_hdr_write(&img, o->c.out_hdr, err); /* PFM, or OpenEXR for .exr */
     }
     ps_image_destroy(&img);
     if (st == PS_OK && o->hdr_layers)
