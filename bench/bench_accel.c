@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/clock.h"
 #include "accel/accel.h"
 #include "bench_util.h"
 #include "scene/scene.h"
@@ -34,13 +35,6 @@
  * shared machine the wall clock also counts the time other programs held the
  * core, which says nothing about either tracer. The two-thread rates are
  * wall-clock: there the question is what two threads deliver. */
-static double thread_cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Rays per scene for the octree and Embree; brute force gets about this many
  * primitive tests in all, and at least BRUTE_MIN_RAYS rays. */
 #define RAYS 1000000
@@ -138,7 +132,7 @@ static double embree_trace(RTCScene scene, const ps_ray *rays, size_t begin, siz
 {
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    double t0 = thread_cpu_now();
+    double t0 = ps_thread_cpu_seconds();
     for (size_t i = begin; i < end; i++) {
         struct RTCRayHit rh;
         rh.ray.org_x = (float)rays[i].o.x;
@@ -161,7 +155,7 @@ static double embree_trace(RTCScene scene, const ps_ray *rays, size_t begin, siz
         else
             prim[i] = rh.hit.geomID == 0 ? rh.hit.primID : (uint32_t)triangles + rh.hit.primID;
     }
-    return thread_cpu_now() - t0;
+    return ps_thread_cpu_seconds() - t0;
 }
 #endif
 
@@ -298,12 +292,12 @@ static int measure(const char *name, const bench_scene *s, const ps_ray *rays, r
     double octree_s = 0.0, scalar_s = 0.0, embree_s = 0.0;
     for (size_t begin = 0; begin < RAYS; begin += CHUNK) {
         size_t end = begin + CHUNK < RAYS ? begin + CHUNK : RAYS;
-        double t0 = thread_cpu_now();
+        double t0 = ps_thread_cpu_seconds();
         octree_trace_range(a, rays, begin, end, prim);
-        double t1 = thread_cpu_now();
+        double t1 = ps_thread_cpu_seconds();
         octree_trace_range(sa, rays, begin, end, sprim);
         octree_s += t1 - t0;
-        scalar_s += thread_cpu_now() - t1;
+        scalar_s += ps_thread_cpu_seconds() - t1;
 #ifdef PS_HAVE_EMBREE
         embree_s += embree_trace(scene, rays, begin, end, s->triangle_count, eprim);
 #endif
@@ -389,19 +383,19 @@ static int measure(const char *name, const bench_scene *s, const ps_ray *rays, r
     }
 
     /* Step 4: the nearest-geometry query from the ray origins, and its oracle on a few. */
-    double t0 = thread_cpu_now(), sink = 0.0;
+    double t0 = ps_thread_cpu_seconds(), sink = 0.0;
     for (size_t i = 0; i < NEAREST_QUERIES; i++)
         sink += ps_accel_nearest_distance(a, rays[i].o);
-    r->nearest_us = 1e6 * (thread_cpu_now() - t0) / NEAREST_QUERIES;
+    r->nearest_us = 1e6 * (ps_thread_cpu_seconds() - t0) / NEAREST_QUERIES;
     size_t same = 0;
-    t0 = thread_cpu_now();
+    t0 = ps_thread_cpu_seconds();
     for (size_t i = 0; i < NEAREST_BRUTE; i++) {
         ps_nearest n1, n2;
         bool f1 = ps_accel_nearest_brute(a, rays[i].o, INFINITY, &n2);
         bool f2 = ps_accel_nearest(a, rays[i].o, INFINITY, &n1);
         same += f1 == f2 && (!f1 || (n1.prim == n2.prim && n1.distance == n2.distance));
     }
-    r->nearest_brute_us = 1e6 * (thread_cpu_now() - t0) / NEAREST_BRUTE - r->nearest_us;
+    r->nearest_brute_us = 1e6 * (ps_thread_cpu_seconds() - t0) / NEAREST_BRUTE - r->nearest_us;
     r->agree_nearest = (double)same / NEAREST_BRUTE;
     if (!(sink >= 0.0))
         fprintf(stderr, "bench_accel: %s: a nearest distance is not a number\n", name);

@@ -15,25 +15,10 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "core/clock.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
 #include "scene/scene.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* Processor time of all the process's threads: what the tracing cost, whatever
- * else shared the cores meanwhile. */
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* A bumpy latitude-longitude sphere of about `triangles` triangles, radius
  * 0.4 at (0, 0.6, 0), as an OBJ file: a closed mesh that photons must find. */
@@ -100,10 +85,10 @@ static int run_map(const char *scene_path, const char *text, const char *dir, in
     }
     ps_photon_map m;
     ps_photon_map_init(&m, kind);
-    double t0 = now(), c0 = cpu_now();
+    double t0 = ps_now_seconds(), c0 = ps_process_cpu_seconds();
     st = ps_tracer_trace(t, kind, 0, photons, photons, &m, &err);
-    r->seconds = now() - t0;
-    r->cpu_seconds = cpu_now() - c0;
+    r->seconds = ps_now_seconds() - t0;
+    r->cpu_seconds = ps_process_cpu_seconds() - c0;
     r->rays_per_photon = (double)m.counters.rays / (double)photons;
     r->stored_per_photon = (double)m.counters.stored / (double)photons;
     (void)ps_scene_triangles(s, &r->triangles);

@@ -8,6 +8,7 @@
  * position minus double query, in double, dx*dx + dy*dy + dz*dz), so the
  * sorted distances must agree bit for bit: ties may pick other photons, but
  * never other distances. */
+#include "core/clock.h"
 #include "test.h"
 
 #include <stdlib.h>
@@ -23,13 +24,6 @@
 /* A build of 200k points takes milliseconds; quadratic behaviour would take
  * minutes. The bound only catches that, never a slow machine or ASan. */
 #define BUILD_SECONDS_BOUND 20.0
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static ps_photon photon_at(ps_vec3 p, ps_vec3 normal, double power)
 {
@@ -566,9 +560,9 @@ static void empty_and_degenerate(void **state)
 
 static void build_order(const ps_photon *ph, size_t n, const char *what)
 {
-    double t0 = now_s();
+    double t0 = ps_now_seconds();
     ps_kdtree *t = build(ph, n);
-    double dt = now_s() - t0;
+    double dt = ps_now_seconds() - t0;
     if (dt > BUILD_SECONDS_BOUND)
         fail_msg("%s: building %zu photons took %.2f s", what, n, dt);
     assert_true(ps_kdtree_check(t));

@@ -5,19 +5,13 @@
 #include <string.h>
 #include <time.h>
 
+#include "core/clock.h"
 #include "accel/accel_internal.h"
 
 /* A triangle whose doubled area is within this fraction of its longest edge
  * squared has no area beyond rounding (coincident or collinear vertices): it
  * is left out, so that it never reports a hit with a meaningless normal. */
 #define DEGENERATE_REL (8.0 * DBL_EPSILON)
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Outside octree_trace_avx2.c, whose code must not run before this says yes. */
 bool ps_accel_cpu_has_avx2(void)
@@ -118,7 +112,7 @@ static ps_status copy_input(ps_accel *a, const ps_accel_input *in, ps_error *err
 
 ps_status ps_accel_build(const ps_accel_input *in, const ps_accel_options *opt, ps_accel **out, ps_error *err)
 {
-    double start = now_seconds();
+    double start = ps_now_seconds();
     *out = NULL;
     ps_accel_options o = {PS_ACCEL_AUTO, 0, 0, false};
     if (opt)
@@ -163,7 +157,7 @@ ps_status ps_accel_build(const ps_accel_input *in, const ps_accel_options *opt, 
     a->stats.bytes = sizeof *a + a->tri_count * (sizeof *a->tris + sizeof *a->tri_ids) +
                      a->sphere_count * (sizeof *a->spheres + sizeof *a->sphere_ids) +
                      a->node_count * sizeof *a->nodes + a->ref_count * sizeof *a->refs;
-    a->stats.build_seconds = now_seconds() - start;
+    a->stats.build_seconds = ps_now_seconds() - start;
     *out = a;
     return PS_OK;
 }
