@@ -101,7 +101,7 @@ void ps_irr_record_from_samples(ps_vec3 p, ps_vec3 t, ps_vec3 b, ps_vec3 nrm, in
 {
     rec->p = p;
     rec->n = nrm;
-    double sum[3] = {0, 0, 0}, inv_t = 0.0;
+    double sum[3] = {0, 0, 0}, inv_t = 0.0, t_min = INFINITY;
     ps_vec3 gr[3], gt[3];
     for (int c = 0; c < 3; c++)
         gr[c] = gt[c] = ps_v3(0, 0, 0);
@@ -114,8 +114,10 @@ void ps_irr_record_from_samples(ps_vec3 p, ps_vec3 t, ps_vec3 b, ps_vec3 nrm, in
         int kp = (k + n - 1) % n;
         for (int j = 0; j < m; j++) {
             const ps_irr_sample *cur = &s[j * n + k];
-            if (isfinite(cur->t) && cur->t > 0.0)
+            if (isfinite(cur->t) && cur->t > 0.0) {
                 inv_t += 1.0 / cur->t;
+                t_min = fmin(t_min, cur->t);
+            }
             double tan_c = mean_tan(j, m) * sinc_phi;
             double sin_lo = sqrt((double)j / m), sin_hi = sqrt((double)(j + 1) / m);
             /* phi boundary with stratum k-1 */
@@ -141,6 +143,7 @@ void ps_irr_record_from_samples(ps_vec3 p, ps_vec3 t, ps_vec3 b, ps_vec3 nrm, in
         rec->grad_t[c] = gt[c];
     }
     rec->r_harmonic = inv_t > 0.0 ? (double)m * n / inv_t : INFINITY;
+    rec->t_min = t_min;
     rec->r = rec->r_harmonic;
 }
 

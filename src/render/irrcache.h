@@ -38,6 +38,7 @@ typedef struct ps_irr_record {
     ps_vec3 grad_t[3];    /* translational gradient per channel: dE = (x - x_i) . grad_t */
     double r;             /* validity radius (scene units) */
     double r_harmonic;    /* the harmonic mean hit distance before any clamp (INFINITY: nothing met) */
+    double t_min;         /* the nearest hit of its rays (INFINITY: nothing met) */
 } ps_irr_record;
 
 /* One gather ray of a record: the radiance it brought back and how far it

@@ -201,6 +201,7 @@ typedef struct cache_hit {
     ps_surface sp;
     ps_vec3 n;        /* the shading normal on the side the path came from */
     double footprint; /* how far apart the surface points of neighbouring pixels are there */
+    double length_footprint; /* a pixel's width at the eye path's length (no curvature) */
 } cache_hit;
 
 /* The diffuse or glossy surfaces the eye ray r reaches through mirrors and
@@ -260,7 +261,7 @@ static int cache_path(worker *wk, ps_ray r, ps_ray off, bool has_off, double dis
         return count;
     hits[count].sp = sp;
     hits[count].n = n;
-    hits[count].footprint = job->footprint * dist;
+    hits[count].footprint = hits[count].length_footprint = job->footprint * dist;
     if (has_off)
         hits[count].footprint = fmax(hits[count].footprint, ps_v3_len(ps_v3_sub(so.p, sp.p)) / sqrt(2.0));
     return count + 1;
@@ -290,14 +291,32 @@ static bool cache_record(worker *wk, const cache_hit *h, uint64_t index, ps_irr_
             s->l = gather_ray(wk, ps_world_spawn(job->world, &h->sp, dir), &rng, &s->t);
         }
     ps_irr_record_from_samples(h->sp.p, t, b, h->n, m, n, wk->samples, rec);
-    double px = h->footprint;
-    double lo = PS_RENDER_CACHE_MIN_PX * px, hi = PS_RENDER_CACHE_MAX_PX * px;
-    double r = fmin(fmax(rec->r_harmonic, lo), hi);
-    if (r > rec->r_harmonic) {
+    /* The clamps from the footprint, but the lower one no larger than at
+     * the path's length: behind a convex mirror neighbouring pixels see
+     * points far apart, and a contact shadow there would otherwise spread
+     * over all of them (the extra records cost few pixels). */
+    double lo = PS_RENDER_CACHE_MIN_PX * fmin(h->footprint, h->length_footprint);
+    double hi = PS_RENDER_CACHE_MAX_PX * h->footprint;
+    /* The split-sphere radius, but reaching (a R) no further than the
+     * nearest thing its rays met: the harmonic mean of a floor's record
+     * beside a sphere is long, and without this its value spread into the
+     * sphere's contact shadow, where no record was then made (placement
+     * found it covered). And no longer than where the translational
+     * gradient would change E by all of it (Krivanek et al. 2006's
+     * gradient limit). Then clamped to the footprints. */
+    double r = fmin(rec->r_harmonic, PS_RENDER_CACHE_NEAREST * rec->t_min);
+    for (int c = 0; c < 3; c++) {
+        double e = c == 0 ? rec->e.r : c == 1 ? rec->e.g : rec->e.b, g = ps_v3_len(rec->grad_t[c]);
+        if (g > 0.0 && e > 0.0)
+            r = fmin(r, e / g);
+    }
+    double unclamped = r;
+    r = fmin(fmax(r, lo), hi);
+    if (r > unclamped) {
         /* Near a corner the gradients are steep over the short harmonic
          * radius; extrapolated over the longer clamped one they would
          * overshoot, so they shrink with it (Tabellion & Lamorlette 2004). */
-        double s = rec->r_harmonic / r;
+        double s = unclamped / r;
         for (int c = 0; c < 3; c++)
             rec->grad_t[c] = ps_v3_scale(rec->grad_t[c], s);
     }

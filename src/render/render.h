@@ -58,6 +58,9 @@ double ps_filter_eval(ps_filter f, double dx);
  * record's noise spreads over a wall. */
 #define PS_RENDER_CACHE_MIN_PX 3.0
 #define PS_RENDER_CACHE_MAX_PX 48.0
+/* ... and, before that clamp, to this many times the nearest hit of its rays
+ * (with a = 0.5, a record then reaches no further than the nearest object). */
+#define PS_RENDER_CACHE_NEAREST 2.0
 /* The coarsest grid of positions asking for records, in pixels. */
 #define PS_RENDER_CACHE_COARSE 64
 /* Mixed into the seed for the records' random numbers. */
