@@ -256,6 +256,37 @@ ps_status ps_irrcache_add(ps_irrcache *c, const ps_irr_record *rec, ps_error *er
     return PS_OK;
 }
 
+/* The error term eps of record r at (p, n), or INFINITY where it does not count at all. */
+static double record_error(const ps_irrcache *c, const ps_irr_record *r, ps_vec3 p, ps_vec3 n)
+{
+    double cosn = ps_v3_dot(n, r->n);
+    if (cosn <= 0.0)
+        return INFINITY;
+    ps_vec3 d = ps_v3_sub(p, r->p);
+    double eps = ps_v3_len(d) / r->r + sqrt(fmax(0.0, 1.0 - cosn));
+    if (eps >= c->a || ps_v3_dot(d, ps_v3_add(n, r->n)) * 0.5 < -IRR_FRONT * r->r)
+        return INFINITY;
+    return eps;
+}
+
+bool ps_irrcache_covered(const ps_irrcache *c, ps_vec3 p, ps_vec3 n, double share)
+{
+    int32_t stack[8 * IRR_MAX_DEPTH + 8];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const irr_node *nd = &c->nodes[stack[--top]];
+        for (int32_t i = nd->first; i >= 0; i = c->next[i])
+            if (record_error(c, &c->recs[i], p, n) < share * c->a)
+                return true;
+        if (nd->child >= 0)
+            for (int k = 0; k < 8; k++)
+                if (inside(&c->nodes[nd->child + k], p, 2.0))
+                    stack[top++] = nd->child + k;
+    }
+    return false;
+}
+
 bool ps_irrcache_lookup(const ps_irrcache *c, ps_vec3 p, ps_vec3 n, ps_rgb *e, double *weight)
 {
     double inv_a = 1.0 / c->a, wsum = 0.0;
@@ -267,15 +298,10 @@ bool ps_irrcache_lookup(const ps_irrcache *c, ps_vec3 p, ps_vec3 n, ps_rgb *e, d
         const irr_node *nd = &c->nodes[stack[--top]];
         for (int32_t i = nd->first; i >= 0; i = c->next[i]) {
             const ps_irr_record *r = &c->recs[i];
-            double cosn = ps_v3_dot(n, r->n);
-            if (cosn <= 0.0)
+            double eps = record_error(c, r, p, n);
+            if (!isfinite(eps))
                 continue;
             ps_vec3 d = ps_v3_sub(p, r->p);
-            double eps = ps_v3_len(d) / r->r + sqrt(fmax(0.0, 1.0 - cosn));
-            if (eps >= c->a)
-                continue;
-            if (ps_v3_dot(d, ps_v3_add(n, r->n)) * 0.5 < -IRR_FRONT * r->r)
-                continue;
             double w = 1.0 / fmax(eps, 1e-9) - inv_a;
             ps_vec3 turn = ps_v3_cross(r->n, n);
             for (int k = 0; k < 3; k++) {

@@ -79,4 +79,8 @@ size_t ps_irrcache_count(const ps_irrcache *c);
  * *weight (may be NULL): the weights' sum. */
 bool ps_irrcache_lookup(const ps_irrcache *c, ps_vec3 p, ps_vec3 n, ps_rgb *e, double *weight);
 
+/* Whether some record has eps_i below share * a at (p, unit n) and does not
+ * lie in front of it: where a new record is not needed. */
+bool ps_irrcache_covered(const ps_irrcache *c, ps_vec3 p, ps_vec3 n, double share);
+
 #endif

@@ -268,8 +268,8 @@ static int cache_path(worker *wk, ps_ray r, ps_ray off, bool has_off, double dis
 }
 
 /* A record at hit h from o->cache_rays stratified gather rays (numbers from
- * `index` alone), its radius clamped to [MIN_PX, MAX_PX] pixel footprints at
- * the eye path's length. False when it is not usable. */
+ * `index` alone), its radius clamped to [MIN_PX x the finest grid spacing,
+ * MAX_PX] pixel footprints there. False when it is not usable. */
 static bool cache_record(worker *wk, const cache_hit *h, uint64_t index, ps_irr_record *rec)
 {
     const render_job *job = wk->job;
@@ -295,7 +295,7 @@ static bool cache_record(worker *wk, const cache_hit *h, uint64_t index, ps_irr_
      * the path's length: behind a convex mirror neighbouring pixels see
      * points far apart, and a contact shadow there would otherwise spread
      * over all of them (the extra records cost few pixels). */
-    double lo = PS_RENDER_CACHE_MIN_PX * fmin(h->footprint, h->length_footprint);
+    double lo = PS_RENDER_CACHE_MIN_PX * o->cache_spacing * fmin(h->footprint, h->length_footprint);
     double hi = PS_RENDER_CACHE_MAX_PX * h->footprint;
     /* The split-sphere radius, but reaching (a R) no further than the
      * nearest thing its rays met: the harmonic mean of a floor's record
@@ -351,8 +351,7 @@ static void *cache_worker(void *arg)
         for (int h = 0; h < CACHE_HITS; h++)
             job->chunk_ok[slot + h] = false;
         for (int h = 0; h < nh; h++) {
-            ps_rgb e;
-            if (ps_irrcache_lookup(job->irr, hits[h].sp.p, hits[h].n, &e, NULL))
+            if (ps_irrcache_covered(job->irr, hits[h].sp.p, hits[h].n, PS_RENDER_CACHE_PLACE))
                 continue;
             uint64_t index = ((uint64_t)job->cache_level << 48) ^ ((uint64_t)i * CACHE_HITS + (uint64_t)h);
             job->chunk_ok[slot + h] = cache_record(wk, &hits[h], index, &job->chunk[slot + h]);

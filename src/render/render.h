@@ -53,14 +53,20 @@ double ps_filter_eval(ps_filter f, double dx);
  * (Ward's a; the smaller, the more records). */
 #define PS_RENDER_CACHE_ERROR 0.5
 /* A record's validity radius (the harmonic mean distance of what its rays
- * met) is clamped to this many pixel footprints at its eye path's length:
- * not so small that corners fill with records, not so large that one
- * record's noise spreads over a wall. */
-#define PS_RENDER_CACHE_MIN_PX 3.0
+ * met) is clamped to between MIN_PX times the finest grid's spacing and
+ * MAX_PX pixel footprints there: not so small that corners fill with records
+ * or that records leave holes between the grid's positions (it reaches
+ * a MIN_PX = 1.25 spacings), not so large that one record's noise spreads
+ * over a wall. */
+#define PS_RENDER_CACHE_MIN_PX 2.5
 #define PS_RENDER_CACHE_MAX_PX 48.0
 /* ... and, before that clamp, to this many times the nearest hit of its rays
  * (with a = 0.5, a record then reaches no further than the nearest object). */
 #define PS_RENDER_CACHE_NEAREST 2.0
+/* A position asks for a record unless one has eps_i below this share of a:
+ * records overlap, so that every point between the positions is reached,
+ * and each point averages several records' noise. */
+#define PS_RENDER_CACHE_PLACE 0.5
 /* The coarsest grid of positions asking for records, in pixels. */
 #define PS_RENDER_CACHE_COARSE 64
 /* Mixed into the seed for the records' random numbers. */
