@@ -29,8 +29,9 @@
  * global, and the global map with direct hits for final gathering), and a
  * pixel's bytes (the float image; the PNG encoder works a row at a time). */
 #define REF_MAPS_AT_ONCE 3
-#define REF_PIXEL_BYTES (3 * sizeof(float) + REF_FILTER_BYTES)
-/* The pixel filter's tile buffers: 4 floats a pixel over tiles grown by 2 on each side (16 + 4)^2 / 16^2. */
+#define REF_PIXEL_BYTES (3 * sizeof(float))
+/* ... and with a pixel filter other than the box, its tile buffers: 4 floats
+ * a pixel over tiles grown by 2 on each side, (16 + 4)^2 / 16^2 of the image. */
 #define REF_FILTER_BYTES (4 * sizeof(float) * 25 / 16)
 
 static const char usage[] =
@@ -421,7 +422,7 @@ int main(int argc, char **argv)
     int width = o.photons_only ? 0 : o.c.width ? o.c.width : def->width;
     int height = o.photons_only ? 0 : o.c.height ? o.c.height : def->height;
     ps_status st = ps_check_run_memory("photosplat-ref", photons, PS_PHOTON_PLAN_BYTES, width, height,
-                                       REF_PIXEL_BYTES, &err);
+                                       REF_PIXEL_BYTES + (o.filter == PS_FILTER_BOX ? 0 : REF_FILTER_BYTES), &err);
     if (st == PS_OK)
         st = run(&o, scene, &err);
     ps_scene_destroy(scene);
