@@ -15,12 +15,16 @@
 # the scene file, the renderer binary, the size and the reference settings:
 # they are rendered again only when one of those changes.
 #
+# Beyond the table: the goals of issue 21 (the default and final presets'
+# seconds, the default's whole-image and specular-term relMSE against their
+# references, and the back wall's band-pass energy, scripts/wall-highpass.py).
+#
 # Output: a Markdown table on stdout, bench/results/ref.md and ref.csv, and
 # bench/results/ref-vs-povray.png (ours | POV-Ray | |difference| x4, both
 # references). Called by `make bench` (scripts/bench.sh); alone:
 #
-#   scripts/bench-ref.sh            # about 10 minutes on 2 idle cores (the
-#                                   # photosplat-ref reference alone 4-5), 3 once cached
+#   scripts/bench-ref.sh            # about 13 minutes on 2 shared cores (the
+#                                   # photosplat-ref references alone 6-9), 3 once cached
 #   SIZE=128 scripts/bench-ref.sh   # a quick smaller run (its own cache keys)
 #
 # Environment: SIZE (square image side, default 512), THREADS (default 2),
