@@ -321,6 +321,14 @@ static bool cache_record(worker *wk, const cache_hit *h, uint64_t index, ps_irr_
             rec->grad_t[c] = ps_v3_scale(rec->grad_t[c], s);
     }
     rec->r = r;
+    /* A record whose rays met something (nearly) where it stands lies on
+     * an edge: half its hemisphere is the other wall, where the photon
+     * maps' estimates are biased low, and its value would spread over the
+     * floor radius; rounding decides whether a position hits it, so it
+     * would also make the image depend on the scene's scale. Not made: its
+     * neighbours reach there, or the point gathers. */
+    if (rec->t_min < PS_RENDER_CACHE_EDGE * lo)
+        return false;
     bool ok = isfinite(r) && r > 0.0 && ps_rgb_isfinite(rec->e);
     for (int c = 0; c < 3 && ok; c++)
         ok = isfinite(ps_v3_len2(rec->grad_r[c])) && isfinite(ps_v3_len2(rec->grad_t[c]));

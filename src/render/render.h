@@ -60,6 +60,9 @@ double ps_filter_eval(ps_filter f, double dx);
  * over a wall. */
 #define PS_RENDER_CACHE_MIN_PX 2.5
 #define PS_RENDER_CACHE_MAX_PX 48.0
+/* No record is made where its nearest hit is below this share of that floor
+ * (it stands on an edge; render.c). */
+#define PS_RENDER_CACHE_EDGE 0.05
 /* ... and, before that clamp, to this many times the nearest hit of its rays
  * (with a = 0.5, a record then reaches no further than the nearest object). */
 #define PS_RENDER_CACHE_NEAREST 2.0
