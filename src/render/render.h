@@ -8,7 +8,10 @@
  * irradiance, Christensen 1999, or the global map's estimate directly). Eye
  * rays that meet mirrors and glass first are followed (Fresnel) and all they
  * then see is the `specular` term. The four terms partition the image:
- * all = direct + caustic + indirect + specular. */
+ * all = direct + caustic + indirect + specular. An irradiance cache with
+ * gradients (irrcache.h) serves the diffuse indirect light wherever a path
+ * meets a diffuse surface, and a pixel filter (Mitchell, Gaussian or box)
+ * makes pixels from the eye samples. */
 #ifndef PS_RENDER_RENDER_H
 #define PS_RENDER_RENDER_H
 
