@@ -15,12 +15,16 @@
 # the scene file, the renderer binary, the size and the reference settings:
 # they are rendered again only when one of those changes.
 #
+# Beyond the table: the goals of issue 21 (the default and final presets'
+# seconds, the default's whole-image and specular-term relMSE against their
+# references, and the back wall's band-pass energy, scripts/wall-highpass.py).
+#
 # Output: a Markdown table on stdout, bench/results/ref.md and ref.csv, and
 # bench/results/ref-vs-povray.png (ours | POV-Ray | |difference| x4, both
 # references). Called by `make bench` (scripts/bench.sh); alone:
 #
-#   scripts/bench-ref.sh            # about 10 minutes on 2 idle cores (the
-#                                   # photosplat-ref reference alone 4-5), 3 once cached
+#   scripts/bench-ref.sh            # about 13 minutes on 2 shared cores (the
+#                                   # photosplat-ref references alone 6-9), 3 once cached
 #   SIZE=128 scripts/bench-ref.sh   # a quick smaller run (its own cache keys)
 #
 # Environment: SIZE (square image side, default 512), THREADS (default 2),
@@ -40,25 +44,33 @@ RUN=$OUT/run
 REF=bin/photosplat-ref
 CMP=bin/photosplat-compare
 
-# photosplat-ref levels: label | options. The default is spp 4, gather 16,
-# an irradiance cache record every 8 pixels; the other levels gather at every
-# eye ray's first surface (--cache 0) or cache more densely.
+# photosplat-ref levels: label | options. The three --quality presets (the
+# default: spp 4, gather 16, the irradiance cache with gradients asked for
+# down to every 2 pixels, 1024 rays a record, the Mitchell filter), then the
+# default without its parts: no cache (gathering at every eye ray's diffuse
+# surface), the box filter.
 OURS_LEVELS=(
-    "spp 1, gather 16, no cache|--spp 1 --gather 16 --cache 0"
-    "spp 4, gather 16, no cache|--spp 4 --gather 16 --cache 0"
-    "spp 4, gather 32, no cache|--spp 4 --gather 32 --cache 0"
+    "draft|--quality draft"
+    "default (default)|--quality default"
+    "final|--quality final"
+    "default, box filter|--filter box"
+    "default, no cache|--cache 0"
     "spp 4, gather 64, no cache|--spp 4 --gather 64 --cache 0"
-    "spp 16, gather 16, no cache|--spp 16 --gather 16 --cache 0"
-    "spp 4, gather 64, no cache, 4x photons|--spp 4 --gather 64 --cache 0 --caustic-photons 800000 --global-photons 200000"
-    "spp 4, gather 16, cache 8 (default)|--spp 4 --gather 16 --cache 8"
-    "spp 4, gather 16, cache 4|--spp 4 --gather 16 --cache 4"
-    "spp 4, gather 64, cache 4, 1024 rays|--spp 4 --gather 64 --cache 4 --cache-rays 1024"
 )
 # The converged reference gathers everywhere (no cache, so no interpolation
 # error of its own) with 8x the no-cache default's eye work, 4x its photons,
 # and another seed (its photons and eye samples independent of the levels').
 OURS_REF_LABEL="spp 16, gather 128, no cache, 4x photons, seed 7"
 OURS_REF_OPTS="--spp 16 --gather 128 --cache 0 --caustic-photons 800000 --global-photons 200000 --seed 7"
+# The specular term alone (what mirrors and glass show), converged the same
+# way with 64 eye samples, against the default's.
+SPEC_REF_LABEL="specular: spp 64, gather 64, no cache, 4x photons, seed 7"
+SPEC_REF_OPTS="--component specular --spp 64 --gather 64 --cache 0 --caustic-photons 800000 --global-photons 200000 --seed 7"
+# Goals (issue 21): seconds on 2 cores, and relMSE against the references.
+GOAL_DEFAULT_S=10
+GOAL_FINAL_S=30
+GOAL_SPECULAR=0.004
+GOAL_WHOLE=0.002
 
 # POV-Ray levels: label | command-line options (Declare= sets the scene's knobs).
 POV_LEVELS=(
@@ -157,24 +169,41 @@ povr() {
 }
 
 rows=()   # renderer|label|wall|prepass|render|relmse_png|relmse_lin|psnr_png
+hp_rows=() # label|highpass|wall|relmse_png|relmse_lin
+spec_row="" # wall|relmse
 ok=1
 
-# The reference, cached.
-ours_key=$(hash_of "$SCN" "$REF" <(echo "$SIZE $EXPOSURE $OURS_REF_OPTS"))
-ours_ref=$CACHE/ours-$SIZE-$ours_key
-prune "ours-$SIZE" "$ours_key"
-if [ -s "$ours_ref.pfm" ] && [ -s "$ours_ref.png" ] && [ -s "$ours_ref.wall" ]; then
-    ours_ref_note="cached"
-else
-    log "photosplat-ref reference ($OURS_REF_LABEL), a few minutes"
-    if ours "$ours_ref.tmp" "$OURS_REF_OPTS"; then
-        for e in png pfm json log; do mv "$ours_ref.tmp.$e" "$ours_ref.$e"; done
-        echo "$WALL" >"$ours_ref.wall"
-        ours_ref_note="rendered now"
-    else
-        ok=0
-        status=1
+# cached_ref PREFIX "OPTS" LABEL: the reference rendered with OPTS, cached
+# (sets REF_BASE and REF_NOTE; returns 1 when it could not be made).
+cached_ref() {
+    local key
+    key=$(hash_of "$SCN" "$REF" <(echo "$SIZE $EXPOSURE $2"))
+    REF_BASE=$CACHE/$1-$SIZE-$key
+    prune "$1-$SIZE" "$key"
+    if [ -s "$REF_BASE.pfm" ] && [ -s "$REF_BASE.png" ] && [ -s "$REF_BASE.wall" ]; then
+        REF_NOTE="cached"
+        return 0
     fi
+    log "photosplat-ref reference ($3), a few minutes"
+    ours "$REF_BASE.tmp" "$2" || return 1
+    for e in png pfm json log; do mv "$REF_BASE.tmp.$e" "$REF_BASE.$e"; done
+    echo "$WALL" >"$REF_BASE.wall"
+    REF_NOTE="rendered now"
+}
+# The references, cached.
+if cached_ref ours "$OURS_REF_OPTS" "$OURS_REF_LABEL"; then
+    ours_ref=$REF_BASE
+    ours_ref_note=$REF_NOTE
+else
+    ok=0
+    status=1
+fi
+spec_ref=""
+if cached_ref spec "$SPEC_REF_OPTS" "$SPEC_REF_LABEL"; then
+    spec_ref=$REF_BASE
+    spec_ref_note=$REF_NOTE
+else
+    status=1
 fi
 
 if [ "$ok" = 1 ]; then
@@ -189,8 +218,19 @@ if [ "$ok" = 1 ]; then
         c_png=$("$CMP" "$base.png" "$ours_ref.png")
         c_lin=$("$CMP" "$base.pfm" "$ours_ref.pfm")
         rows+=("photosplat-ref|$label|$WALL|$(fmt %.2f "$(json maps_seconds "$base.json")")|$(fmt %.2f "$(json render_seconds "$base.json")")|$(fmt %.3g "$(field relmse "$c_png")")|$(fmt %.3g "$(field relmse "$c_lin")")|$(fmt %.2f "$(field psnr "$c_png")")")
+        # The back wall's band-pass energy (scripts/wall-highpass.py): spots or blotches.
+        hp_rows+=("$label|$(python3 scripts/wall-highpass.py "$base.pfm" | sed -n 's/^highpass=\([^ ]*\).*/\1/p')|$WALL|$(fmt %.3g "$(field relmse "$c_png")")|$(fmt %.3g "$(field relmse "$c_lin")")")
     done
+    # The specular term at the default settings against its own reference.
+    if [ -n "$spec_ref" ]; then
+        log "photosplat-ref: the default's specular term"
+        if ours "$RUN/ours-spec" "--component specular"; then
+            c_spec=$("$CMP" "$RUN/ours-spec.pfm" "$spec_ref.pfm")
+            spec_row="$WALL|$(field relmse "$c_spec")"
+        fi
+    fi
 fi
+hp_ref=$(python3 scripts/wall-highpass.py "$ours_ref.pfm" 2>/dev/null | sed -n 's/^highpass=\([^ ]*\).*/\1/p')
 
 # ---- POV-Ray ------------------------------------------------------------------
 pov_version=""
@@ -306,6 +346,30 @@ cpu=$(sed -n 's/^model name[^:]*: *//p' /proc/cpuinfo 2>/dev/null | head -1)
         [ "$r" = "POV-Ray" ] || continue
         echo "| $r | $l | $w | $p | $re | $e | $el | $ps | | |"
     done
+    echo
+    echo "### The goals (issue 21)"
+    echo
+    echo "Back wall band-pass energy (\`scripts/wall-highpass.py\`: mean (box3 - box17)^2 / mean^2 of the luminance"
+    echo "above the spheres; the converged reference's own noise: ${hp_ref:-?}):"
+    echo
+    echo "| settings | wall s | relMSE (PNG) | relMSE (linear) | back-wall band-pass | goal |"
+    echo "| --- | ---: | ---: | ---: | ---: | --- |"
+    for row in "${hp_rows[@]}"; do
+        IFS='|' read -r l h w e el <<<"$row"
+        goal=""
+        case "$l" in
+        "default (default)") goal="$(awk -v w="$w" -v g=$GOAL_DEFAULT_S -v e="$e" -v ge=$GOAL_WHOLE 'BEGIN { printf "%s s <= %d: %s; relMSE %s <= %s: %s", w, g, (w <= g ? "met" : "MISSED"), e, ge, (e <= ge ? "met" : "MISSED") }')" ;;
+        final) goal="$(awk -v w="$w" -v g=$GOAL_FINAL_S 'BEGIN { printf "%s s <= %d: %s", w, g, (w <= g ? "met" : "MISSED") }')" ;;
+        esac
+        echo "| $l | $w | $e | $el | $h | $goal |"
+    done
+    if [ -n "$spec_row" ]; then
+        IFS='|' read -r w e <<<"$spec_row"
+        echo
+        echo "The specular term at the default settings: relMSE $(fmt %.3g "$e") (linear) against $SPEC_REF_LABEL" \
+            "($(cat "$spec_ref.wall" 2>/dev/null || echo '?') s, ${spec_ref_note:-failed}); goal $GOAL_SPECULAR:" \
+            "$(awk -v e="$e" -v g=$GOAL_SPECULAR 'BEGIN { print (e <= g ? "met" : "MISSED") }'); $w s."
+    fi
     def=$(grep '(default)' <<<"$ratio_rows" | head -1)
     if [ -n "$def" ] && [ "$have_pov" = 1 ]; then
         IFS='|' read -r r l w p re e el ps pt ra <<<"$def"

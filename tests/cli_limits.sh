@@ -33,7 +33,7 @@ expect_match "ref photons message" "$cli_err" \
     '^photosplat-ref: 10[0-9]+ photons and a 512x512 image would need [0-9]+ MiB, more than the memory budget of 64 MiB \(set by PS_MEMORY_LIMIT\)$'
 nothing_left "ref photons over budget"
 expect_usage_error "ref image over budget" "$ref" "$scene" -o "$out/a.png" --size 16384x16384 "${small[@]}"
-expect_match "ref image message" "$cli_err" 'a 16384x16384 image would need 3\.0 GiB, more than the memory budget'
+expect_match "ref image message" "$cli_err" 'a 16384x16384 image would need 9\.3 GiB, more than the memory budget'
 nothing_left "ref image over budget"
 expect_usage_error "snap image over budget" "$snap" "$scene" -o "$out/a.png" --size 4000x4000 "${small[@]}"
 expect_match "snap image message" "$cli_err" '^photosplat-snap: .*4000x4000 image would need'

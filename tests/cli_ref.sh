@@ -89,11 +89,31 @@ cmp -s "$cli_tmp/t1.pfm" "$cli_tmp/t2.pfm" && ok || bad "images differ between 1
 # ... nor with the irradiance cache, whose records are made in any order.
 for n in 1 2; do
     expect_success "cache, $n threads" "$ref" "$scene" --hdr "$cli_tmp/k$n.pfm" --size 16x16 --spp 1 --gather 2 \
-        --cache 4 --cache-rays 16 --threads $n "${small[@]}"
+        --cache 1 --cache-rays 16 --threads $n "${small[@]}"
 done
 cmp -s "$cli_tmp/k1.pfm" "$cli_tmp/k2.pfm" && ok || bad "cached images differ between 1 and 2 threads"
 cmp -s "$cli_tmp/k1.pfm" "$cli_tmp/t1.pfm" && bad "the cache changed nothing" || ok
 expect_usage_error "negative cache" "$ref" "$scene" -o "$cli_tmp/x.png" --cache -1
+# Quality presets set their options together; options given explicitly win.
+expect_usage_error "bad quality" "$ref" "$scene" -o "$cli_tmp/x.png" --quality best
+expect_usage_error "bad filter" "$ref" "$scene" -o "$cli_tmp/x.png" --filter lanczos
+expect_success "final, spp 1" "$ref" "$scene" --hdr "$cli_tmp/q.pfm" --size 16x16 --quality final --spp 1 \
+    --caustic-photons 20000 --stats "$cli_tmp/q.json"
+grep -q '"spp": 1,' "$cli_tmp/q.json" && ok || bad "--spp did not win over --quality final"
+grep -q '"cache_rays": 2048,' "$cli_tmp/q.json" && ok || bad "--quality final did not set --cache-rays"
+grep -q '"emitted_caustic": 20000,' "$cli_tmp/q.json" && ok || bad "--caustic-photons did not win over the preset"
+grep -q '"emitted_global": 100000,' "$cli_tmp/q.json" && ok || bad "--quality final did not double the global photons"
+expect_success "draft" "$ref" "$scene" --hdr "$cli_tmp/d.pfm" --size 16x16 --quality draft --stats "$cli_tmp/d.json"
+grep -q '"spp": 1,' "$cli_tmp/d.json" && grep -q '"gather": 8,' "$cli_tmp/d.json" && ok || bad "--quality draft: $(cat "$cli_tmp/d.json")"
+# The filters: box is each pixel's own samples; the wider ones differ, same bytes for any thread count.
+for f in box mitchell gaussian; do
+    for n in 1 2; do
+        expect_success "filter $f, $n threads" "$ref" "$scene" --hdr "$cli_tmp/f-$f-$n.pfm" --size 24x24 --spp 2 \
+            --gather 2 --cache-rays 16 --filter $f --threads $n "${small[@]}"
+    done
+    cmp -s "$cli_tmp/f-$f-1.pfm" "$cli_tmp/f-$f-2.pfm" && ok || bad "filter $f: images differ between 1 and 2 threads"
+done
+cmp -s "$cli_tmp/f-box-1.pfm" "$cli_tmp/f-mitchell-1.pfm" && bad "the Mitchell filter changed nothing" || ok
 
 # The golden image (scripts/regen-golden.sh remakes it, on purpose only). The
 # renderer is deterministic, so the tolerance only absorbs compiler-level

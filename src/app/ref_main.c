@@ -21,15 +21,11 @@
 #include "render/render.h"
 #include "scene/scene.h"
 
-/* Defaults for the image (see the README's recommended settings). */
-#define REF_DEFAULT_SPP 4
+/* Defaults for the image: --quality default's settings (ps_render_quality),
+ * then k. */
 #define REF_DEFAULT_K 100
-#define REF_DEFAULT_GATHER 16
-/* The irradiance cache by default: at a record every 8 pixels of 256 rays it
- * reached in 3.9 s the error that gathering everywhere (64 rays) reached in
- * 28 s on the default scene (make bench). */
-#define REF_DEFAULT_CACHE 8
-#define REF_DEFAULT_CACHE_RAYS 256
+/* An option --quality leaves to the preset. */
+#define REF_UNSET (-1)
 /* Final gathering looks irradiance up at every this-many-th photon (Christensen 1999 uses a subset). */
 #define REF_IRRADIANCE_STRIDE 4
 /* The memory plan (ps_check_run_memory): maps in memory at once (caustic,
@@ -37,6 +33,9 @@
  * pixel's bytes (the float image; the PNG encoder works a row at a time). */
 #define REF_MAPS_AT_ONCE 3
 #define REF_PIXEL_BYTES (3 * sizeof(float))
+/* ... and with a pixel filter other than the box, its tile buffers: 4 floats
+ * a pixel over tiles grown by 2 on each side, (16 + 4)^2 / 16^2 of the image. */
+#define REF_FILTER_BYTES (4 * sizeof(float) * 25 / 16)
 
 static const char usage[] =
     "usage: photosplat-ref SCENE.scn --photons-only [options]\n"
@@ -65,6 +64,13 @@ static const char usage[] =
     "  --stats FILE.json        figures of the run\n"
     "  --dump-photons FILE      every stored photon: map x y z r g b dx dy dz nx ny nz\n"
     "  --photons-only           trace the photon maps only; -o is not needed\n"
+    "  --quality draft|default|final  sets --spp, --gather, --cache, --cache-rays and the\n"
+    "                           photon counts together (default: default); options given\n"
+    "                           explicitly win: draft spp 1, gather 8, cache 4, 256 rays,\n"
+    "                           photons x0.5; default spp 4, gather 16, cache 2, 1024 rays;\n"
+    "                           final spp 16, gather 32, cache 1, 2048 rays, photons x2\n"
+    "  --filter mitchell|gaussian|box  pixel filter (default mitchell; box: each pixel\n"
+    "                           the mean of its own samples)\n"
     "  --spp N                  eye samples per pixel (default 4)\n"
     "  --k N                    photons per radiance estimate (default 100)\n"
     "  --max-radius R           largest search radius of both maps (default: their radii)\n"
@@ -72,8 +78,10 @@ static const char usage[] =
     "                           0: the global map's estimate directly)\n"
     "  --kernel box|cone|gauss|epanechnikov  radiance estimate kernel (default cone)\n"
     "  --light-samples N        shadow rays per area light per eye sample (default 1)\n"
-    "  --cache N                irradiance cache: a record every N pixels (default 8; 0: off)\n"
-    "  --cache-rays N           gather rays per cache record (default 256)\n"
+    "  --cache N                irradiance cache with gradients, records placed where none\n"
+    "                           reaches, asked for on pixel grids down to N apart\n"
+    "                           (default 2; 0: off)\n"
+    "  --cache-rays N           gather rays per cache record (default 1024)\n"
     "  --component all|direct|caustic|indirect|specular\n"
     "                           render one term of the split rendering equation\n"
     "  --caustic-cones on|off   aim caustic photons only at specular objects (default on)\n"
@@ -86,7 +94,7 @@ typedef struct ref_options {
     ps_shared_options c;
     double max_radius; /* 0: the radii */
     int64_t spp, k, gather, light_samples, cache, cache_rays;
-    int component, kernel;
+    int component, kernel, quality, filter;
     bool photons_only;
     bool cones, first_hit;
     const char *out_lux, *out_false; /* --illuminance, --false-color */
@@ -99,16 +107,17 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
     static const char *const on_off[] = {"off", "on", NULL};
     static const char *const components[] = {"all", "direct", "caustic", "indirect", "specular", NULL};
     static const char *const accels[] = {"auto", "octree", "brute", NULL};
+    static const char *const qualities[] = {"draft", "default", "final", NULL};
+    static const char *const filters[] = {"box", "mitchell", "gaussian", NULL};
     ps_cli cli = ps_cli_begin("photosplat-ref", argc, argv);
     memset(o, 0, sizeof *o);
     ps_shared_options_init(&o->c);
     o->cones = o->first_hit = true;
-    o->spp = REF_DEFAULT_SPP;
+    o->spp = o->gather = o->cache = o->cache_rays = REF_UNSET;
+    o->quality = PS_QUALITY_DEFAULT;
+    o->filter = PS_FILTER_MITCHELL;
     o->k = REF_DEFAULT_K;
-    o->gather = REF_DEFAULT_GATHER;
     o->light_samples = 1;
-    o->cache = REF_DEFAULT_CACHE;
-    o->cache_rays = REF_DEFAULT_CACHE_RAYS;
     o->kernel = PS_KERNEL_CONE;
     ps_status st = PS_OK;
     int choice;
@@ -134,6 +143,10 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
             st = ps_cli_int(&cli, 1, 100000, &o->light_samples, err);
         } else if (ps_cli_is(&cli, "--component")) {
             st = ps_cli_choice(&cli, components, &o->component, err);
+        } else if (ps_cli_is(&cli, "--quality")) {
+            st = ps_cli_choice(&cli, qualities, &o->quality, err);
+        } else if (ps_cli_is(&cli, "--filter")) {
+            st = ps_cli_choice(&cli, filters, &o->filter, err);
         } else if (ps_cli_is(&cli, "--kernel")) {
             st = ps_cli_choice(&cli, ps_kernel_names, &o->kernel, err);
         } else if (ps_cli_is(&cli, "--illuminance")) {
@@ -156,6 +169,15 @@ static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, p
     }
     if (st != PS_OK)
         return st;
+    ps_render_preset pre = ps_render_quality((ps_quality)o->quality);
+    if (o->spp == REF_UNSET)
+        o->spp = pre.spp;
+    if (o->gather == REF_UNSET)
+        o->gather = pre.gather;
+    if (o->cache == REF_UNSET)
+        o->cache = pre.cache_spacing;
+    if (o->cache_rays == REF_UNSET)
+        o->cache_rays = pre.cache_rays;
     if (!o->c.scene)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-ref: no scene given (see --help)");
     if (!o->photons_only && !o->c.out_png && !o->c.out_hdr && !o->out_lux && !o->out_false)
@@ -217,7 +239,8 @@ static void ref_run_free(ref_run *r)
 static ps_status render_illuminance(ref_run *r, const ps_render_maps *maps, ps_render_options *ro,
                                     ps_render_stats *stats, ps_error *err)
 {
-    ps_render_stats more = {0, 0.0, 0.0};
+    ps_render_stats more;
+    memset(&more, 0, sizeof more);
     ro->illuminance = true;
     ps_status st = ps_render(r->world, r->lights, maps, ro, &r->lux_image, &more, err);
     ro->illuminance = false;
@@ -262,6 +285,7 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
     ro.seed = (uint64_t)o->c.seed;
     ro.threads = ps_tracer_threads(r->tracer);
     ro.component = (ps_component)o->component;
+    ro.filter = (ps_filter)o->filter;
     ro.caustic.k = ro.global.k = (size_t)o->k;
     ro.caustic.kernel = ro.global.kernel = (ps_kernel)o->kernel;
     ro.caustic.max_radius = o->max_radius > 0.0 ? o->max_radius : radius[PS_MAP_CAUSTIC];
@@ -300,7 +324,8 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
         ro.progress = show_progress;
         ro.progress_user = &pr;
     }
-    ps_render_stats stats = {0, 0.0, 0.0};
+    ps_render_stats stats;
+    memset(&stats, 0, sizeof stats);
     if (st == PS_OK && (o->c.out_png || o->c.out_hdr))
         st = ps_render(r->world, r->lights, &maps, &ro, &r->image, &stats, err);
     if (st == PS_OK && (o->out_lux || o->out_false))
@@ -316,6 +341,9 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
     ps_stats_add(rs, "k", (double)ro.caustic.k);
     ps_stats_add(rs, "gather", ro.gather);
     ps_stats_add(rs, "cache", ro.cache_spacing);
+    ps_stats_add(rs, "cache_rays", ro.cache_rays);
+    ps_stats_add(rs, "cache_records", (double)stats.cache_records);
+    ps_stats_add(rs, "cache_seconds", stats.cache_seconds);
     ps_stats_add(rs, "caustic_radius", ro.caustic.max_radius);
     ps_stats_add(rs, "global_radius", ro.global.max_radius);
     return st;
@@ -440,15 +468,20 @@ int main(int argc, char **argv)
     ps_scene *scene;
     if (ps_scene_load(o.c.scene, NULL, &scene, &err) != PS_OK)
         return ps_cli_fail(&err);
-    /* Refuse what would not fit before tracing a photon. */
+    /* The preset's photon counts, where none were given. */
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
+    double factor = ps_render_quality((ps_quality)o.quality).photon_factor;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        if (o.c.photons[k] < 0)
+            o.c.photons[k] = (int64_t)llround(factor * (double)ps_shared_photons(&o.c, def, (ps_map_kind)k));
+    /* Refuse what would not fit before tracing a photon. */
     uint64_t photons = ps_shared_photons(&o.c, def, PS_MAP_CAUSTIC) + ps_shared_photons(&o.c, def, PS_MAP_GLOBAL);
     if (o.gather > 0 && !o.photons_only)
         photons += ps_shared_photons(&o.c, def, PS_MAP_GLOBAL); /* the map with direct hits */
     int width = o.photons_only ? 0 : o.c.width ? o.c.width : def->width;
     int height = o.photons_only ? 0 : o.c.height ? o.c.height : def->height;
     ps_status st = ps_check_run_memory("photosplat-ref", photons, PS_PHOTON_PLAN_BYTES, width, height,
-                                       REF_PIXEL_BYTES, &err);
+                                       REF_PIXEL_BYTES + (o.filter == PS_FILTER_BOX ? 0 : REF_FILTER_BYTES), &err);
     if (st == PS_OK)
         st = run(&o, scene, &err);
     ps_scene_destroy(scene);

@@ -8,7 +8,10 @@
  * irradiance, Christensen 1999, or the global map's estimate directly). Eye
  * rays that meet mirrors and glass first are followed (Fresnel) and all they
  * then see is the `specular` term. The four terms partition the image:
- * all = direct + caustic + indirect + specular. */
+ * all = direct + caustic + indirect + specular. An irradiance cache with
+ * gradients (irrcache.h) serves the diffuse indirect light wherever a path
+ * meets a diffuse surface, and a pixel filter (Mitchell, Gaussian or box)
+ * makes pixels from the eye samples. */
 #ifndef PS_RENDER_RENDER_H
 #define PS_RENDER_RENDER_H
 
@@ -33,6 +36,15 @@ typedef enum ps_component {
 
 const char *ps_component_name(ps_component c);
 
+/* How eye samples make pixels: the box (each pixel the mean of its own
+ * samples), or a wider filter as in pbrt (render.c). */
+typedef enum ps_filter { PS_FILTER_BOX, PS_FILTER_MITCHELL, PS_FILTER_GAUSSIAN, PS_FILTER_COUNT } ps_filter;
+
+const char *ps_filter_name(ps_filter f);
+/* The filter's 1-D profile at dx pixels from a pixel's centre (separable:
+ * a sample's weight is f(dx) f(dy)); 0 beyond its radius. */
+double ps_filter_eval(ps_filter f, double dx);
+
 /* Eye paths end after this many mirror/glass bounces. */
 #define PS_RENDER_MAX_SPECULAR 16
 /* Through the first this many glass surfaces an eye ray follows both the
@@ -41,8 +53,28 @@ const char *ps_component_name(ps_component c);
  * takes most of the noise out of glass for little cost. */
 #define PS_RENDER_SPLIT_DEPTH 2
 /* Cache records count where |x - x_i| / R_i + sqrt(1 - n.n_i) is below this
- * (Ward's a; the smaller, the more gathering where records do not reach). */
+ * (Ward's a; the smaller, the more records). */
 #define PS_RENDER_CACHE_ERROR 0.5
+/* A record's validity radius (the harmonic mean distance of what its rays
+ * met) is clamped to between MIN_PX times the finest grid's spacing and
+ * MAX_PX pixel footprints there: not so small that corners fill with records
+ * or that records leave holes between the grid's positions (it reaches
+ * a MIN_PX = 1.25 spacings), not so large that one record's noise spreads
+ * over a wall. */
+#define PS_RENDER_CACHE_MIN_PX 2.5
+#define PS_RENDER_CACHE_MAX_PX 48.0
+/* No record is made where its nearest hit is below this share of that floor
+ * (it stands on an edge; render.c). */
+#define PS_RENDER_CACHE_EDGE 0.05
+/* ... and, before that clamp, to this many times the nearest hit of its rays
+ * (with a = 0.5, a record then reaches no further than the nearest object). */
+#define PS_RENDER_CACHE_NEAREST 2.0
+/* A position asks for a record unless one has eps_i below this share of a:
+ * records overlap, so that every point between the positions is reached,
+ * and each point averages several records' noise. */
+#define PS_RENDER_CACHE_PLACE 0.5
+/* The coarsest grid of positions asking for records, in pixels. */
+#define PS_RENDER_CACHE_COARSE 64
 /* Mixed into the seed for the records' random numbers. */
 #define PS_RENDER_CACHE_KEY 0x6361636865ULL
 /* Final gather rays that meet mirrors or glass follow at most this many bounces. */
@@ -63,14 +95,17 @@ typedef struct ps_render_options {
     uint64_t seed;
     int threads;             /* >= 1 */
     ps_component component;
+    ps_filter filter;
     ps_estimate_options caustic, global;
     double irradiance_radius; /* how far a gather ray's hit may be from a precomputed irradiance */
-    /* An irradiance cache (Ward 1988) for the diffuse indirect term at the
-     * first surfaces eye rays meet: a record of cache_rays gather rays every
-     * cache_spacing pixels (0: none), made before the image, so it does not
-     * depend on the thread count, and interpolated between (without
-     * gradients) where the records are valid; elsewhere gathering as usual.
-     * It trades noise for smooth interpolation error and much less time. */
+    /* An irradiance cache (Ward 1988, with Ward & Heckbert's gradients;
+     * src/render/irrcache.h) for the diffuse indirect term wherever an eye
+     * path meets a diffuse surface, directly or through mirrors and glass:
+     * records of cache_rays gather rays, made before the image where eye
+     * paths through grids of pixel positions, PS_RENDER_CACHE_COARSE apart
+     * down to cache_spacing (0: no cache), find no record reaching; in a
+     * fixed order, so it does not depend on the thread count. Where no record
+     * reaches at render time, gathering as usual. */
     int cache_spacing;
     int cache_rays;
     /* Instead of radiance, the irradiance (W/m^2 per channel) arriving at the
@@ -89,9 +124,25 @@ typedef struct ps_render_options {
 
 typedef struct ps_render_stats {
     uint64_t rays;
+    size_t cache_records;
+    double cache_seconds; /* making the cache, part of seconds */
     double seconds;
     double fraction; /* of the tiles finished: 1 unless interrupted */
 } ps_render_stats;
+
+/* Quality presets: eye samples, gather rays, the cache's finest grid and
+ * rays a record, photons as a multiple of the scene's, and the pixel filter,
+ * set together (times and errors measured in docs/reference-renderer.md). */
+typedef enum ps_quality { PS_QUALITY_DRAFT, PS_QUALITY_DEFAULT, PS_QUALITY_FINAL, PS_QUALITY_COUNT } ps_quality;
+
+typedef struct ps_render_preset {
+    int spp, gather, cache_spacing, cache_rays;
+    double photon_factor;
+    ps_filter filter;
+} ps_render_preset;
+
+const char *ps_quality_name(ps_quality q);
+ps_render_preset ps_render_quality(ps_quality q);
 
 /* Renders the image into out (created here; the caller destroys it). Pixel
  * (x, y) depends only on (scene, maps, options, seed, x, y): the image is the
