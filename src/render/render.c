@@ -1,5 +1,6 @@
 /* render.c: eye rays, the split rendering equation, tiles on threads. */
 #include "render/render.h"
+#include "core/clock.h"
 #include "render/irrcache.h"
 
 #include <math.h>
@@ -857,13 +858,6 @@ static void *render_worker(void *arg)
     return NULL;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_render_maps *maps,
                     const ps_render_options *o, ps_image *out, ps_render_stats *stats, ps_error *err)
 {
@@ -871,7 +865,7 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     ps_status st = ps_image_create(o->width, o->height, out, err);
     if (st != PS_OK)
         return st;
-    double t0 = now();
+    double t0 = ps_now_seconds();
     render_job job;
     memset(&job, 0, sizeof job);
     job.world = w;
@@ -926,7 +920,7 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     bool indirect = o->component == PS_COMPONENT_ALL || o->component == PS_COMPONENT_INDIRECT ||
                     o->component == PS_COMPONENT_SPECULAR;
     st = PS_OK;
-    double t_cache = now();
+    double t_cache = ps_now_seconds();
     if (o->cache_spacing > 0 && o->cache_rays > 0 && o->gather > 0 && indirect && maps->irradiance && maps->full) {
         job.footprint = 2.0 * job.cam.tan_half_fov / o->height;
         st = ps_irrcache_create(ps_scene_bounds(s), PS_RENDER_CACHE_ERROR, &job.irr, err);
@@ -935,7 +929,7 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
         free(job.chunk);
         free(job.chunk_ok);
     }
-    t_cache = now() - t_cache;
+    t_cache = ps_now_seconds() - t_cache;
     if (st != PS_OK) {
         for (int i = 0; i < threads; i++) {
             free(wk[i].scratch);
@@ -961,7 +955,7 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
         stats->cache_records = job.irr ? ps_irrcache_count(job.irr) : 0;
         stats->cache_seconds = t_cache;
         stats->rays = atomic_load(&job.rays);
-        stats->seconds = now() - t0;
+        stats->seconds = ps_now_seconds() - t0;
         stats->fraction = (double)done / job.tiles;
     }
     ps_irrcache_destroy(job.irr);
