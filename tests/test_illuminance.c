@@ -5,6 +5,7 @@
  * reflectance rho (E = flux / (S (1 - rho))); direct within 1 %,
  * inter-reflected within 3 %. */
 #include "test.h"
+#include "render_rig.h"
 #include "analytic.h"
 
 #include <stdlib.h>
@@ -20,92 +21,9 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
-typedef struct rig {
-    ps_scene *scene;
-    ps_world *world;
-    ps_tracer *tracer, *full_tracer;
-    ps_light_sampler *ls;
-    ps_photon_map maps[PS_MAP_COUNT], full;
-    ps_kdtree *trees[PS_MAP_COUNT], *full_tree, *irr;
-} rig;
-
-/* Scene, both maps (and the full map with its irradiance when gathering). */
-static rig rig_make(const char *text, uint64_t caustic, uint64_t global, const ps_estimate_options *est, bool gather)
-{
-    rig r;
-    memset(&r, 0, sizeof r);
-    ps_error err;
-    if (ps_scene_load_text(text, "inline.scn", "", NULL, &r.scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    assert_int_equal(ps_world_create(r.scene, NULL, &r.world, &err), PS_OK);
-    ps_tracer_options o = ps_tracer_default_options();
-    o.seed = 3;
-    assert_int_equal(ps_tracer_create(r.world, &o, &r.tracer, &err), PS_OK);
-    assert_int_equal(ps_light_sampler_create(r.scene, &r.ls, &err), PS_OK);
-    uint64_t n[PS_MAP_COUNT] = {caustic, global};
-    for (int k = 0; k < PS_MAP_COUNT; k++) {
-        ps_photon_map_init(&r.maps[k], (ps_map_kind)k);
-        assert_int_equal(ps_tracer_trace(r.tracer, (ps_map_kind)k, 0, n[k], n[k], &r.maps[k], &err), PS_OK);
-        assert_int_equal(ps_kdtree_build(r.maps[k].photons, r.maps[k].count, &r.trees[k], &err), PS_OK);
-    }
-    ps_photon_map_init(&r.full, PS_MAP_GLOBAL);
-    if (gather) {
-        o.global_direct = true;
-        assert_int_equal(ps_tracer_create(r.world, &o, &r.full_tracer, &err), PS_OK);
-        assert_int_equal(ps_tracer_trace(r.full_tracer, PS_MAP_GLOBAL, 0, global, global, &r.full, &err), PS_OK);
-        assert_int_equal(ps_kdtree_build(r.full.photons, r.full.count, &r.full_tree, &err), PS_OK);
-        assert_int_equal(ps_irradiance_precompute(r.full_tree, est, 4, 2, &r.irr, &err), PS_OK);
-    }
-    return r;
-}
-
-static void rig_free(rig *r)
-{
-    for (int k = 0; k < PS_MAP_COUNT; k++) {
-        ps_photon_map_free(&r->maps[k]);
-        ps_kdtree_destroy(r->trees[k]);
-    }
-    ps_photon_map_free(&r->full);
-    ps_kdtree_destroy(r->full_tree);
-    ps_kdtree_destroy(r->irr);
-    ps_light_sampler_destroy(r->ls);
-    ps_tracer_destroy(r->full_tracer);
-    ps_tracer_destroy(r->tracer);
-    ps_world_destroy(r->world);
-    ps_scene_destroy(r->scene);
-}
-
-static ps_render_options options(int w, int h, int spp, ps_component c, const ps_estimate_options *est, int gather)
-{
-    ps_render_options o;
-    memset(&o, 0, sizeof o);
-    o.width = w;
-    o.height = h;
-    o.spp = spp;
-    o.light_samples = 1;
-    o.gather = gather;
-    o.seed = 5;
-    o.threads = 2;
-    o.component = c;
-    o.caustic = o.global = *est;
-    o.irradiance_radius = est->max_radius;
-    return o;
-}
-
-static ps_image render(rig *r, const ps_render_options *o)
-{
-    ps_render_maps maps = {r->trees[PS_MAP_CAUSTIC], r->trees[PS_MAP_GLOBAL], r->full_tree, r->irr};
-    ps_image img;
-    ps_error err;
-    ps_render_stats st;
-    if (ps_render(r->world, r->ls, &maps, o, &img, &st, &err) != PS_OK)
-        fail_msg("render: %s", err.msg);
-    assert_true(st.rays > 0);
-    return img;
-}
 
 /* The lux image (683 Y of the irradiance) of the options' component. */
-static ps_image render_lux(rig *r, ps_render_options *o)
+static ps_image render_lux(render_rig *r, ps_render_options *o)
 {
     o->illuminance = true;
     ps_image img = render(r, o);
@@ -142,7 +60,7 @@ static void point_candela_on_plane(void **state)
                  "light point position 0.3 1 -0.2 candela 100 color 1 0.8 0.5\n",
                  albedo[a], albedo[a], albedo[a]);
         ps_estimate_options est = {50, 0.05, PS_KERNEL_BOX};
-        rig r = rig_make(text, 0, 0, &est, false);
+        render_rig r = render_rig_make(text, 0, 0, &est, false);
         ps_render_options o = options(32, 32, 16, PS_COMPONENT_DIRECT, &est, 0);
         ps_image img = render_lux(&r, &o);
         ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(r.scene), o.width, o.height);
@@ -173,7 +91,7 @@ static void point_candela_on_plane(void **state)
             ps_image_destroy(&img);
             ps_image_destroy(&first);
         }
-        rig_free(&r);
+        render_rig_free(&r);
     }
 }
 
@@ -212,7 +130,7 @@ static void ies_at_points(void **state)
                  "light ies %s position 0 %g 0 color 1 1 1\n",
                  px, pz, px, pz, path, h);
         ps_estimate_options est = {50, 0.05, PS_KERNEL_BOX};
-        rig r = rig_make(text, 0, 0, &est, false);
+        render_rig r = render_rig_make(text, 0, 0, &est, false);
         ps_render_options o = options(2, 2, 1, PS_COMPONENT_DIRECT, &est, 0);
         ps_image img = render_lux(&r, &o);
         double d2 = h * h + dist * dist, expect = points[k].candela * cos(t) / d2;
@@ -220,7 +138,7 @@ static void ies_at_points(void **state)
                image_mean(&img), expect);
         assert_near(image_mean(&img), expect, 0.01 * expect);
         ps_image_destroy(&img);
-        rig_free(&r);
+        render_rig_free(&r);
     }
 }
 
@@ -246,7 +164,7 @@ static void caustic_from_mirror(void **state)
                  "quad corner -0.5 2 -0.5 edge1 1 0 0 edge2 0 0 1 material mirror\n%s\n",
                  lights[k]);
         ps_estimate_options est = {400, 0.15, PS_KERNEL_BOX};
-        rig r = rig_make(text, 1000000, 0, &est, false);
+        render_rig r = render_rig_make(text, 1000000, 0, &est, false);
         ps_render_options o = options(24, 24, 4, PS_COMPONENT_CAUSTIC, &est, 0);
         ps_image img = render_lux(&r, &o);
         ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(r.scene), o.width, o.height);
@@ -278,7 +196,7 @@ static void caustic_from_mirror(void **state)
         assert_true(n > 30);
         assert_true(worst < 0.03);
         ps_image_destroy(&img);
-        rig_free(&r);
+        render_rig_free(&r);
     }
 }
 
@@ -292,7 +210,7 @@ static void disc_on_axis(void **state)
                        "quad corner -50 0 50 edge1 100 0 0 edge2 0 0 -100 material floor\n"
                        "light disc center 0 1 0 normal 0 -1 0 radius 0.3 lumens 1000\n";
     ps_estimate_options est = {50, 0.05, PS_KERNEL_BOX};
-    rig r = rig_make(text, 0, 0, &est, false);
+    render_rig r = render_rig_make(text, 0, 0, &est, false);
     ps_render_options o = options(8, 8, 16, PS_COMPONENT_DIRECT, &est, 0);
     o.light_samples = 16;
     ps_image img = render_lux(&r, &o);
@@ -300,7 +218,7 @@ static void disc_on_axis(void **state)
     printf("disc on its axis: %.4f lx, closed form %.4f lx\n", image_mean(&img), expect);
     assert_near(image_mean(&img), expect, 0.01 * expect);
     ps_image_destroy(&img);
-    rig_free(&r);
+    render_rig_free(&r);
 }
 
 /* A closed room of reflectance rho = 0.5 (a sphere of radius 1) lit by 1000 lm
@@ -315,7 +233,7 @@ static void closed_room(void **state)
                        "sphere center 0 0 0 radius 1 material wall\n"
                        "light point position 0 0 0 lumens 1000\n";
     ps_estimate_options est = {200, 0.3, PS_KERNEL_BOX};
-    rig r = rig_make(text, 0, 200000, &est, true);
+    render_rig r = render_rig_make(text, 0, 200000, &est, true);
     double S = 4 * PS_PI, direct = 1000.0 / S, all = 1000.0 / (S * (1 - 0.5));
     ps_render_options o = options(16, 16, 4, PS_COMPONENT_DIRECT, &est, 16);
     ps_image img = render_lux(&r, &o);
@@ -335,7 +253,7 @@ static void closed_room(void **state)
         assert_near(image_mean(&img), all, 0.03 * all);
         ps_image_destroy(&img);
     }
-    rig_free(&r);
+    render_rig_free(&r);
 }
 
 /* A closed cubic room (side 2, S = 24 m^2) of reflectance 0.5 with 1000 lm
@@ -362,7 +280,7 @@ static void closed_box_room(void **state)
     for (int v = 0; v < 6; v++) {
         char text[2048];
         snprintf(text, sizeof text, "camera eye 0 0 0 target %s fov 90\n%s", views[v], room);
-        rig r = rig_make(text, 0, 40000, &est, true);
+        render_rig r = render_rig_make(text, 0, 40000, &est, true);
         ps_render_options o = options(12, 12, 4, PS_COMPONENT_DIRECT, &est, 16);
         ps_image img = render_lux(&r, &o);
         direct += image_mean(&img) / 6;
@@ -373,7 +291,7 @@ static void closed_box_room(void **state)
         img = render_lux(&r, &o);
         all += image_mean(&img) / 6;
         ps_image_destroy(&img);
-        rig_free(&r);
+        render_rig_free(&r);
     }
     double S = 24.0;
     printf("closed box room: direct %.3f lx (F / S = %.3f), all %.3f lx (F / (S (1 - rho)) = %.3f)\n", direct,

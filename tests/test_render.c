@@ -3,6 +3,7 @@
  * components add up to the whole; thread counts never change the image. */
 #include "test.h"
 #include "analytic.h"
+#include "render_rig.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -18,78 +19,6 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
-typedef struct rig {
-    ps_scene *scene;
-    ps_world *world;
-    ps_tracer *tracer, *full_tracer;
-    ps_light_sampler *ls;
-    ps_photon_map maps[PS_MAP_COUNT], full;
-    ps_kdtree *trees[PS_MAP_COUNT], *full_tree, *irr;
-} rig;
-
-/* Scene, both maps (and the full map with its irradiance when gathering). */
-static rig rig_make(const char *text, uint64_t caustic, uint64_t global, const ps_estimate_options *est, bool gather)
-{
-    rig r;
-    memset(&r, 0, sizeof r);
-    ps_error err;
-    if (ps_scene_load_text(text, "inline.scn", "", NULL, &r.scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    assert_int_equal(ps_world_create(r.scene, NULL, &r.world, &err), PS_OK);
-    ps_tracer_options o = ps_tracer_default_options();
-    o.seed = 3;
-    assert_int_equal(ps_tracer_create(r.world, &o, &r.tracer, &err), PS_OK);
-    assert_int_equal(ps_light_sampler_create(r.scene, &r.ls, &err), PS_OK);
-    uint64_t n[PS_MAP_COUNT] = {caustic, global};
-    for (int k = 0; k < PS_MAP_COUNT; k++) {
-        ps_photon_map_init(&r.maps[k], (ps_map_kind)k);
-        assert_int_equal(ps_tracer_trace(r.tracer, (ps_map_kind)k, 0, n[k], n[k], &r.maps[k], &err), PS_OK);
-        assert_int_equal(ps_kdtree_build(r.maps[k].photons, r.maps[k].count, &r.trees[k], &err), PS_OK);
-    }
-    ps_photon_map_init(&r.full, PS_MAP_GLOBAL);
-    if (gather) {
-        o.global_direct = true;
-        assert_int_equal(ps_tracer_create(r.world, &o, &r.full_tracer, &err), PS_OK);
-        assert_int_equal(ps_tracer_trace(r.full_tracer, PS_MAP_GLOBAL, 0, global, global, &r.full, &err), PS_OK);
-        assert_int_equal(ps_kdtree_build(r.full.photons, r.full.count, &r.full_tree, &err), PS_OK);
-        assert_int_equal(ps_irradiance_precompute(r.full_tree, est, 4, 2, &r.irr, &err), PS_OK);
-    }
-    return r;
-}
-
-static void rig_free(rig *r)
-{
-    for (int k = 0; k < PS_MAP_COUNT; k++) {
-        ps_photon_map_free(&r->maps[k]);
-        ps_kdtree_destroy(r->trees[k]);
-    }
-    ps_photon_map_free(&r->full);
-    ps_kdtree_destroy(r->full_tree);
-    ps_kdtree_destroy(r->irr);
-    ps_light_sampler_destroy(r->ls);
-    ps_tracer_destroy(r->full_tracer);
-    ps_tracer_destroy(r->tracer);
-    ps_world_destroy(r->world);
-    ps_scene_destroy(r->scene);
-}
-
-static ps_render_options options(int w, int h, int spp, ps_component c, const ps_estimate_options *est, int gather)
-{
-    ps_render_options o;
-    memset(&o, 0, sizeof o);
-    o.width = w;
-    o.height = h;
-    o.spp = spp;
-    o.light_samples = 1;
-    o.gather = gather;
-    o.seed = 5;
-    o.threads = 2;
-    o.component = c;
-    o.caustic = o.global = *est;
-    o.irradiance_radius = est->max_radius;
-    return o;
-}
-
 /* The options a quality preset sets (as photosplat-ref applies them). */
 static void apply_preset(ps_render_options *o, ps_quality q)
 {
@@ -99,18 +28,6 @@ static void apply_preset(ps_render_options *o, ps_quality q)
     o->cache_spacing = o->gather ? p.cache_spacing : 0;
     o->cache_rays = p.cache_rays;
     o->filter = p.filter;
-}
-
-static ps_image render(rig *r, const ps_render_options *o)
-{
-    ps_render_maps maps = {r->trees[PS_MAP_CAUSTIC], r->trees[PS_MAP_GLOBAL], r->full_tree, r->irr};
-    ps_image img;
-    ps_error err;
-    ps_render_stats st;
-    if (ps_render(r->world, r->ls, &maps, o, &img, &st, &err) != PS_OK)
-        fail_msg("render: %s", err.msg);
-    assert_true(st.rays > 0);
-    return img;
 }
 
 static double image_mean(const ps_image *img, int channel)
@@ -132,7 +49,7 @@ static void direct_on_plane(void **state)
                        "quad corner -50 0 50 edge1 100 0 0 edge2 0 0 -100 material floor\n"
                        "light point position 0.3 1 -0.2 power 100 100 100\n";
     ps_estimate_options est = {50, 0.05, PS_KERNEL_BOX};
-    rig r = rig_make(text, 0, 0, &est, false);
+    render_rig r = render_rig_make(text, 0, 0, &est, false);
     /* The box filter, then every preset (with its Mitchell filter). */
     for (int q = -1; q < PS_QUALITY_COUNT; q++) {
     ps_render_options o = options(48, 48, 16, PS_COMPONENT_DIRECT, &est, 0);
@@ -172,7 +89,7 @@ static void direct_on_plane(void **state)
     assert_true(worst < tolerance);
     ps_image_destroy(&img);
     }
-    rig_free(&r);
+    render_rig_free(&r);
 }
 
 /* A disc light of radius R = 0.3 at height h = 1 over a diffuse floor: on its
@@ -188,7 +105,7 @@ static void disc_light(void **state)
                        "quad corner -50 0 50 edge1 100 0 0 edge2 0 0 -100 material floor\n"
                        "light disc center 0 1 0 normal 0 -1 0 radius 0.3 power 100 100 100\n";
     ps_estimate_options est = {50, 0.05, PS_KERNEL_BOX};
-    rig r = rig_make(text, 0, 0, &est, false);
+    render_rig r = render_rig_make(text, 0, 0, &est, false);
     ps_render_options o = options(8, 8, 16, PS_COMPONENT_ALL, &est, 0);
     o.light_samples = 16;
     ps_image img = render(&r, &o);
@@ -197,14 +114,14 @@ static void disc_light(void **state)
     printf("disc light: floor radiance %.5f, analytic %.5f\n", image_mean(&img, 1), expect);
     assert_near(image_mean(&img, 1), expect, 0.01 * expect);
     ps_image_destroy(&img);
-    rig_free(&r);
+    render_rig_free(&r);
 
     /* Looking up at it from 0.5 below: every pixel sees the disc. */
     const char *below = "camera eye 0 0.5 0 target 0 1 0 up 0 0 -1 fov 10\n"
                         "material floor diffuse albedo 0.5 0.5 0.5\n"
                         "quad corner -50 0 50 edge1 100 0 0 edge2 0 0 -100 material floor\n"
                         "light disc center 0 1 0 normal 0 -1 0 radius 0.3 power 100 100 100\n";
-    r = rig_make(below, 0, 0, &est, false);
+    r = render_rig_make(below, 0, 0, &est, false);
     for (int c = 0; c < 2; c++) {
         o = options(4, 4, 1, c ? PS_COMPONENT_DIRECT : PS_COMPONENT_INDIRECT, &est, 0);
         img = render(&r, &o);
@@ -213,7 +130,7 @@ static void disc_light(void **state)
                 assert_near(ps_image_at(&img, x, y)[0], c ? le : 0.0, 1e-5 * le);
         ps_image_destroy(&img);
     }
-    rig_free(&r);
+    render_rig_free(&r);
 }
 
 /* Inside a closed sphere of radius 1 and albedo 0.5 with a point light of
@@ -228,7 +145,7 @@ static void furnace_sphere(void **state)
                        "sphere center 0 0 0 radius 1 material wall\n"
                        "light point position 0 0 0 power 39.47841760435743 39.47841760435743 39.47841760435743\n";
     ps_estimate_options est = {200, 0.3, PS_KERNEL_BOX};
-    rig r = rig_make(text, 0, 200000, &est, true);
+    render_rig r = render_rig_make(text, 0, 200000, &est, true);
     /* Final gathering, the global map directly, and final gathering through
      * the irradiance cache (a record every 3 pixels). */
     int gathers[3] = {16, 0, 16}, spacing[3] = {0, 0, 3};
@@ -270,7 +187,7 @@ static void furnace_sphere(void **state)
         assert_true(lo > 0.95 && hi < 1.05);
         ps_image_destroy(&img);
     }
-    rig_free(&r);
+    render_rig_free(&r);
 }
 
 /* A small glossy quad (albedo 0, specular 0.5, exponent 4) inside the
@@ -288,7 +205,7 @@ static void glossy_in_furnace(void **state)
                        "quad corner -0.005 -0.005 0.5 edge1 0.01 0 0 edge2 0 0.01 0 material gloss\n"
                        "light point position 0 0 0 power 39.47841760435743 39.47841760435743 39.47841760435743\n";
     ps_estimate_options est = {100, 0.3, PS_KERNEL_BOX};
-    rig r = rig_make(text, 0, 200000, &est, true);
+    render_rig r = render_rig_make(text, 0, 200000, &est, true);
     ps_render_options o = options(4, 4, 16, PS_COMPONENT_ALL, &est, 64);
     ps_image img = render(&r, &o);
     printf("glossy quad in the furnace: radiance %.4f, expected 0.5\n", image_mean(&img, 1));
@@ -298,7 +215,7 @@ static void glossy_in_furnace(void **state)
     img = render(&r, &o);
     assert_true(image_mean(&img, 1) == 0.0);
     ps_image_destroy(&img);
-    rig_free(&r);
+    render_rig_free(&r);
 }
 
 /* The caustic of a mirror quad on the floor: the light of the mirror image of
@@ -318,7 +235,7 @@ static void mirror_caustic_image(void **state)
      * (a multiple of 5 10^5) and filter. */
     for (int q = -1; q < PS_QUALITY_COUNT; q++) {
     double factor = q < 0 ? 2.0 : ps_render_quality((ps_quality)q).photon_factor;
-    rig r = rig_make(text, (uint64_t)(500000 * factor), 0, &est, false);
+    render_rig r = render_rig_make(text, (uint64_t)(500000 * factor), 0, &est, false);
     ps_render_options o = options(32, 32, 4, PS_COMPONENT_CAUSTIC, &est, 0);
     if (q >= 0)
         apply_preset(&o, (ps_quality)q);
@@ -346,7 +263,7 @@ static void mirror_caustic_image(void **state)
     assert_true(n > 100);
     assert_true(worst < 0.03);
     ps_image_destroy(&img);
-    rig_free(&r);
+    render_rig_free(&r);
     }
 }
 
@@ -371,7 +288,7 @@ static void components_add_up(void **state)
                        "sphere center -0.45 0.35 -0.4 radius 0.35 material mirror\n"
                        "light quad corner -0.25 1.999 -0.25 edge1 0.5 0 0 edge2 0 0 0.5 power 100 100 100\n";
     ps_estimate_options est = {50, 0.1, PS_KERNEL_CONE};
-    rig r = rig_make(text, 20000, 20000, &est, true);
+    render_rig r = render_rig_make(text, 20000, 20000, &est, true);
     ps_image parts[PS_COMPONENT_COUNT];
     for (int c = 0; c < PS_COMPONENT_COUNT; c++) {
         ps_render_options o = options(24, 24, 2, (ps_component)c, &est, 4);
@@ -405,7 +322,7 @@ static void components_add_up(void **state)
     ps_image_destroy(&one);
     for (int c = 0; c < PS_COMPONENT_COUNT; c++)
         ps_image_destroy(&parts[c]);
-    rig_free(&r);
+    render_rig_free(&r);
 }
 
 /* A mirror quad reflecting an evenly lit diffuse floor shows it with the
@@ -416,7 +333,7 @@ static void components_add_up(void **state)
  * indirectly) is seen through the mirror from one eye, and directly, in a
  * scene without the mirror, from that eye's mirror image: the same region.
  * Noise: the rms difference of two renders of another seed, over sqrt 2. */
-static double seed_noise(rig *r, ps_render_options o, double *mean)
+static double seed_noise(render_rig *r, ps_render_options o, double *mean)
 {
     ps_image a = render(r, &o);
     o.seed += 1;
@@ -449,12 +366,12 @@ static void mirror_shows_floor_noise(void **state)
     double mean[2], noise[2];
     const char *texts[2] = {mirrored, direct};
     for (int i = 0; i < 2; i++) {
-        rig r = rig_make(texts[i], 0, 100000, &est, true);
+        render_rig r = render_rig_make(texts[i], 0, 100000, &est, true);
         ps_render_options o = options(24, 24, 4, PS_COMPONENT_ALL, &est, 16);
         o.cache_spacing = 2;
         o.cache_rays = 256;
         noise[i] = seed_noise(&r, o, &mean[i]);
-        rig_free(&r);
+        render_rig_free(&r);
     }
     printf("floor through a mirror: mean %.4f, noise %.4f; seen directly: mean %.4f, noise %.4f (ratio %.2f)\n", mean[0],
            noise[0], mean[1], noise[1], noise[0] / noise[1]);
@@ -546,7 +463,7 @@ static void cancelled_render(void **state)
                        "quad corner -50 0 50 edge1 100 0 0 edge2 0 0 -100\n"
                        "light point position 0 1 0 power 100 100 100\n";
     ps_estimate_options est = {50, 0.05, PS_KERNEL_BOX};
-    rig r = rig_make(text, 0, 0, &est, false);
+    render_rig r = render_rig_make(text, 0, 0, &est, false);
     ps_render_options o = options(40, 40, 1, PS_COMPONENT_DIRECT, &est, 0);
     ps_cancel_flag flag = 2; /* as a SIGINT handler leaves it */
     o.cancel = &flag;
@@ -562,7 +479,7 @@ static void cancelled_render(void **state)
     assert_int_equal(ps_render(r.world, r.ls, &maps, &o, &img, &st, &err), PS_OK);
     assert_near(st.fraction, 1.0, 0.0);
     ps_image_destroy(&img);
-    rig_free(&r);
+    render_rig_free(&r);
 }
 
 int main(void)
