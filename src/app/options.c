@@ -101,6 +101,15 @@ ps_status ps_write_illuminance(const char *out_lux, const char *out_false, const
     return st;
 }
 
+void ps_print_run_end(const ps_skip *skips, size_t skip_count, const char *const *paths, size_t path_count)
+{
+    for (size_t k = 0; k < skip_count; k++)
+        printf("skipped %s: %s\n", skips[k].pass, skips[k].reason);
+    for (size_t k = 0; k < path_count; k++)
+        if (paths[k])
+            printf("wrote %s\n", paths[k]);
+}
+
 ps_status ps_check_outputs(const ps_shared_options *o, ps_error *err)
 {
     const char *paths[] = {o->out_png, o->out_hdr, o->stats, o->dump};

@@ -70,6 +70,10 @@ ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_
 ps_status ps_write_illuminance(const char *out_lux, const char *out_false, const ps_image *irradiance,
                                const char *prog, ps_error *err);
 
+/* What a run tells on stdout at its end: each skipped stage ("skipped PASS:
+ * REASON") and each file written ("wrote PATH", NULL paths left out). */
+void ps_print_run_end(const ps_skip *skips, size_t skip_count, const char *const *paths, size_t path_count);
+
 /* --dump-photons: every photon of both maps, written whole or not at all. */
 ps_status ps_write_photon_dump(const char *path, const ps_photon_map maps[PS_MAP_COUNT], ps_error *err);
 

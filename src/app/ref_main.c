@@ -250,22 +250,6 @@ static ps_status render_illuminance(ref_run *r, const ps_render_maps *maps, ps_r
     return st;
 }
 
-/* --illuminance and --false-color from the irradiance image, in lux. */
-static ps_status write_illuminance(const ref_options *o, const ps_image *irr, ps_error *err)
-{
-    size_t n = (size_t)irr->width * (size_t)irr->height;
-    float *lux = malloc(n * sizeof *lux);
-    if (!lux)
-        return ps_error_set(err, PS_ERR_NOMEM, "photosplat-ref: out of memory for the illuminance image");
-    ps_lux_from_irradiance(irr, lux);
-    ps_status st = PS_OK;
-    if (o->out_lux)
-        st = ps_gray_write(lux, irr->width, irr->height, o->out_lux, err);
-    if (st == PS_OK && o->out_false)
-        st = ps_falsecolor_write(lux, irr->width, irr->height, o->out_false, err);
-    free(lux);
-    return st;
-}
 
 /* What the image needs beyond the two maps: the kd-trees, and for final
  * gathering a global map with the direct hits and its precomputed irradiance. */
@@ -422,7 +406,7 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
     if (st == PS_OK && !o->photons_only && o->c.out_hdr)
         st = ps_hdr_write(&r.image, o->c.out_hdr, err);
     if (st == PS_OK && !o->photons_only && (o->out_lux || o->out_false))
-        st = write_illuminance(o, &r.lux_image, err);
+        st = ps_write_illuminance(o->out_lux, o->out_false, &r.lux_image, "photosplat-ref", err);
     if (st == PS_OK && !o->photons_only && o->c.out_png)
         st = ps_png_write(&r.image, o->c.out_png, (float)o->c.exposure, err);
     if (st == PS_OK && o->c.dump)
@@ -434,16 +418,8 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
                "(%d threads)\n",
                (unsigned long long)rs.emitted[0], (unsigned long long)rs.stored[0], (unsigned long long)rs.emitted[1],
                (unsigned long long)rs.stored[1], t_trace, (unsigned long long)rs.rays, ps_tracer_threads(r.tracer));
-        for (size_t k = 0; k < rs.skip_count; k++)
-            printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
-        if (o->c.out_png)
-            printf("wrote %s\n", o->c.out_png);
-        if (o->c.out_hdr)
-            printf("wrote %s\n", o->c.out_hdr);
-        if (o->out_lux)
-            printf("wrote %s\n", o->out_lux);
-        if (o->out_false)
-            printf("wrote %s\n", o->out_false);
+        const char *const written[] = {o->c.out_png, o->c.out_hdr, o->out_lux, o->out_false};
+        ps_print_run_end(rs.skips, rs.skip_count, written, sizeof written / sizeof written[0]);
     }
     ref_run_free(&r);
     return st;

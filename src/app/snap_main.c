@@ -442,16 +442,8 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
         printf("error counter: stopped shooting at %llu photons: %.1f %% of a refresh's splat energy rounded "
                "away in the 8-bit buffer (threshold %.1f %%)\n",
                (unsigned long long)counter_at, 100.0 * s->frame.round_off, 100.0 * o->p.counter_threshold);
-    for (size_t k = 0; k < rs.skip_count; k++)
-        printf("skipped %s: %s\n", rs.skips[k].pass, rs.skips[k].reason);
-    if (o->c.out_png)
-        printf("wrote %s\n", o->c.out_png);
-    if (o->c.out_hdr)
-        printf("wrote %s\n", o->c.out_hdr);
-    if (o->out_lux)
-        printf("wrote %s\n", o->out_lux);
-    if (o->out_false)
-        printf("wrote %s\n", o->out_false);
+    const char *const written[] = {o->c.out_png, o->c.out_hdr, o->out_lux, o->out_false};
+    ps_print_run_end(rs.skips, rs.skip_count, written, sizeof written / sizeof written[0]);
     return PS_OK;
 }
 
