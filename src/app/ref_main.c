@@ -17,7 +17,6 @@
 #include "photon/tracer.h"
 #include "photon/world.h"
 #include "image/exr_io.h"
-#include "image/falsecolor.h"
 #include "render/render.h"
 #include "scene/scene.h"
 
