@@ -388,6 +388,11 @@ static ps_status show_false_color(app *a, const double gains[PS_MAP_COUNT], ps_e
 static void set_false_color(app *a, bool on)
 {
     ps_error err;
+    if (on && !ps_session_get_settings(a->session)->float_buffer) {
+        /* 8-bit layers would clip the irradiance (E / pi at exposure 1). */
+        say(a, "false colour needs float layers (--color-depth float, the default)");
+        return;
+    }
     if (ps_session_set_illuminance(a->session, on, &err) != PS_OK) {
         say(a, err.msg);
         return;
