@@ -94,6 +94,14 @@ expect_success "progressive" "$snap" "$scene" --size 32x32 --time 0.6 --tau 0.1 
 frames=$(sed -n 's/.*"frames": \([0-9]*\).*/\1/p' "$cli_tmp/p.json")
 awk_true "$frames >= 2" && ok || bad "progressive mode refreshed $frames times in 0.6 s at tau 0.1"
 grep -q '"first_frame_seconds":' "$cli_tmp/p.json" && ok || bad "no first_frame_seconds"
+# Progressive in float draws only new photons into layers kept between
+# refreshes (as the window): at the caps the same picture as drawing them all
+# at once, but for the order of float additions.
+expect_success "progressive float" "$snap" "$scene" "${small[@]}" --color-depth float --time 30 --tau 0.05 \
+    --hdr "$cli_tmp/pf.pfm" --stats "$cli_tmp/pf.json"
+expect_success "fixed float" "$snap" "$scene" "${small[@]}" --color-depth float --hdr "$cli_tmp/ff.pfm"
+rel=$("$bin/photosplat-compare" "$cli_tmp/pf.pfm" "$cli_tmp/ff.pfm" | sed -n 's/.*relmse=\([^ ]*\).*/\1/p')
+awk_true "$rel < 1e-8" && ok || bad "progressive float layers differ from one whole frame: relMSE $rel"
 
 # The precision stress: a caustic of many faint photons, with an exposure
 # that keeps each photon under half a code of the 8-bit buffer, in every

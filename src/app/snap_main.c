@@ -68,6 +68,10 @@ static const char usage[] =
     "  --checkpoint-prefix P    where checkpoints go (needed with --checkpoints)\n"
     "  --help                   this text\n";
 
+/* Progressive float refreshes may give this share of tau to new splats:
+ * snap shows nothing between them (the window leaves room to show). */
+#define SNAP_SPLAT_SHARE 0.9
+
 /* Enough checkpoints for a log-spaced curve from milliseconds to hours. */
 #define SNAP_MAX_CHECKPOINTS 64
 
@@ -141,22 +145,34 @@ typedef struct snap_run {
     ps_session *session;
     ps_gl_renderer *gl;
     ps_platform *platform;
+    /* Progressive with a float buffer: layers kept between refreshes, each
+     * refresh adding only the photons that arrived (session.h, incremental),
+     * as the window does. NULL: every refresh draws a whole frame into the
+     * colour buffer (8 bits, or a fixed photon count). */
+    ps_gl_layers *layers;
     ps_camera_frame cam;
     ps_session_frame frame; /* the last refresh's */
-    uint64_t frames;
+    uint64_t frames, splats; /* refreshes; splats drawn in all (layers) */
     double draw_seconds;
 } snap_run;
 
-/* One refresh: the session's splats of everything that has arrived, drawn
- * over the scene into the colour buffer. */
+/* One refresh: what the session says, drawn into the layers (the new
+ * photons) or over the scene into the colour buffer (all of them). */
 static ps_status refresh(snap_run *s, ps_error *err)
 {
     ps_status st = ps_session_refresh(s->session, &s->cam, &s->frame, err);
     if (st != PS_OK)
         return st;
     double t0 = ps_now_seconds();
-    ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+    if (s->layers) {
+        ps_gl_layers_draw(s->layers, s->gl, &s->cam, &s->frame);
+        if (s->frame.splats > 0)
+            ps_gl_finish(); /* llvmpipe draws when flushed: time the drawing, not the queueing */
+    } else {
+        ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+    }
     double spent = ps_now_seconds() - t0;
+    s->splats += s->frame.splats;
     s->draw_seconds += spent;
     s->frames++;
     ps_session_drawn(s->session, spent);
@@ -172,10 +188,32 @@ static void to_radiance(const snap_run *s, ps_image *img)
         img->rgb[i] *= inv;
 }
 
+/* The picture as shown, radiance times exposure: the layers' composite with
+ * the refresh's gains, or the colour buffer. direct, map[]: which layers. */
+static ps_status read_picture(snap_run *s, bool direct, const bool map[PS_MAP_COUNT], ps_image *img, ps_error *err)
+{
+    if (!s->layers)
+        return ps_platform_read(s->platform, img, err);
+    double gains[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        gains[k] = map[k] ? s->frame.map[k].gain : 0.0;
+    return ps_gl_layers_composite(s->layers, direct ? s->frame.direct_gain : 0.0, gains, img, err);
+}
+
+static const bool every_map[PS_MAP_COUNT] = {true, true};
+
+/* After a layer alone was drawn into the colour buffer: the whole frame
+ * again (the layers' composite is read without drawing anything). */
+static void redraw_frame(snap_run *s)
+{
+    if (!s->layers)
+        ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+}
+
 static ps_status write_radiance(snap_run *s, const char *path, ps_error *err)
 {
     ps_image img;
-    ps_status st = ps_platform_read(s->platform, &img, err);
+    ps_status st = read_picture(s, true, every_map, &img, err);
     if (st == PS_OK) {
         to_radiance(s, &img);
         st = ps_pfm_write(&img, path, err);
@@ -197,10 +235,21 @@ static ps_status write_layers(snap_run *s, const char *prefix, ps_error *err)
         /* layer -1: the direct light alone, no splats. */
         if (snprintf(path, sizeof path, "%s-%s.pfm", prefix, layer < 0 ? "direct" : names[layer]) >= (int)sizeof path)
             return ps_error_set(err, PS_ERR_IO, "%s: path too long", prefix);
-        ps_gl_begin_frame(s->gl, &s->cam, f->direct_exposure, layer < 0 && f->direct);
-        if (layer >= 0)
-            ps_gl_draw_splats(s->gl, f->map[layer].batch, f->splat, f->map[layer].radius, f->point_size);
-        st = write_radiance(s, path, err);
+        ps_image img;
+        if (s->layers) {
+            bool map[PS_MAP_COUNT] = {layer == 0, layer == 1};
+            st = read_picture(s, layer < 0, map, &img, err);
+        } else {
+            ps_gl_begin_frame(s->gl, &s->cam, f->direct_exposure, layer < 0 && f->direct);
+            if (layer >= 0)
+                ps_gl_draw_splats(s->gl, f->map[layer].batch, f->splat, f->map[layer].radius, f->point_size);
+            st = ps_platform_read(s->platform, &img, err);
+        }
+        if (st == PS_OK) {
+            to_radiance(s, &img);
+            st = ps_pfm_write(&img, path, err);
+        }
+        ps_image_destroy(&img);
     }
     return st;
 }
@@ -209,7 +258,7 @@ static ps_status write_outputs(snap_run *s, ps_error *err)
 {
     const snap_options *o = s->o;
     ps_image img;
-    ps_status st = ps_platform_read(s->platform, &img, err);
+    ps_status st = read_picture(s, true, every_map, &img, err);
     if (st != PS_OK)
         return st;
     /* The buffer holds radiance times exposure: the PNG takes it as it is,
@@ -245,8 +294,15 @@ static ps_status write_illuminance(snap_run *s, ps_error *err)
         st = ps_session_refresh(s->session, &s->cam, &f, err);
     ps_image irr;
     memset(&irr, 0, sizeof irr);
-    if (st == PS_OK) {
+    if (st == PS_OK)
         ps_gl_layers_draw(layers, s->gl, &s->cam, &f);
+    /* Incremental sessions draw by batches: all of them before reading. */
+    while (st == PS_OK && !ps_session_settled(s->session)) {
+        st = ps_session_refresh(s->session, &s->cam, &f, err);
+        if (st == PS_OK)
+            ps_gl_layers_draw(layers, s->gl, &s->cam, &f);
+    }
+    if (st == PS_OK) {
         double gains[PS_MAP_COUNT] = {f.map[0].gain, f.map[1].gain};
         st = ps_gl_layers_composite(layers, f.direct_gain, gains, &irr, err);
     }
@@ -354,7 +410,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             double at = now - t_start - excluded;
             for (int first = cp; st == PS_OK && cp < o->checkpoint_count && at >= o->checkpoints[cp]; cp++) {
                 if (cp > first) /* the layers of the last one overwrote it */
-                    ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+                    redraw_frame(s);
                 st = write_checkpoint(s, cp, at, &rows[cp], err);
             }
             ps_session_hold(s->session, false);
@@ -374,8 +430,11 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
     ps_status stop = ps_session_stop(s->session, st == PS_OK ? err : NULL);
     if (st == PS_OK)
         st = stop;
-    /* The snapshot: everything that arrived, drawn once more. */
+    /* The snapshot: everything that arrived, drawn once more (layers: the
+     * batches not drawn yet, however many refreshes the budget takes). */
     if (st == PS_OK)
+        st = refresh(s, err);
+    while (st == PS_OK && s->layers && !ps_session_settled(s->session))
         st = refresh(s, err);
     /* Checkpoints after the end (every cap reached, or the counter stopped
      * the tracer) show the final picture, at the time it was done. */
@@ -383,7 +442,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
     for (; st == PS_OK && cp < o->checkpoint_count; cp++) {
         st = write_checkpoint(s, cp, done, &rows[cp], err);
         if (st == PS_OK)
-            ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+            redraw_frame(s);
     }
     if (st == PS_OK && o->checkpoint_count > 0)
         st = write_checkpoint_csv(o, rows, o->checkpoint_count, err);
@@ -417,7 +476,9 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
     ps_stats_add(&rs, "height", height);
     ps_stats_add(&rs, "seconds", ps_now_seconds() - t_start);
     ps_stats_add(&rs, "first_frame_seconds", first_frame);
-    ps_stats_add(&rs, "splats", (double)s->frame.splats);
+    /* The splats the picture is made of: drawn over all refreshes into
+     * layers, or the last whole frame's. */
+    ps_stats_add(&rs, "splats", (double)(s->layers ? s->splats : s->frame.splats));
     ps_stats_add(&rs, "kernel_mean", ps_session_kernel(s->session)->mean);
     ps_stats_add(&rs, "caustic_radius", ps_session_radius(s->session, PS_MAP_CAUSTIC));
     ps_stats_add(&rs, "global_radius", ps_session_radius(s->session, PS_MAP_GLOBAL));
@@ -460,12 +521,18 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
     ps_session_settings set = ps_preview_settings(&o->c, &o->p, scene);
     set.skip_hidden = true; /* a layer left out is not traced */
     set.cancel = o->cancel;
+    /* Progressive in float: only new photons each refresh, so that a refresh
+     * (and a checkpoint) comes when it is due however many have arrived. */
+    set.incremental = o->time > 0.0 && set.float_buffer;
+    set.splat_share = SNAP_SPLAT_SHARE;
     ps_status st = ps_session_create(scene, &set, &s.session, err);
     ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0};
     if (st == PS_OK) {
         ps_gl_scene gs = ps_gl_scene_of(s.session);
         st = ps_gl_renderer_create(&gs, ps_session_kernel(s.session), &gopt, &s.gl, err);
     }
+    if (st == PS_OK && set.incremental)
+        st = ps_gl_layers_create(width, height, true, &s.layers, err);
     double t_start = ps_now_seconds(), first_frame = -1.0;
     if (st == PS_OK && o->time <= 0.0) {
         /* A fixed photon count: trace everything, then draw once. */
@@ -489,6 +556,7 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
         st = ps_write_photon_dump(o->c.dump, ps_session_maps(s.session), err);
     if (st == PS_OK)
         st = write_stats_and_report(&s, width, height, t_start, first_frame, err);
+    ps_gl_layers_destroy(s.layers);
     ps_gl_renderer_destroy(s.gl);
     ps_session_destroy(s.session);
     return st;

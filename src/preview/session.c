@@ -61,6 +61,7 @@ ps_session_settings ps_session_default_settings(const ps_scene *scene)
     set.radius_alpha = PS_RADIUS_ALPHA_DEFAULT;
     set.exposure = 1.0;
     set.tau = 0.1;
+    set.splat_share = PS_SESSION_SPLAT_TIME_SHARE;
     set.shadow_size = PS_SHADOW_SIZE_DEFAULT;
     return set;
 }
@@ -389,7 +390,7 @@ void ps_session_drawn(ps_session *s, double draw_seconds)
 {
     if (incremental(s) && s->last_splats > 0) {
         double rate = (double)s->last_splats / fmax(s->last_build + draw_seconds, 1e-6);
-        s->budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * PS_SESSION_SPLAT_TIME_SHARE / PS_MAP_COUNT);
+        s->budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * s->set.splat_share / PS_MAP_COUNT);
     }
     /* Thesis 5.1: once a refresh loses this much to round-off, more photons
      * only add noise: stop shooting (until the next edit). */

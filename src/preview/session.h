@@ -43,7 +43,8 @@
 #include "scene/scene.h"
 
 /* An incremental refresh splats at most as many photons a map as fit in this
- * share of tau at the rate the last refreshes drew them, so that a refresh
+ * share of tau (by default: the window's, which also composites and shows
+ * the picture) at the rate the last refreshes drew them, so that a refresh
  * comes every tau however fast photons arrive (llvmpipe draws a few hundred
  * thousand large splats a second); never fewer than the first bound. */
 #define PS_SESSION_SPLAT_TIME_SHARE 0.5
@@ -76,6 +77,9 @@ typedef struct ps_session_settings {
     double exposure;
     bool incremental;              /* see above: only with float_buffer */
     double tau;                    /* seconds between refreshes: the budget's time */
+    double splat_share;            /* incremental: the share of tau new splats may take
+                                    * (PS_SESSION_SPLAT_TIME_SHARE; more where nothing else
+                                    * waits, as in photosplat-snap) */
     int shadow_size;               /* the GL lights' shadow maps (texels a side), 0: none;
                                     * only planned here, against the memory budget */
 } ps_session_settings;
