@@ -213,7 +213,7 @@ static int first_picture_run(bench_gl *g, double t[STAGE_COUNT], double warm[3],
     mopt.max_edge = HUGE_VAL;
     if (ps_preview_mesh_build(g->scene, &mopt, &g->coarse, err) != PS_OK)
         goto done;
-    if (ps_preview_lights_build(g->scene, NULL, &g->coarse, PS_GL_SHADOW_SIZE, &g->lights, err) != PS_OK)
+    if (ps_preview_lights_build(g->scene, NULL, &g->coarse, PS_GL_SHADOW_SIZE, PS_PREVIEW_AREA_SIDE, &g->lights, err) != PS_OK)
         goto done;
     size_t nmat;
     ps_gl_scene gs = {&g->mesh, &g->coarse, ps_scene_materials(g->scene, &nmat), &g->lights, ps_scene_bounds(g->scene), false};

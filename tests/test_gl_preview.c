@@ -61,7 +61,7 @@ static void preview_make(preview *out, const char *text, int w, int h, ps_kernel
     assert_true(OSMesaMakeCurrent(p.ctx, p.buffer, GL_FLOAT, w, h));
     ps_gl_options go = {true, true, 0};
     *pp = p;
-    assert_int_equal(ps_preview_lights_build(pp->scene, NULL, &pp->coarse, PS_GL_SHADOW_SIZE, &pp->lights, &err), PS_OK);
+    assert_int_equal(ps_preview_lights_build(pp->scene, NULL, &pp->coarse, PS_GL_SHADOW_SIZE, PS_PREVIEW_AREA_SIDE, &pp->lights, &err), PS_OK);
     size_t nmat;
     ps_gl_scene gs = {&pp->mesh, &pp->coarse, ps_scene_materials(pp->scene, &nmat), &pp->lights, ps_scene_bounds(pp->scene),
                       false};

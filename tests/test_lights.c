@@ -30,7 +30,7 @@ static lit lit_make(const char *text)
     mo.max_edge = HUGE_VAL;
     if (ps_preview_mesh_build(l.scene, &mo, &l.coarse, &err) != PS_OK)
         fail_msg("mesh: %s", err.msg);
-    if (ps_preview_lights_build(l.scene, NULL, &l.coarse, PS_SHADOW_SIZE_DEFAULT, &l.lights, &err) != PS_OK)
+    if (ps_preview_lights_build(l.scene, NULL, &l.coarse, PS_SHADOW_SIZE_DEFAULT, PS_PREVIEW_AREA_SIDE, &l.lights, &err) != PS_OK)
         fail_msg("lights: %s", err.msg);
     return l;
 }
@@ -128,6 +128,36 @@ static void area_light_is_sixteen_cosine_emitters(void **state)
     lit_free(&l);
 }
 
+/* Fewer strata, the same flux: 1 and 2 x 2 virtual lights (the progressive
+ * first pictures) carry the area light's power as the 16 do. */
+static void coarser_area_lights_keep_the_flux(void **state)
+{
+    (void)state;
+    ps_scene *scene;
+    ps_error err;
+    assert_int_equal(ps_scene_load_text(WHITE FLOOR "light quad corner -0.25 1.9 -0.25 edge1 0.5 0 0 edge2 0 0 0.5 "
+                                                    "power 30 30 30\n",
+                                        "area.scn", "", NULL, &scene, &err),
+                     PS_OK);
+    ps_preview_mesh coarse;
+    ps_mesh_options mo = ps_mesh_default_options(scene);
+    assert_int_equal(ps_preview_mesh_build(scene, &mo, &coarse, &err), PS_OK);
+    for (int side = 1; side <= PS_PREVIEW_AREA_SIDE; side *= 2) {
+        ps_preview_lights l;
+        assert_int_equal(ps_preview_lights_build(scene, NULL, &coarse, 0, side, &l, &err), PS_OK);
+        assert_int_equal(l.count, (size_t)(side * side));
+        double total = 0.0;
+        for (size_t i = 0; i < l.count; i++)
+            total += flux(&l.lights[i]);
+        assert_near(total, 30.0, 1e-9);
+        if (side == 1) /* the one stratum's centre: the quad's */
+            assert_true(fabs(l.lights[0].pos.x) < 1e-12 && fabs(l.lights[0].pos.z) < 1e-12);
+        ps_preview_lights_free(&l);
+    }
+    ps_preview_mesh_free(&coarse);
+    ps_scene_destroy(scene);
+}
+
 static void disc_and_sphere_lights(void **state)
 {
     (void)state;
@@ -180,7 +210,7 @@ static void near_plane_from_the_accelerator(void **state)
     ps_error err;
     assert_int_equal(ps_world_create(l.scene, NULL, &w, &err), PS_OK);
     ps_preview_lights fast;
-    assert_int_equal(ps_preview_lights_build(l.scene, ps_world_accel(w), &l.coarse, 0, &fast, &err), PS_OK);
+    assert_int_equal(ps_preview_lights_build(l.scene, ps_world_accel(w), &l.coarse, 0, PS_PREVIEW_AREA_SIDE, &fast, &err), PS_OK);
     /* Over the sphere: 1.5 - (0.5 + 0.3) = 0.7 to its top. */
     assert_near(fast.lights[0].shadow_near, PS_SHADOW_NEAR_SHARE * 0.7, 1e-9);
     assert_true(fast.lights[0].shadow_near <= l.lights.lights[0].shadow_near + 1e-6); /* float vertices */
@@ -223,7 +253,7 @@ static void shadow_maps_planned_against_the_budget(void **state)
     assert_int_equal(ps_preview_mesh_build(scene, &mo, &coarse, &err), PS_OK);
     ps_preview_lights l;
     /* Six faces of 2^20 texels a side, 4 bytes each: 2^43 bytes. */
-    assert_int_equal(ps_preview_lights_build(scene, NULL, &coarse, 1 << 20, &l, &err), PS_ERR_LIMIT);
+    assert_int_equal(ps_preview_lights_build(scene, NULL, &coarse, 1 << 20, PS_PREVIEW_AREA_SIDE, &l, &err), PS_ERR_LIMIT);
     assert_non_null(strstr(err.msg, "big.scn"));
     assert_non_null(strstr(err.msg, "shadow maps"));
     assert_int_equal(l.count, 0);
@@ -239,6 +269,7 @@ int main(void)
         cmocka_unit_test(spot_light_reaches_one_face),
         cmocka_unit_test(wide_spot_reaches_five_faces),
         cmocka_unit_test(area_light_is_sixteen_cosine_emitters),
+        cmocka_unit_test(coarser_area_lights_keep_the_flux),
         cmocka_unit_test(disc_and_sphere_lights),
         cmocka_unit_test(near_plane_without_geometry),
         cmocka_unit_test(near_plane_from_the_accelerator),

@@ -374,6 +374,44 @@ static void radius_follows_the_schedule(void **state)
     ps_scene_destroy(scene);
 }
 
+/* Progressive area lights: the first refresh with one virtual light an area
+ * light, then 2 x 2, then all 16, each change said (lights_changed); an
+ * edit starts over at one; without the setting, 16 from the start. */
+static void area_lights_refine(void **state)
+{
+    (void)state;
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load("data/scenes/cornell-caustic-area.scn", NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_session_settings set = settings(scene, true);
+    set.progressive_lights = true;
+    ps_session *s = open_session(scene, &set);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    const size_t want[3] = {1, 4, PS_PREVIEW_AREA_SAMPLES};
+    for (int i = 0; i < 3; i++) {
+        refresh(s, &cam, &f);
+        assert_int_equal(f.lights_changed, i > 0);
+        assert_int_equal(ps_session_lights(s)->count, want[i]);
+        ps_session_drawn(s, 0.001);
+    }
+    refresh(s, &cam, &f);
+    assert_false(f.lights_changed);
+    assert_int_equal(ps_session_lights(s)->count, PS_PREVIEW_AREA_SAMPLES);
+    assert_int_equal(ps_session_move_light(s, 0, ps_v3(0.1, 1.9, 0.0), &err), PS_OK);
+    ps_session_changes ch;
+    assert_int_equal(ps_session_update(s, &ch, &err), PS_OK);
+    assert_int_equal(ps_session_lights(s)->count, 1);
+    ps_session_destroy(s);
+    set.progressive_lights = false;
+    s = open_session(scene, &set);
+    assert_int_equal(ps_session_lights(s)->count, PS_PREVIEW_AREA_SAMPLES);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -384,6 +422,7 @@ int main(void)
         cmocka_unit_test(edits_restart_the_maps),
         cmocka_unit_test(hidden_layers_are_skipped),
         cmocka_unit_test(radius_follows_the_schedule),
+        cmocka_unit_test(area_lights_refine),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -161,6 +161,10 @@ typedef struct snap_run {
 static ps_status refresh(snap_run *s, ps_error *err)
 {
     ps_status st = ps_session_refresh(s->session, &s->cam, &s->frame, err);
+    if (st == PS_OK && s->frame.lights_changed) {
+        ps_gl_scene gs = ps_gl_scene_of(s->session);
+        st = ps_gl_renderer_set_scene(s->gl, &gs, err);
+    }
     if (st != PS_OK)
         return st;
     double t0 = ps_now_seconds();
@@ -431,7 +435,9 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
     if (st == PS_OK)
         st = stop;
     /* The snapshot: everything that arrived, drawn once more (layers: the
-     * batches not drawn yet, however many refreshes the budget takes). */
+     * batches not drawn yet, however many refreshes the budget takes), and
+     * the area lights with all their virtual lights. */
+    ps_session_full_lights(s->session);
     if (st == PS_OK)
         st = refresh(s, err);
     while (st == PS_OK && s->layers && !ps_session_settled(s->session))
@@ -525,6 +531,9 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
      * (and a checkpoint) comes when it is due however many have arrived. */
     set.incremental = o->time > 0.0 && set.float_buffer;
     set.splat_share = SNAP_SPLAT_SHARE;
+    /* Progressive: the first picture without waiting for every area light's
+     * 16 shadow cubes; a fixed photon count draws once, with all of them. */
+    set.progressive_lights = o->time > 0.0;
     ps_status st = ps_session_create(scene, &set, &s.session, err);
     ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0};
     if (st == PS_OK) {

@@ -244,6 +244,7 @@ static ps_status open_session(app *a, ps_error *err)
     set.max_stored = (size_t)a->o.max_photons;
     set.incremental = true;
     set.shadow_size = a->o.p.shadows ? WIN_SHADOW_SIZE : 0;
+    set.progressive_lights = true; /* the first picture (and the first after an edit) sooner */
     ps_status st = ps_session_create(a->scene, &set, &a->session, err);
     ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE};
     if (st == PS_OK) {
@@ -410,6 +411,10 @@ static ps_status refresh(app *a, ps_error *err)
     double t0 = ps_now_seconds();
     ps_camera_frame cam = camera_frame(a);
     ps_status st = ps_session_refresh(a->session, &cam, &a->frame, err);
+    if (st == PS_OK && a->frame.lights_changed) {
+        ps_gl_scene gs = ps_gl_scene_of(a->session);
+        st = ps_gl_renderer_set_scene(a->gl, &gs, err);
+    }
     if (st != PS_OK)
         return st;
     double t_draw = ps_now_seconds();

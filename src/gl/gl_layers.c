@@ -120,8 +120,18 @@ static void add_texture(GLuint t, double gain)
 
 void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f)
 {
-    if (f->new_view)
+    if (f->new_view) {
         ps_gl_layers_view(l, r, cam, f->direct_exposure, f->direct);
+    } else if (f->lights_changed) {
+        /* New lights, the same view: only the direct layer again. Its pass
+         * redraws the shared depth prepass too, the same depths, so the map
+         * layers' splats stay right. */
+        GLint old_fbo = 0;
+        glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_DIRECT_TEX]);
+        ps_gl_begin_frame(r, cam, f->direct_exposure, f->direct);
+        glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    }
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         if (f->map[k].clear)
             ps_gl_layers_clear_map(l, k);

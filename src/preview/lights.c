@@ -78,6 +78,7 @@ typedef struct builder {
     const ps_scene *scene;
     ps_preview_lights *out;
     size_t cap;
+    int area_side;
 } builder;
 
 static bool push_light(builder *b, ps_preview_light v)
@@ -163,7 +164,7 @@ static bool add_ies_light(builder *b, uint32_t light, const ps_light *L)
  * the area, each a cosine emitter of power / (pi * count). */
 static bool add_area_light(builder *b, uint32_t light, const ps_light *L)
 {
-    const int side = 4; /* side^2 = PS_PREVIEW_AREA_SAMPLES */
+    const int side = b->area_side;
     const int count = side * side;
     ps_rgb each = ps_rgb_scale(L->power, PS_INV_PI / count);
     if (L->type == PS_LIGHT_SPHERE) /* outside it, a Lambertian sphere lights like a point at its centre */
@@ -226,10 +227,11 @@ static ps_status fail(ps_preview_lights *out, const ps_scene *s, ps_error *err)
 }
 
 ps_status ps_preview_lights_build(const ps_scene *s, const ps_accel *accel, const ps_preview_mesh *coarse,
-                                  int shadow_size, ps_preview_lights *out, ps_error *err)
+                                  int shadow_size, int area_side, ps_preview_lights *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
-    builder b = {s, out, 0};
+    int side = area_side < 1 ? 1 : area_side > PS_PREVIEW_AREA_SIDE ? PS_PREVIEW_AREA_SIDE : area_side;
+    builder b = {s, out, 0, side};
     size_t n;
     const ps_light *lights = ps_scene_lights(s, &n);
     size_t emitters = 0, spheres = 0;

@@ -34,7 +34,8 @@
 #include "scene/scene.h"
 #include "scene/tessellate.h"
 
-#define PS_PREVIEW_AREA_SAMPLES 16 /* a 4 x 4 grid of strata */
+#define PS_PREVIEW_AREA_SIDE 4 /* the strata of an area light: a 4 x 4 grid ... */
+#define PS_PREVIEW_AREA_SAMPLES (PS_PREVIEW_AREA_SIDE * PS_PREVIEW_AREA_SIDE) /* ... 16 GL lights */
 
 /* The six faces of a light's shadow cube, in GL's cube-map order: +x, -x,
  * +y, -y, +z, -z. */
@@ -117,7 +118,9 @@ typedef struct ps_preview_lights {
 #define PS_SHADOW_TEXEL_BYTES 4
 #define PS_SPHERE_TRIANGLE_BYTES (24 + 3 * 4)
 
-/* The GL lights and emitters of scene s. The near planes come from accel (the
+/* The GL lights and emitters of scene s, an area light as area_side x
+ * area_side virtual lights (1 to PS_PREVIEW_AREA_SIDE: fewer draw the first
+ * picture sooner, a shadow cube each). The near planes come from accel (the
  * scene's ray accelerator, ps_accel_nearest_distance: exact spheres, which
  * lie nearer than their tessellation, so nothing the depth pass draws is
  * clipped) or, given NULL, from brute force over `coarse` (its depth-only
@@ -125,7 +128,7 @@ typedef struct ps_preview_lights {
  * their memory and the sphere meshes' are planned against the budget first
  * (PS_ERR_LIMIT names the scene). out is overwritten; on error it is empty. */
 ps_status ps_preview_lights_build(const ps_scene *s, const ps_accel *accel, const ps_preview_mesh *coarse,
-                                  int shadow_size, ps_preview_lights *out, ps_error *err);
+                                  int shadow_size, int area_side, ps_preview_lights *out, ps_error *err);
 void ps_preview_lights_free(ps_preview_lights *l); /* and zero it; accepts a zeroed one */
 
 /* Which shadow-cube faces can receive light from v: a face is left out only

@@ -20,6 +20,8 @@ struct ps_session {
     ps_kernel_texture kernel;
     ps_splat_batch batch[PS_MAP_COUNT];
     bool illuminance;      /* white Lambertian, exposure 1, float (ps_session_set_illuminance) */
+    int area_side;         /* an area light's virtual lights a side, refined up to PS_PREVIEW_AREA_SIDE */
+    bool lights_pending;   /* area_side grew: lights to rebuild at the next refresh */
     ps_material *white;    /* as many as the scene's, for illuminance mode */
     /* Invariant: drawn[k] photons of map k (a prefix ending at a feed mark,
      * drawn_emitted[k] emitted) are in the layers since the last new view. */
@@ -102,7 +104,8 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
 static ps_status build_lights(ps_session *s, ps_error *err)
 {
     ps_preview_lights_free(&s->lights);
-    return ps_preview_lights_build(s->scene, ps_world_accel(s->world), &s->coarse, s->set.shadow_size, &s->lights, err);
+    return ps_preview_lights_build(s->scene, ps_world_accel(s->world), &s->coarse, s->set.shadow_size, s->area_side,
+                                   &s->lights, err);
 }
 
 static void free_maps(ps_session *s)
@@ -175,6 +178,7 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
     s->scene = scene;
     s->set = *set;
     s->budget = PS_SESSION_BUDGET_START;
+    s->area_side = set->progressive_lights ? 1 : PS_PREVIEW_AREA_SIDE;
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_splat_batch_init(&s->batch[k]);
         s->splat_radius[k] = set->radius[k];
@@ -311,6 +315,13 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         s->view_dirty = true;
     }
     bool inc = incremental(s);
+    if (s->lights_pending) {
+        s->lights_pending = false;
+        ps_status lst = build_lights(s, err);
+        if (lst != PS_OK)
+            return lst;
+        out->lights_changed = true;
+    }
     out->new_view = s->view_dirty;
     if (s->view_dirty) {
         for (int k = 0; k < PS_MAP_COUNT; k++)
@@ -386,6 +397,24 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     return PS_OK;
 }
 
+void ps_session_full_lights(ps_session *s)
+{
+    if (s->area_side < PS_PREVIEW_AREA_SIDE) {
+        s->area_side = PS_PREVIEW_AREA_SIDE;
+        s->lights_pending = true;
+    }
+}
+
+static bool has_area_lights(const ps_session *s)
+{
+    size_t n;
+    const ps_light *L = ps_scene_lights(s->scene, &n);
+    for (size_t i = 0; i < n; i++)
+        if (L[i].type == PS_LIGHT_QUAD || L[i].type == PS_LIGHT_DISC || L[i].type == PS_LIGHT_MESH)
+            return true;
+    return false;
+}
+
 void ps_session_drawn(ps_session *s, double draw_seconds)
 {
     if (incremental(s) && s->last_splats > 0) {
@@ -401,11 +430,18 @@ void ps_session_drawn(ps_session *s, double draw_seconds)
     }
     s->first_pending = false;
     apply_pause(s);
+    /* Progressive area lights: a refresh drawn, the next one with twice as
+     * many virtual lights a side, until all (only when the scene has an area
+     * light: the others' GL lights do not change). */
+    if (s->area_side < PS_PREVIEW_AREA_SIDE && has_area_lights(s)) {
+        s->area_side *= 2;
+        s->lights_pending = true;
+    }
 }
 
 bool ps_session_settled(ps_session *s)
 {
-    if (s->edited || s->view_dirty || !s->have_cam)
+    if (s->edited || s->view_dirty || !s->have_cam || s->lights_pending)
         return false;
     if (s->user_paused || s->counter_stopped)
         return true;
@@ -550,6 +586,9 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
     ps_status st = PS_OK;
     if (s->geometry_edited)
         st = build_geometry(s, err);
+    /* The first picture after the edit as soon as after loading. */
+    s->area_side = s->set.progressive_lights ? 1 : PS_PREVIEW_AREA_SIDE;
+    s->lights_pending = false;
     if (st == PS_OK)
         st = build_lights(s, err);
     if (st == PS_OK)

@@ -82,6 +82,11 @@ typedef struct ps_session_settings {
                                     * waits, as in photosplat-snap) */
     int shadow_size;               /* the GL lights' shadow maps (texels a side), 0: none;
                                     * only planned here, against the memory budget */
+    bool progressive_lights;       /* area lights start as one virtual light each and
+                                    * refine to PS_PREVIEW_AREA_SAMPLES over the first
+                                    * refreshes (after loading and after each edit), so
+                                    * that the first picture does not wait for all their
+                                    * shadow cubes; else all from the start */
 } ps_session_settings;
 
 /* Defaults: the scene's photon counts and radii, every layer, triangles, the
@@ -134,6 +139,10 @@ typedef struct ps_session_frame {
     /* The layers hold nothing valid (a new camera, setting or edit): draw the
      * depth prepass and the direct layer again, and empty the map layers. */
     bool new_view;
+    /* The GL lights are new (progressive area lights refined): give the
+     * renderer ps_gl_scene_of again; the direct layer is to be drawn again
+     * (implied by new_view), the map layers kept. */
+    bool lights_changed;
     bool direct;             /* the direct layer is shown (else the scene is drawn black) */
     double direct_exposure;  /* the exposure GL lights are drawn with */
     double direct_gain;      /* the direct layer's weight in the composite */
@@ -148,6 +157,9 @@ typedef struct ps_session_frame {
 /* Builds this refresh's splats for camera cam (a camera unlike the last
  * refresh's starts a new view). Briefly holds the feed's lock. */
 ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_session_frame *out, ps_error *err);
+/* Progressive area lights: all their virtual lights from the next refresh on
+ * (a snapshot's last picture). */
+void ps_session_full_lights(ps_session *s);
 /* After the refresh's splats were drawn, in draw_seconds (finished, not only
  * queued): the budget for the next, a held feed let go, and the error
  * counter's verdict (which pauses tracing). */
