@@ -294,15 +294,17 @@ static ps_status write_illuminance(snap_run *s, ps_error *err)
     ps_gl_layers *layers = NULL;
     st = ps_gl_layers_create(s->cam.width, s->cam.height, true, &layers, err);
     ps_session_frame f;
-    if (st == PS_OK)
-        st = ps_session_refresh(s->session, &s->cam, &f, err);
     ps_image irr;
     memset(&irr, 0, sizeof irr);
-    if (st == PS_OK)
-        ps_gl_layers_draw(layers, s->gl, &s->cam, &f);
     /* Incremental sessions draw by batches: all of them before reading. */
-    while (st == PS_OK && !ps_session_settled(s->session)) {
+    bool first = true;
+    while (st == PS_OK && (first || !ps_session_settled(s->session))) {
+        first = false;
         st = ps_session_refresh(s->session, &s->cam, &f, err);
+        if (st == PS_OK && f.lights_changed) {
+            ps_gl_scene gs = ps_gl_scene_of(s->session);
+            st = ps_gl_renderer_set_scene(s->gl, &gs, err);
+        }
         if (st == PS_OK)
             ps_gl_layers_draw(layers, s->gl, &s->cam, &f);
     }
