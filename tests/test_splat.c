@@ -951,6 +951,58 @@ static void halftone_texture(void **state)
     }
 }
 
+/* Built on one thread or several, in every mode and precision: the same
+ * bytes (the ranges and their sums do not depend on the threads). */
+static void same_bytes_for_any_threads(void **state)
+{
+    (void)state;
+    enum { N = 200000 };
+    ps_photon *ph = malloc(N * sizeof *ph);
+    uint16_t *mat = calloc(N, sizeof *mat);
+    uint32_t *obj = malloc(N * sizeof *obj);
+    assert_non_null(ph);
+    assert_non_null(mat);
+    assert_non_null(obj);
+    ps_material m = diffuse(ps_rgb_make(0.5, 0.5, 0.5));
+    for (size_t i = 0; i < N; i++) {
+        ps_rng r = ps_rng_make(7, PS_STREAM_TEST, i);
+        ps_vec3 at = ps_v3(2.0 * ps_rng_uniform(&r) - 1.0, 2.0 * ps_rng_uniform(&r) - 1.0, 0.0);
+        /* A tenth facing away: skipped, so that the ranges' counts differ. */
+        ps_vec3 n = i % 10 == 3 ? ps_v3(0, 0, -1) : ps_v3(0, 0, 1);
+        ph[i] = ps_photon_pack(at, ps_rgb_make(1.0, 0.5, 0.25), ps_v3(0, 0, -1), n, 0.5);
+        obj[i] = (uint32_t)(i % 7);
+    }
+    for (int mode = 0; mode < PS_SPLAT_MODE_COUNT; mode++)
+        for (int pr = 0; pr < PS_PRECISION_COUNT; pr++) {
+            ps_splat_params p = params((ps_splat_mode)mode, &m, frame(ps_v3(0, 0, 5), ps_v3(0, 0, 0), 640, 480));
+            p.scale = 1e-4;
+            p.levels = 255;
+            p.precision = (ps_precision)pr;
+            p.objects = obj;
+            ps_splat_batch a, b;
+            ps_splat_batch_init(&a);
+            ps_splat_batch_init(&b);
+            p.threads = 1;
+            build(ph, mat, N, &p, &a);
+            p.threads = 3;
+            build(ph, mat, N, &p, &b);
+            assert_int_equal(a.splats, b.splats);
+            assert_true(a.splats > N / 2 && a.splats < N);
+            assert_memory_equal(a.positions, b.positions, 3 * a.vertex_count * sizeof(float));
+            assert_memory_equal(a.colors, b.colors, 4 * a.vertex_count * sizeof(float));
+            if (mode == PS_SPLAT_TRIANGLES)
+                assert_memory_equal(a.texcoords, b.texcoords, 2 * a.vertex_count * sizeof(float));
+            assert_memory_equal(a.group_first, b.group_first, sizeof a.group_first);
+            assert_true(a.wanted == b.wanted && a.lost == b.lost);
+            assert_memory_equal(a.carry, b.carry, sizeof a.carry);
+            ps_splat_batch_free(&a);
+            ps_splat_batch_free(&b);
+        }
+    free(ph);
+    free(mat);
+    free(obj);
+}
+
 /* Error diffusion runs in screen order (a Z-order curve over the splats'
  * pixels): the codes sent into any aligned 32 x 32 block of the screen add up
  * to what its photons asked for within one code, where index order (the
@@ -1005,7 +1057,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(kernel_texture),
         cmocka_unit_test(halftone_texture),
-        cmocka_unit_test(diffusion_in_screen_order), cmocka_unit_test(splat_basis),         cmocka_unit_test(triangles), cmocka_unit_test(sprites),
+        cmocka_unit_test(diffusion_in_screen_order),
+        cmocka_unit_test(same_bytes_for_any_threads), cmocka_unit_test(splat_basis),         cmocka_unit_test(triangles), cmocka_unit_test(sprites),
         cmocka_unit_test(points),         cmocka_unit_test(glossy),              cmocka_unit_test(back_faces),
         cmocka_unit_test(batches), cmocka_unit_test(groups),        cmocka_unit_test(precision_diffusion), cmocka_unit_test(precision_counter),
         cmocka_unit_test(names), cmocka_unit_test(radius_schedule),

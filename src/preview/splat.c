@@ -2,10 +2,12 @@
 #include "preview/splat.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/array.h"
+#include "photon/tracer.h"
 #include "scene/bsdf.h"
 
 const char *const ps_splat_mode_names[PS_SPLAT_MODE_COUNT + 1] = {"points", "triangles", "sprites", NULL};
@@ -188,23 +190,6 @@ static double to_steps(double x, double L)
     return (double)(int64_t)(steps + 0.5) / L;
 }
 
-/* The 8-bit handling of one colour channel: what is sent to GL. */
-static double quantise(ps_splat_batch *b, const ps_splat_params *p, int ch, double c)
-{
-    if (p->levels <= 0 || p->precision == PS_PRECISION_NONE)
-        return c;
-    double L = p->levels;
-    if (p->precision == PS_PRECISION_DIFFUSION) {
-        double want = c + b->carry[ch];
-        double q = to_steps(want, L);
-        b->carry[ch] = want - q;
-        return q;
-    }
-    /* Counter: send as is, and count what the buffer will round away. */
-    b->wanted += c;
-    b->lost += c - to_steps(c, L);
-    return c;
-}
 
 /* Where a splat's centre falls on the screen, as a Z-order (Morton) key of
  * its pixel: interleaved bits of x and y, so that splats near each other on
@@ -219,11 +204,25 @@ static uint32_t spread_bits(uint32_t v)
     return v;
 }
 
-static uint32_t z_order(double x, double y)
+static uint32_t z_order(double x, double y, uint32_t side)
 {
-    uint32_t ix = x > 0.0 ? (x < 65535.0 ? (uint32_t)x : 65535u) : 0u;
-    uint32_t iy = y > 0.0 ? (y < 65535.0 ? (uint32_t)y : 65535u) : 0u;
+    double top = (double)(side - 1);
+    uint32_t ix = x > 0.0 ? (x < top ? (uint32_t)x : side - 1) : 0u;
+    uint32_t iy = y > 0.0 ? (y < top ? (uint32_t)y : side - 1) : 0u;
     return spread_bits(ix) | spread_bits(iy) << 1;
+}
+
+/* The Z-order keys' square: the smallest power of two covering the image
+ * (at most 2^16); splats off the image clamp to its edge. Its bits, twice
+ * its side's, are all the radix sort below needs to look at. */
+static uint32_t z_side(const ps_camera_frame *cam, int *key_bits)
+{
+    int side_bits = 0;
+    int m = cam->width > cam->height ? cam->width : cam->height;
+    while (side_bits < 16 && (1 << side_bits) < m)
+        side_bits++;
+    *key_bits = 2 * side_bits;
+    return 1u << side_bits;
 }
 
 /* Error diffusion in screen order. Thesis departure: the thesis carries each
@@ -235,58 +234,104 @@ static uint32_t z_order(double x, double y)
  * any region of it is under one code. The order is a stable sort of the
  * batch's splats by their keys (LSD radix on the key, the splat's place as
  * the tie-break), so the same photons always give the same picture. */
+/* Radix digits of the sort: 11 bits, two passes for images up to 2048 a side. */
+#define SORT_PREFETCH 32
+#if defined(__GNUC__)
+#define PS_PREFETCH_WRITE(addr) __builtin_prefetch((addr), 1, 0)
+#else
+#define PS_PREFETCH_WRITE(addr) ((void)(addr))
+#endif
+#define SORT_DIGIT_BITS 11
+
 static void diffuse_in_screen_order(ps_splat_batch *b, const ps_splat_params *p, size_t first_splat, size_t per)
 {
     size_t n = b->splats - first_splat;
     uint64_t *a = b->order, *t = b->order_tmp;
-    for (int pass = 0; pass < 4; pass++) { /* the key is the upper 32 bits, 8 at a time */
-        size_t count[257] = {0};
-        int shift = 32 + 8 * pass;
+    int key_bits;
+    (void)z_side(&p->cam, &key_bits);
+    size_t count[(1 << SORT_DIGIT_BITS) + 1]; /* 16 KiB of stack */
+    for (int shift = 32; shift < 32 + key_bits; shift += SORT_DIGIT_BITS) { /* the key: the upper 32 bits */
+        const uint64_t mask = (1u << SORT_DIGIT_BITS) - 1;
+        memset(count, 0, sizeof count);
         for (size_t i = 0; i < n; i++)
-            count[((a[i] >> shift) & 0xff) + 1]++;
-        for (int d = 0; d < 256; d++)
+            count[((a[i] >> shift) & mask) + 1]++;
+        for (size_t d = 0; d < mask + 1; d++)
             count[d + 1] += count[d];
         for (size_t i = 0; i < n; i++)
-            t[count[(a[i] >> shift) & 0xff]++] = a[i];
+            t[count[(a[i] >> shift) & mask]++] = a[i];
         uint64_t *swap = a;
         a = t;
         t = swap;
     }
-    /* Four passes: the sorted keys are back in b->order. */
+    /* a holds the sorted keys (b->order or b->order_tmp, by the passes' parity). */
+    double carry[3] = {b->carry[0], b->carry[1], b->carry[2]}, L = p->levels;
     size_t v0 = b->vertex_count - n * per;
     for (size_t i = 0; i < n; i++) {
+        /* The colours are read in screen order, scattered over the array:
+         * ask for one a few dozen ahead, so that the wait overlaps (it is
+         * most of this loop's time otherwise). */
+        if (i + SORT_PREFETCH < n)
+            PS_PREFETCH_WRITE(&b->colors[4 * (v0 + (size_t)(a[i + SORT_PREFETCH] & 0xffffffffu) * per)]);
         size_t v = v0 + (size_t)(a[i] & 0xffffffffu) * per;
         float *rgba = &b->colors[4 * v];
-        for (int ch = 0; ch < 3; ch++)
-            rgba[ch] = (float)quantise(b, p, ch, rgba[ch]);
+        for (int ch = 0; ch < 3; ch++) { /* the round-off carried into the next splat, per channel */
+            double want = rgba[ch] + carry[ch];
+            double q = to_steps(want, L);
+            carry[ch] = want - q;
+            rgba[ch] = (float)q;
+        }
         for (size_t k = 1; k < per; k++)
             memcpy(&b->colors[4 * (v + k)], rgba, 4 * sizeof *rgba);
     }
+    memcpy(b->carry, carry, sizeof carry);
 }
 
-ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
-                         ps_splat_batch *b, ps_error *err)
+/* Photons are built in ranges of this many, on as many threads as there are
+ * cores: a range's splats are written where its first photon would put them
+ * and then moved down in range order, and its round-off counts are added in
+ * range order, so the result is the same bytes for any number of threads. */
+#define BUILD_RANGE 65536
+#define PS_SPLAT_MAX_THREADS 64
+
+typedef struct build_range {
+    const ps_photon *photons;
+    const uint16_t *materials;
+    const ps_splat_params *p;
+    ps_splat_batch *b;
+    size_t first, end;     /* photons [first, end) */
+    size_t first_splat;    /* the batch's splats before this build */
+    size_t splats;         /* written by this range */
+    double wanted, lost;   /* the counter's sums over this range */
+} build_range;
+
+/* The counter: send as is, and count what the buffer will round away. */
+static double count_round_off(build_range *R, double L, double c)
 {
+    R->wanted += c;
+    R->lost += c - to_steps(c, L);
+    return c;
+}
+
+static void build_splats_of(build_range *R)
+{
+    const ps_splat_params *p = R->p;
+    ps_splat_batch *b = R->b;
     size_t per = p->mode == PS_SPLAT_TRIANGLES ? 3 : 1;
-    if (count > (SIZE_MAX / 4 - b->vertex_count) / per ||
-        !PS_RESERVE(b->positions, b->cap_pos, 3 * (b->vertex_count + per * count)) ||
-        !PS_RESERVE(b->colors, b->cap_col, 4 * (b->vertex_count + per * count)) ||
-        (per == 3 && !PS_RESERVE(b->texcoords, b->cap_tex, 2 * (b->vertex_count + per * count))) ||
-        (p->objects && !PS_RESERVE(b->group, b->cap_group, b->splats + count)))
-        return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
-    size_t first_splat = b->splats;
+    size_t first_splat = R->first_splat;
+    /* Where this range writes: as if every photon before it made a splat. */
+    size_t s0 = first_splat + R->first, v0 = b->vertex_count + R->first * per;
     const ps_camera_frame *cam = &p->cam;
     double r = p->radius;
     double disc = 1.0 / (p->kernel_mean * PS_PI * r * r);
-    /* Whether the 8-bit handling does anything (hoisted: the loop is hot). */
     bool rounds = p->levels > 0 && p->precision != PS_PRECISION_NONE;
     bool diffuse = rounds && p->precision == PS_PRECISION_DIFFUSION;
-    if (diffuse && (!PS_RESERVE(b->order, b->cap_order, count) || !PS_RESERVE(b->order_tmp, b->cap_order_tmp, count)))
-        return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
+    double L = p->levels;
+    int key_bits;
+    uint32_t zside = z_side(cam, &key_bits);
     /* World size of one pixel at unit depth along the view axis. */
     double pixel = 2.0 * cam->tan_half_fov / cam->height;
-    for (size_t i = 0; i < count; i++) {
-        const ps_photon *ph = &photons[i];
+    for (size_t i = R->first; i < R->end; i++) {
+        const ps_photon *ph = &R->photons[i];
         ps_vec3 pos = ps_photon_position(ph), n = ps_photon_normal(ph);
         ps_vec3 to_eye = ps_v3_sub(cam->eye, pos);
         double dist = ps_v3_len(to_eye);
@@ -303,7 +348,7 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
             continue;
         /* A diffuse BRDF needs no direction (and decoding one is half the
          * cost of a point splat). */
-        const ps_material *mat = &p->materials[materials[i]];
+        const ps_material *mat = &p->materials[R->materials[i]];
         ps_rgb f = mat->type == PS_MAT_DIFFUSE ? ps_rgb_scale(mat->albedo, PS_INV_PI)
                                                : ps_bsdf_eval(mat, n, ps_photon_dir(ph), wo);
         ps_rgb c = ps_rgb_scale(ps_rgb_mul(f, ps_photon_power(ph)), p->scale);
@@ -333,19 +378,19 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
          * dist / (dist - lift) a side, so its colour shrinks to match. */
         if (p->mode == PS_SPLAT_SPRITES)
             c = ps_rgb_scale(c, ((dist - lift) / dist) * ((dist - lift) / dist));
+        size_t sp = s0 + R->splats; /* its place until compaction */
         float rgba[4] = {(float)c.r, (float)c.g, (float)c.b, 1.0f};
         if (rounds && !diffuse) {
-            rgba[0] = (float)quantise(b, p, 0, c.r);
-            rgba[1] = (float)quantise(b, p, 1, c.g);
-            rgba[2] = (float)quantise(b, p, 2, c.b);
+            rgba[0] = (float)count_round_off(R, L, c.r);
+            rgba[1] = (float)count_round_off(R, L, c.g);
+            rgba[2] = (float)count_round_off(R, L, c.b);
         } else if (diffuse) {
             /* Rounded below, in screen order; the exact colour till then. */
             double px = 0.0, py = 0.0;
             (void)ps_camera_project(cam, centre, &px, &py);
-            b->order[b->splats - first_splat] =
-                (uint64_t)z_order(px, py) << 32 | (uint64_t)(b->splats - first_splat);
+            b->order[sp - first_splat] = (uint64_t)z_order(px, py, zside) << 32; /* the place: when compacted */
         }
-        size_t v = b->vertex_count;
+        size_t v = v0 + R->splats * per;
         if (p->mode == PS_SPLAT_TRIANGLES) {
             /* The equilateral triangle around the disc of radius r: corners
              * at 2r, at 90, 210 and 330 degrees; the texture's unit square
@@ -371,10 +416,121 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
             memcpy(&b->colors[4 * v], rgba, sizeof rgba);
         }
         if (p->objects)
-            b->group[b->splats] = (uint8_t)ps_splat_stencil(p->objects[i]);
-        b->vertex_count += per;
-        b->splats++;
+            b->group[sp] = (uint8_t)ps_splat_stencil(p->objects[i]);
+        R->splats++;
     }
+}
+
+static void *build_thread(void *arg)
+{
+    build_range **next = arg; /* a NULL-terminated list of this thread's ranges */
+    for (; *next; next++)
+        build_splats_of(*next);
+    return NULL;
+}
+
+/* The ranges on the cores (one thread: here). */
+static void run_ranges(build_range *R, size_t ranges, int threads)
+{
+    if (threads <= 0)
+        threads = ps_online_cores();
+    if (threads > PS_SPLAT_MAX_THREADS)
+        threads = PS_SPLAT_MAX_THREADS;
+    if ((size_t)threads > ranges)
+        threads = (int)ranges;
+    if (threads <= 1) {
+        for (size_t k = 0; k < ranges; k++)
+            build_splats_of(&R[k]);
+        return;
+    }
+    /* Ranges dealt round-robin: thread t takes t, t + threads, ... */
+    build_range **lists = calloc((size_t)threads * (ranges + 1), sizeof *lists);
+    pthread_t tid[PS_SPLAT_MAX_THREADS];
+    int started = 0;
+    if (lists) {
+        for (int t = 0; t < threads; t++) {
+            build_range **l = lists + (size_t)t * (ranges + 1);
+            size_t m = 0;
+            for (size_t k = (size_t)t; k < ranges; k += (size_t)threads)
+                l[m++] = &R[k];
+            l[m] = NULL;
+            if (t > 0 && pthread_create(&tid[t], NULL, build_thread, l) == 0)
+                started = t;
+            else if (t > 0)
+                break;
+        }
+    }
+    if (!lists || started < threads - 1) {
+        /* No threads to be had: the ranges not started, here. */
+        for (int t = started + 1; t < threads && lists; t++)
+            build_thread(lists + (size_t)t * (ranges + 1));
+        if (!lists)
+            for (size_t k = 0; k < ranges; k++)
+                build_splats_of(&R[k]);
+    }
+    if (lists)
+        build_thread(lists); /* thread 0's share, here */
+    for (int t = 1; t <= started; t++)
+        pthread_join(tid[t], NULL);
+    free(lists);
+}
+
+ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
+                         ps_splat_batch *b, ps_error *err)
+{
+    size_t per = p->mode == PS_SPLAT_TRIANGLES ? 3 : 1;
+    if (count > (SIZE_MAX / 4 - b->vertex_count) / per ||
+        !PS_RESERVE(b->positions, b->cap_pos, 3 * (b->vertex_count + per * count)) ||
+        !PS_RESERVE(b->colors, b->cap_col, 4 * (b->vertex_count + per * count)) ||
+        (per == 3 && !PS_RESERVE(b->texcoords, b->cap_tex, 2 * (b->vertex_count + per * count))) ||
+        (p->objects && !PS_RESERVE(b->group, b->cap_group, b->splats + count)))
+        return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
+    size_t first_splat = b->splats;
+    bool diffuse = p->levels > 0 && p->precision == PS_PRECISION_DIFFUSION;
+    if (diffuse && (!PS_RESERVE(b->order, b->cap_order, count) || !PS_RESERVE(b->order_tmp, b->cap_order_tmp, count)))
+        return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
+    size_t ranges = count ? (count + BUILD_RANGE - 1) / BUILD_RANGE : 0;
+    build_range *R = ranges ? calloc(ranges, sizeof *R) : NULL;
+    if (ranges && !R)
+        return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
+    for (size_t k = 0; k < ranges; k++) {
+        R[k].photons = photons;
+        R[k].materials = materials;
+        R[k].p = p;
+        R[k].b = b;
+        R[k].first = k * BUILD_RANGE;
+        R[k].end = k + 1 < ranges ? (k + 1) * BUILD_RANGE : count;
+        R[k].first_splat = first_splat;
+    }
+    run_ranges(R, ranges, p->threads);
+    /* Compaction: each range's splats down to where the ranges before it
+     * ended, in order; the diffusion order's places become final. */
+    size_t at = first_splat;
+    for (size_t k = 0; k < ranges; k++) {
+        size_t from = first_splat + R[k].first, n = R[k].splats;
+        if (from != at && n) {
+            memmove(b->positions + 3 * (b->vertex_count + (at - first_splat) * per),
+                    b->positions + 3 * (b->vertex_count + R[k].first * per), n * per * 3 * sizeof *b->positions);
+            memmove(b->colors + 4 * (b->vertex_count + (at - first_splat) * per),
+                    b->colors + 4 * (b->vertex_count + R[k].first * per), n * per * 4 * sizeof *b->colors);
+            if (per == 3)
+                memmove(b->texcoords + 2 * (b->vertex_count + (at - first_splat) * per),
+                        b->texcoords + 2 * (b->vertex_count + R[k].first * per), n * per * 2 * sizeof *b->texcoords);
+            if (p->objects)
+                memmove(b->group + at, b->group + from, n);
+            if (diffuse)
+                memmove(b->order + (at - first_splat), b->order + (from - first_splat), n * sizeof *b->order);
+        }
+        if (diffuse)
+            for (size_t q = 0; q < n; q++)
+                b->order[at - first_splat + q] |= (uint64_t)(at - first_splat + q);
+        b->wanted += R[k].wanted;
+        b->lost += R[k].lost;
+        at += n;
+    }
+    free(R);
+    b->vertex_count += (at - first_splat) * per;
+    b->splats = at;
     if (diffuse)
         diffuse_in_screen_order(b, p, first_splat, per);
     if (p->objects && !group_splats(b, first_splat, per))

@@ -108,6 +108,7 @@ typedef struct ps_splat_params {
      * whatever lies behind its edge. */
     const uint32_t *objects;
     ps_camera_frame cam;
+    int threads;        /* building threads; 0: one a core (the same bytes either way) */
 } ps_splat_params;
 
 /* Stencil values 1..255 stand for objects (0 is "no object"); with more than
