@@ -15,11 +15,13 @@
  *  - whole: every refresh splats every photon that has arrived, scaled for
  *    display (exposure N / n) into layers cleared first. What an 8-bit
  *    colour buffer needs (thesis 5.1: faint photons must be drawn at their
- *    displayed value, or they round away), and what photosplat-snap does.
+ *    displayed value, or they round away), and photosplat-snap's single
+ *    frame of a fixed photon count.
  *  - incremental: layers keep their float sums between refreshes; a refresh
  *    splats only the batches not drawn yet, at their stored power, at most
  *    the budget's worth, and the composite scales each map by exposure N / n.
- *    The window's float layers.
+ *    Float buffers in progressive mode: the window's layers, and
+ *    photosplat-snap --time.
  * Either way the photons drawn are a prefix of each map ending at a batch the
  * feed handed over, so the picture after n photons is the same picture
  * however fast they came. */
