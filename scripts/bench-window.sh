@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # bench-window.sh: the preview window's speed under Xvfb (make bench runs it):
 # frames per second while refining with 10^5 and 10^6 photons (the view
-# still, and orbiting every frame), and the time from a light move to the
+# still, orbiting every 0.05 s while tracing, and orbiting once the maps are
+# full: "orbit-full", the frame rate over every stored photon; the fps figure
+# is smoothed over the last few frames), and the time from a light move to the
 # first refreshed frame. Each run is made twice, the picture composited and
 # encoded by GL (the window's default) and, as the baseline measured in the
 # same run, read back and encoded on the CPU (--composite cpu): the last
@@ -32,6 +34,12 @@ orbit_lines() { # an orbit step every 0.05 s for 4 s, then quit
     for t in $(seq 0.5 0.05 4.5); do echo "$t orbit 2 0"; done
     echo "4.6 quit"
 }
+full_orbit_lines() { # the same once both maps are full (wait done): orbiting over every photon
+    local t
+    echo "0 wait done"
+    for t in $(seq 0.05 0.05 3); do echo "$t orbit 2 0"; done
+    echo "3.1 quit"
+}
 
 echo "| photons (caustic + global) | view | fps | frames | emitted by the end | composite ms (GL) | composite ms (CPU read-back) | fps (CPU read-back) |"
 echo "| ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: |"
@@ -39,7 +47,9 @@ for n in 100000 1000000; do
     run still-$n $n "4.5 quit"
     mapfile -t lines < <(orbit_lines)
     run orbit-$n $n "${lines[@]}"
-    for view in still orbit; do
+    mapfile -t lines < <(full_orbit_lines)
+    run orbit-full-$n $n "${lines[@]}"
+    for view in still orbit orbit-full; do
         f=$tmp/$view-$n.json
         c=$tmp/$view-$n-cpu.json
         printf '| %d + %d | %s | %.1f | %s | %s | %s | %s | %.1f |\n' $n $((n / 4)) "$view" "$(stat_of fps "$f")" \

@@ -374,6 +374,42 @@ static void radius_follows_the_schedule(void **state)
     ps_scene_destroy(scene);
 }
 
+/* A moving camera (incremental): each refresh with a new camera is a level
+ * of detail (a prefix of the budget's share, its radius grown for the
+ * photons left out); the first refresh with the camera still starts over at
+ * full detail. */
+static void moving_camera_level_of_detail(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = 4 * PS_FEED_BATCH;
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    assert_false(f.moving); /* the first view is no move */
+    ps_session_drawn(s, 100.0); /* slow: the budget at its floor, a batch a refresh */
+    wait_ended(s);
+    cam.eye.x += 0.05;
+    refresh(s, &cam, &f);
+    assert_true(f.moving);
+    assert_true(f.new_view);
+    /* One batch of the four that arrived: the radius grown by sqrt(4) = 2. */
+    assert_int_equal(f.emitted[PS_MAP_CAUSTIC], PS_FEED_BATCH);
+    assert_near(f.map[PS_MAP_CAUSTIC].radius, 2.0 * set.radius[PS_MAP_CAUSTIC], 1e-12);
+    assert_near(f.map[PS_MAP_CAUSTIC].gain, EXPOSURE * 4.0, 1e-12);
+    /* Still: full detail again, from a new view. */
+    refresh(s, &cam, &f);
+    assert_false(f.moving);
+    assert_true(f.new_view);
+    assert_near(f.map[PS_MAP_CAUSTIC].radius, set.radius[PS_MAP_CAUSTIC], 1e-12);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 /* Progressive area lights: the first refresh with one virtual light an area
  * light, then 2 x 2, then all 16, each change said (lights_changed); an
  * edit starts over at one; without the setting, 16 from the start. */
@@ -423,6 +459,7 @@ int main(void)
         cmocka_unit_test(hidden_layers_are_skipped),
         cmocka_unit_test(radius_follows_the_schedule),
         cmocka_unit_test(area_lights_refine),
+        cmocka_unit_test(moving_camera_level_of_detail),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

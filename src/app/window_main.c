@@ -899,8 +899,14 @@ static ps_status session(app *a, ps_error *err)
             break;
         }
         double now = ps_now_seconds();
-        if (now < next && !a->redraw && !ps_session_edited(a->session))
-            glfwWaitEventsTimeout(next - now);
+        /* Asleep until the next refresh, an input event, or the script's
+         * next action (a scripted camera step every 0.05 s is due then, not
+         * at the next tau). */
+        double wake = next;
+        if (a->script && a->frames > 0 && !a->script_waiting && a->script_next < ps_script_count(a->script))
+            wake = fmin(wake, a->t_first_frame + a->script_delay + ps_script_at(a->script, a->script_next)->time);
+        if (now < wake && !a->redraw && !ps_session_edited(a->session))
+            glfwWaitEventsTimeout(wake - now);
         else
             glfwPollEvents();
         /* Script actions that are due, in order; times count from the first frame. */

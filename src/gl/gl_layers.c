@@ -121,7 +121,15 @@ static void add_texture(GLuint t, double gain)
 void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f)
 {
     if (f->new_view) {
+        /* While the camera moves, the direct layer's level of detail: no
+         * shadow passes (one pass a light instead of one a lit cube face,
+         * most of a moving frame's time); they come back with the full view
+         * when the camera stops. */
+        bool shadows = r->opt.shadows;
+        if (f->moving)
+            r->opt.shadows = false;
         ps_gl_layers_view(l, r, cam, f->direct_exposure, f->direct);
+        r->opt.shadows = shadows;
     } else if (f->lights_changed) {
         /* New lights, the same view: only the direct layer again. Its pass
          * redraws the shared depth prepass too, the same depths, so the map

@@ -33,6 +33,7 @@ struct ps_session {
     double last_build;     /* ... in this many seconds */
     double round_off;
     bool have_cam, view_dirty;
+    bool moving;           /* the last refresh had a new camera: a level of detail */
     ps_camera_frame cam;
     bool edited, geometry_edited;
     uint64_t edits;
@@ -277,6 +278,7 @@ static bool same_camera(const ps_camera_frame *a, const ps_camera_frame *b)
  * emitted for that prefix, which its splats are scaled by. Under the lock. */
 static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emitted, uint64_t *emitted)
 {
+    double budget = s->moving ? s->budget * PS_SESSION_MOVING_SHARE : s->budget;
     size_t n;
     const ps_feed_mark *m = ps_feed_marks(s->feed, (ps_map_kind)k, &n);
     size_t end = from;
@@ -284,7 +286,7 @@ static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emit
     for (size_t i = 0; i < n; i++) {
         if (m[i].stored < from || m[i].emitted < *emitted)
             continue;
-        bool over = incremental(s) && (double)(m[i].stored - from) > s->budget;
+        bool over = incremental(s) && (double)(m[i].stored - from) > budget;
         if (over && end > from)
             break;
         end = m[i].stored;
@@ -309,12 +311,19 @@ static double radius_at(const ps_session *s, int k, uint64_t emitted)
 ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_session_frame *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
+    bool inc = incremental(s);
     if (!s->have_cam || !same_camera(cam, &s->cam)) {
+        /* A camera move (not the first view): draw the level of detail. */
+        s->moving = inc && s->have_cam;
         s->cam = *cam;
         s->have_cam = true;
         s->view_dirty = true;
+    } else if (s->moving) {
+        /* Still again: the view starts over at full detail. */
+        s->moving = false;
+        s->view_dirty = true;
     }
-    bool inc = incremental(s);
+    out->moving = s->moving;
     if (s->lights_pending) {
         s->lights_pending = false;
         ps_status lst = build_lights(s, err);
@@ -355,6 +364,13 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         memset(&p, 0, sizeof p);
         p.mode = s->set.splat;
         s->splat_radius[k] = radius_at(s, k, emitted);
+        if (s->moving) {
+            /* The level of detail: as many photons' worth of cover as have arrived. */
+            size_t nm;
+            const ps_feed_mark *mk = ps_feed_marks(s->feed, (ps_map_kind)k, &nm);
+            double arrived = nm ? (double)mk[nm - 1].emitted : (double)emitted;
+            s->splat_radius[k] *= fmin(PS_RADIUS_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
+        }
         p.radius = s->splat_radius[k];
         p.kernel_mean = s->kernel.mean;
         p.kernel_extent = s->kernel.extent;

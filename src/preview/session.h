@@ -52,6 +52,13 @@
 #define PS_SESSION_SPLAT_TIME_SHARE 0.5
 #define PS_SESSION_BUDGET_MIN 2048
 #define PS_SESSION_BUDGET_START 16384
+/* While the camera moves (a new camera every refresh), an incremental
+ * refresh draws a level of detail: this share of the budget (still at least
+ * one batch: a prefix of each map, which in index order is an unbiased subset
+ * scaled by N / n), its splats' radius grown by sqrt(arrived / drawn) (at
+ * most PS_RADIUS_GROWTH_MAX) so that the fewer photons still cover; the
+ * first refresh with the camera still starts the view over in full. */
+#define PS_SESSION_MOVING_SHARE 0.25
 
 typedef struct ps_session_settings {
     /* The photons. */
@@ -151,6 +158,7 @@ typedef struct ps_session_frame {
     ps_session_layer map[PS_MAP_COUNT];
     ps_splat_mode splat;
     double point_size;
+    bool moving;             /* the camera moved: this picture is the level of detail */
     uint64_t emitted[PS_MAP_COUNT]; /* the photons emitted that this picture shows */
     size_t splats;           /* splats built this refresh */
     double round_off;        /* 8 bits: the fraction of this refresh's splat energy rounded away */
