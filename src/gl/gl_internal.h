@@ -48,8 +48,13 @@ ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err); /* new lights: s
 void ps_gl_lights_free(ps_gl_renderer *r);
 void ps_gl_make_spot_texture(ps_gl_renderer *r);
 void ps_gl_make_shadow_maps(ps_gl_renderer *r);
-/* Each GL light's pass added to the frame, times exposure, then emissive faces. */
-void ps_gl_draw_direct(ps_gl_renderer *r, double exposure);
+/* Each GL light's pass added to the frame, times exposure, then emissive
+ * faces; shadows: through the shadow cubes (else one pass a light). */
+void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows);
+/* ps_gl_begin_frame with the shadows said here instead of by the options
+ * (the window's moving camera draws without them). */
+void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
+                               bool shadows);
 /* Area lights as the eye sees them, in their radiance times exposure, or
  * black when the direct layer is off. */
 void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct);

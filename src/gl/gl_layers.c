@@ -72,15 +72,22 @@ void ps_gl_layers_destroy(ps_gl_layers *l)
     free(l);
 }
 
-void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
+/* A new view, the direct layer's shadows as said. */
+static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
+                     bool shadows)
 {
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_DIRECT_TEX]);
-    ps_gl_begin_frame(r, cam, exposure, direct);
+    ps_gl_begin_frame_shadows(r, cam, exposure, direct, shadows);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_gl_layers_clear_map(l, k);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
+void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
+{
+    new_view(l, r, cam, exposure, direct, r->opt.shadows);
 }
 
 void ps_gl_layers_clear_map(ps_gl_layers *l, int map)
@@ -125,11 +132,7 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
          * shadow passes (one pass a light instead of one a lit cube face,
          * most of a moving frame's time); they come back with the full view
          * when the camera stops. */
-        bool shadows = r->opt.shadows;
-        if (f->moving)
-            r->opt.shadows = false;
-        ps_gl_layers_view(l, r, cam, f->direct_exposure, f->direct);
-        r->opt.shadows = shadows;
+        new_view(l, r, cam, f->direct_exposure, f->direct, r->opt.shadows && !f->moving);
     } else if (f->lights_changed) {
         /* New lights, the same view: only the direct layer again. Its pass
          * redraws the shared depth prepass too, the same depths, so the map

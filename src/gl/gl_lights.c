@@ -348,7 +348,7 @@ static void disable_texgen(void)
     glDisable(GL_TEXTURE_GEN_Q);
 }
 
-void ps_gl_draw_direct(ps_gl_renderer *r, double exposure)
+void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows)
 {
     glEnable(GL_LIGHTING);
     glEnable(GL_LIGHT0);
@@ -367,7 +367,7 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure)
             begin_spot(r, v);
         if (profile)
             begin_profile(r, v);
-        if (!r->opt.shadows) {
+        if (!shadows) {
             ps_gl_draw_mesh(r, true, false);
             r->stats.light_passes++;
             if (spot)

@@ -115,8 +115,14 @@ void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil)
 
 void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
 {
+    ps_gl_begin_frame_shadows(r, cam, exposure, direct, r->opt.shadows);
+}
+
+void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
+                               bool shadows)
+{
     r->stats.light_passes = 0;
-    if (direct && r->opt.shadows && !r->shadows_valid)
+    if (direct && shadows && !r->shadows_valid)
         ps_gl_make_shadow_maps(r);
     r->width = cam->width;
     r->height = cam->height;
@@ -170,7 +176,7 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
         glDepthFunc(GL_LEQUAL);
         glEnable(GL_BLEND);
         glBlendFunc(GL_ONE, GL_ONE);
-        ps_gl_draw_direct(r, exposure);
+        ps_gl_draw_direct(r, exposure, shadows);
         glDisable(GL_BLEND);
     }
     ps_gl_draw_emitters(r, exposure, direct);

@@ -595,7 +595,6 @@ uint64_t ps_session_edits(const ps_session *s) { return s->edits; }
 ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error *err)
 {
     changes->geometry = s->geometry_edited;
-    changes->lights = true;
     /* Every edit restarts both maps from photon 0 (thesis 4.1.4): the tracer's
      * caustic cones follow lights and objects. */
     free_maps(s);

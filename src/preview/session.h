@@ -216,8 +216,7 @@ ps_status ps_session_set_spot_angle(ps_session *s, size_t light, double degrees,
 
 /* What ps_session_update rebuilt, for the drawing side to follow. */
 typedef struct ps_session_changes {
-    bool geometry; /* meshes and lights are new (ps_session_mesh, _coarse_mesh, _lights) */
-    bool lights;   /* lights are new */
+    bool geometry; /* meshes are new (ps_session_mesh, _coarse_mesh); the lights always are */
 } ps_session_changes;
 /* Whether edits wait for ps_session_update. */
 bool ps_session_edited(const ps_session *s);
