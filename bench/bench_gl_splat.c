@@ -128,7 +128,7 @@ static int build_frame(bench_gl *g, first_picture *fp, ps_error *err)
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_splat_batch *b = &fp->batch[k];
         ps_splat_batch_clear(b);
-        b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
+        ps_splat_batch_reset_carry(b);
         const ps_photon_map *m = &fp->maps[k];
         if (m->count == 0 || m->counters.emitted == 0)
             continue;
@@ -380,7 +380,7 @@ static ps_status build(const bench_gl *g, const ps_photon_map *m, size_t n, ps_s
     /* A whole frame from scratch, as snap builds each refresh: the same
      * photons give the same arrays every repetition. */
     ps_splat_batch_clear(b);
-    b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
+    ps_splat_batch_reset_carry(b);
     b->wanted = b->lost = 0.0;
     return ps_splat_build(m->photons, m->materials, n, &p, b, err);
 }

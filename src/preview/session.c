@@ -349,7 +349,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         /* A whole refresh is built afresh, so its round-off carry starts at 0:
          * the same photons give the same picture. Incremental layers are
          * float, where nothing rounds. */
-        b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
+        ps_splat_batch_reset_carry(b);
         b->wanted = b->lost = 0.0;
         const ps_photon_map *m = &maps[k];
         size_t from = inc ? s->drawn[k] : 0;

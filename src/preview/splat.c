@@ -111,6 +111,16 @@ void ps_splat_batch_clear(ps_splat_batch *b)
     b->grouped = false;
 }
 
+void ps_splat_batch_reset_carry(ps_splat_batch *b) { memset(b->carry, 0, sizeof b->carry); }
+
+double ps_splat_batch_carry(const ps_splat_batch *b, int ch)
+{
+    double sum = 0.0;
+    for (int g = 0; g < PS_SPLAT_DIFFUSION_REGIONS; g++)
+        sum += b->carry[g][ch];
+    return sum;
+}
+
 /* Reorders the splats [first, splats) by stencil value (a stable counting
  * sort, so error diffusion's order within a group is kept) and records where
  * each group starts. */
@@ -231,10 +241,10 @@ static uint32_t z_side(const ps_camera_frame *cam, int *key_bits)
  * screen, a noise of its own. Carried along a Z-order curve over the splats'
  * pixels instead (as Riemersma's dither carries along a Hilbert curve), the
  * photons that carry a code lie evenly over the screen, and the round-off of
- * any region of it is under one code. The order is a stable sort of the
- * batch's splats by their keys (LSD radix on the key, the splat's place as
- * the tie-break), so the same photons always give the same picture. */
-/* Radix digits of the sort: 11 bits, two passes for images up to 2048 a side. */
+ * any stretch of the curve is under one code: the screen is carried as
+ * PS_SPLAT_DIFFUSION_REGIONS tiles, each on its own curve and carry, so that
+ * the tiles run on the cores (below). */
+/* Radix digits of the sort: 11 bits a pass. */
 #define SORT_PREFETCH 32
 #if defined(__GNUC__)
 #define PS_PREFETCH_WRITE(addr) __builtin_prefetch((addr), 1, 0)
@@ -242,30 +252,113 @@ static uint32_t z_side(const ps_camera_frame *cam, int *key_bits)
 #define PS_PREFETCH_WRITE(addr) ((void)(addr))
 #endif
 #define SORT_DIGIT_BITS 11
+/* The screen's 4 x 4 tiles are the Z-order's first 4 bits (splat.h). */
+#define REGION_BITS 4
 
-static void diffuse_in_screen_order(ps_splat_batch *b, const ps_splat_params *p, size_t first_splat, size_t per)
+/* Jobs 0..count-1 on up to `threads` threads (0: one a core), dealt
+ * round-robin; what a job does never depends on which thread runs it. */
+typedef void (*job_fn)(void *ctx, size_t job);
+typedef struct job_list {
+    job_fn fn;
+    void *ctx;
+    size_t first, step, count;
+} job_list;
+
+#define PS_SPLAT_MAX_THREADS 64
+
+static void *job_thread(void *arg)
 {
-    size_t n = b->splats - first_splat;
-    uint64_t *a = b->order, *t = b->order_tmp;
-    int key_bits;
-    (void)z_side(&p->cam, &key_bits);
+    const job_list *l = arg;
+    for (size_t j = l->first; j < l->count; j += l->step)
+        l->fn(l->ctx, j);
+    return NULL;
+}
+
+static void run_jobs(size_t count, int threads, job_fn fn, void *ctx)
+{
+    if (threads <= 0)
+        threads = ps_online_cores();
+    if (threads > PS_SPLAT_MAX_THREADS)
+        threads = PS_SPLAT_MAX_THREADS;
+    if ((size_t)threads > count)
+        threads = (int)count;
+    if (threads < 1)
+        threads = 1;
+    job_list lists[PS_SPLAT_MAX_THREADS];
+    pthread_t tid[PS_SPLAT_MAX_THREADS];
+    int started = 1; /* thread 0's share runs here */
+    for (int t = 0; t < threads; t++)
+        lists[t] = (job_list){fn, ctx, (size_t)t, (size_t)threads, count};
+    while (started < threads && pthread_create(&tid[started], NULL, job_thread, &lists[started]) == 0)
+        started++;
+    for (int t = started; t < threads; t++) /* no threads to be had: their shares here */
+        job_thread(&lists[t]);
+    job_thread(&lists[0]);
+    for (int t = 1; t < started; t++)
+        pthread_join(tid[t], NULL);
+}
+
+/* The diffusion's shared state: the sorted keys go from `a` to `t`, a region
+ * at a time (its splats' slice [start[g], start[g + 1]) of both). */
+typedef struct diffusion {
+    ps_splat_batch *b;
+    const ps_splat_params *p;
+    size_t per, v0;
+    int key_bits, region_bits;
+    uint64_t *a, *t;
+    size_t start[PS_SPLAT_DIFFUSION_REGIONS + 1];
+    /* Per build range: its splats' slice of `a` and where each region's of
+     * them go in `t` (the stable bucket pass). */
+    size_t ranges;
+    const size_t *range_at, *range_n;
+    size_t (*range_base)[PS_SPLAT_DIFFUSION_REGIONS];
+} diffusion;
+
+static unsigned region_of(const diffusion *d, uint64_t entry)
+{
+    return (unsigned)((entry >> 32) >> (d->key_bits - d->region_bits));
+}
+
+/* Bucket pass, one build range: its splats into their regions' slices of t,
+ * in order (stable). */
+static void bucket_range(void *ctx, size_t k)
+{
+    diffusion *d = ctx;
+    size_t base[PS_SPLAT_DIFFUSION_REGIONS];
+    memcpy(base, d->range_base[k], sizeof base);
+    const uint64_t *a = d->a + d->range_at[k];
+    for (size_t i = 0; i < d->range_n[k]; i++)
+        d->t[base[region_of(d, a[i])]++] = a[i];
+}
+
+/* One region: the rest of the key sorted (LSD radix, stable), then each
+ * splat's round-off carried into the next along the curve. */
+static void diffuse_region(void *ctx, size_t g)
+{
+    diffusion *d = ctx;
+    size_t n = d->start[g + 1] - d->start[g];
+    if (n == 0)
+        return;
+    uint64_t *a = d->t + d->start[g], *t = d->a + d->start[g];
     size_t count[(1 << SORT_DIGIT_BITS) + 1]; /* 16 KiB of stack */
-    for (int shift = 32; shift < 32 + key_bits; shift += SORT_DIGIT_BITS) { /* the key: the upper 32 bits */
-        const uint64_t mask = (1u << SORT_DIGIT_BITS) - 1;
+    int low_bits = d->key_bits - d->region_bits;
+    for (int shift = 32; shift < 32 + low_bits; shift += SORT_DIGIT_BITS) { /* the key: the upper 32 bits */
+        int bits = 32 + low_bits - shift < SORT_DIGIT_BITS ? 32 + low_bits - shift : SORT_DIGIT_BITS;
+        const uint64_t mask = ((uint64_t)1 << bits) - 1;
         memset(count, 0, sizeof count);
         for (size_t i = 0; i < n; i++)
             count[((a[i] >> shift) & mask) + 1]++;
-        for (size_t d = 0; d < mask + 1; d++)
-            count[d + 1] += count[d];
+        for (size_t v = 0; v < mask + 1; v++)
+            count[v + 1] += count[v];
         for (size_t i = 0; i < n; i++)
             t[count[(a[i] >> shift) & mask]++] = a[i];
         uint64_t *swap = a;
         a = t;
         t = swap;
     }
-    /* a holds the sorted keys (b->order or b->order_tmp, by the passes' parity). */
-    double carry[3] = {b->carry[0], b->carry[1], b->carry[2]}, L = p->levels;
-    size_t v0 = b->vertex_count - n * per;
+    ps_splat_batch *b = d->b;
+    double carry[3] = {b->carry[g][0], b->carry[g][1], b->carry[g][2]}, L = d->p->levels;
+    size_t per = d->per, v0 = d->v0;
     for (size_t i = 0; i < n; i++) {
         /* The colours are read in screen order, scattered over the array:
          * ask for one a few dozen ahead, so that the wait overlaps (it is
@@ -283,7 +376,51 @@ static void diffuse_in_screen_order(ps_splat_batch *b, const ps_splat_params *p,
         for (size_t k = 1; k < per; k++)
             memcpy(&b->colors[4 * (v + k)], rgba, 4 * sizeof *rgba);
     }
-    memcpy(b->carry, carry, sizeof carry);
+    memcpy(b->carry[g], carry, sizeof carry);
+}
+
+/* The order is a stable sort of the splats by their keys (the splat's place
+ * as the tie-break), so the same photons always give the same picture. It is
+ * sorted a region at a time: a stable bucket pass on the key's first
+ * REGION_BITS (each build range's splats on a thread), then each region's
+ * rest of the key and its carry on a thread. Each region carries its own
+ * round-off (b->carry[g]): the regions are fixed by the screen, not the
+ * threads, so the bytes are the same for any thread count. */
+static void diffuse_in_screen_order(ps_splat_batch *b, const ps_splat_params *p, size_t first_splat, size_t per,
+                                    const size_t *range_at, const size_t *range_n,
+                                    size_t (*range_count)[PS_SPLAT_DIFFUSION_REGIONS], size_t ranges)
+{
+    diffusion d;
+    memset(&d, 0, sizeof d);
+    d.b = b;
+    d.p = p;
+    d.per = per;
+    size_t n = b->splats - first_splat;
+    d.v0 = b->vertex_count - n * per;
+    (void)z_side(&p->cam, &d.key_bits);
+    d.region_bits = d.key_bits < REGION_BITS ? d.key_bits : REGION_BITS;
+    d.a = b->order;
+    d.t = b->order_tmp;
+    d.ranges = ranges;
+    d.range_at = range_at;
+    d.range_n = range_n;
+    d.range_base = range_count; /* turned into bases in place */
+    size_t regions = (size_t)1 << d.region_bits;
+    /* Region g's slice starts after every region before it; range k's
+     * share of it after the ranges before k. */
+    size_t at = 0;
+    for (size_t g = 0; g < regions; g++) {
+        d.start[g] = at;
+        for (size_t k = 0; k < ranges; k++) {
+            size_t c = range_count[k][g];
+            range_count[k][g] = at;
+            at += c;
+        }
+    }
+    for (size_t g = regions; g <= PS_SPLAT_DIFFUSION_REGIONS; g++)
+        d.start[g] = at;
+    run_jobs(ranges, p->threads, bucket_range, &d);
+    run_jobs(regions, p->threads, diffuse_region, &d);
 }
 
 /* Photons are built in ranges of this many, on as many threads as there are
@@ -291,7 +428,6 @@ static void diffuse_in_screen_order(ps_splat_batch *b, const ps_splat_params *p,
  * and then moved down in range order, and its round-off counts are added in
  * range order, so the result is the same bytes for any number of threads. */
 #define BUILD_RANGE 65536
-#define PS_SPLAT_MAX_THREADS 64
 
 typedef struct build_range {
     const ps_photon *photons;
@@ -302,6 +438,7 @@ typedef struct build_range {
     size_t first_splat;    /* the batch's splats before this build */
     size_t splats;         /* written by this range */
     double wanted, lost;   /* the counter's sums over this range */
+    size_t regions[PS_SPLAT_DIFFUSION_REGIONS]; /* diffusion: its splats in each screen tile */
 } build_range;
 
 /* The counter: send as is, and count what the buffer will round away. */
@@ -328,6 +465,7 @@ static void build_splats_of(build_range *R)
     double L = p->levels;
     int key_bits;
     uint32_t zside = z_side(cam, &key_bits);
+    int region_bits = key_bits < REGION_BITS ? key_bits : REGION_BITS;
     /* World size of one pixel at unit depth along the view axis. */
     double pixel = 2.0 * cam->tan_half_fov / cam->height;
     for (size_t i = R->first; i < R->end; i++) {
@@ -388,7 +526,9 @@ static void build_splats_of(build_range *R)
             /* Rounded below, in screen order; the exact colour till then. */
             double px = 0.0, py = 0.0;
             (void)ps_camera_project(cam, centre, &px, &py);
-            b->order[sp - first_splat] = (uint64_t)z_order(px, py, zside) << 32; /* the place: when compacted */
+            uint32_t key = z_order(px, py, zside);
+            b->order[sp - first_splat] = (uint64_t)key << 32; /* the place: when compacted */
+            R->regions[key >> (key_bits - region_bits)]++;
         }
         size_t v = v0 + R->splats * per;
         if (p->mode == PS_SPLAT_TRIANGLES) {
@@ -421,59 +561,7 @@ static void build_splats_of(build_range *R)
     }
 }
 
-static void *build_thread(void *arg)
-{
-    build_range **next = arg; /* a NULL-terminated list of this thread's ranges */
-    for (; *next; next++)
-        build_splats_of(*next);
-    return NULL;
-}
-
-/* The ranges on the cores (one thread: here). */
-static void run_ranges(build_range *R, size_t ranges, int threads)
-{
-    if (threads <= 0)
-        threads = ps_online_cores();
-    if (threads > PS_SPLAT_MAX_THREADS)
-        threads = PS_SPLAT_MAX_THREADS;
-    if ((size_t)threads > ranges)
-        threads = (int)ranges;
-    if (threads <= 1) {
-        for (size_t k = 0; k < ranges; k++)
-            build_splats_of(&R[k]);
-        return;
-    }
-    /* Ranges dealt round-robin: thread t takes t, t + threads, ... */
-    build_range **lists = calloc((size_t)threads * (ranges + 1), sizeof *lists);
-    pthread_t tid[PS_SPLAT_MAX_THREADS];
-    int started = 0;
-    if (lists) {
-        for (int t = 0; t < threads; t++) {
-            build_range **l = lists + (size_t)t * (ranges + 1);
-            size_t m = 0;
-            for (size_t k = (size_t)t; k < ranges; k += (size_t)threads)
-                l[m++] = &R[k];
-            l[m] = NULL;
-            if (t > 0 && pthread_create(&tid[t], NULL, build_thread, l) == 0)
-                started = t;
-            else if (t > 0)
-                break;
-        }
-    }
-    if (!lists || started < threads - 1) {
-        /* No threads to be had: the ranges not started, here. */
-        for (int t = started + 1; t < threads && lists; t++)
-            build_thread(lists + (size_t)t * (ranges + 1));
-        if (!lists)
-            for (size_t k = 0; k < ranges; k++)
-                build_splats_of(&R[k]);
-    }
-    if (lists)
-        build_thread(lists); /* thread 0's share, here */
-    for (int t = 1; t <= started; t++)
-        pthread_join(tid[t], NULL);
-    free(lists);
-}
+static void build_range_job(void *ctx, size_t k) { build_splats_of(&((build_range *)ctx)[k]); }
 
 ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
                          ps_splat_batch *b, ps_error *err)
@@ -502,7 +590,15 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
         R[k].end = k + 1 < ranges ? (k + 1) * BUILD_RANGE : count;
         R[k].first_splat = first_splat;
     }
-    run_ranges(R, ranges, p->threads);
+    size_t *range_at = NULL, *range_n = NULL;
+    size_t(*range_regions)[PS_SPLAT_DIFFUSION_REGIONS] = NULL;
+    if (diffuse && ranges &&
+        (!(range_at = calloc(ranges, sizeof *range_at)) || !(range_n = calloc(ranges, sizeof *range_n)) ||
+         !(range_regions = calloc(ranges, sizeof *range_regions)))) {
+        free(R), free(range_at), free(range_n), free(range_regions);
+        return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
+    }
+    run_jobs(ranges, p->threads, build_range_job, R);
     /* Compaction: each range's splats down to where the ranges before it
      * ended, in order; the diffusion order's places become final. */
     size_t at = first_splat;
@@ -521,9 +617,13 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
             if (diffuse)
                 memmove(b->order + (at - first_splat), b->order + (from - first_splat), n * sizeof *b->order);
         }
-        if (diffuse)
+        if (diffuse) {
             for (size_t q = 0; q < n; q++)
                 b->order[at - first_splat + q] |= (uint64_t)(at - first_splat + q);
+            range_at[k] = at - first_splat;
+            range_n[k] = n;
+            memcpy(range_regions[k], R[k].regions, sizeof R[k].regions);
+        }
         b->wanted += R[k].wanted;
         b->lost += R[k].lost;
         at += n;
@@ -532,7 +632,8 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
     b->vertex_count += (at - first_splat) * per;
     b->splats = at;
     if (diffuse)
-        diffuse_in_screen_order(b, p, first_splat, per);
+        diffuse_in_screen_order(b, p, first_splat, per, range_at, range_n, range_regions, ranges);
+    free(range_at), free(range_n), free(range_regions);
     if (p->objects && !group_splats(b, first_splat, per))
         return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory grouping %zu photons", count);
     return PS_OK;

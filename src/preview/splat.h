@@ -128,6 +128,10 @@ static inline unsigned ps_splat_stencil(uint32_t object) { return object % (PS_S
  * tan held at this much (beyond, the surface is nearly edge-on). */
 #define PS_SPLAT_SPRITE_MAX_TAN 10.0
 
+/* Error diffusion carries round-off along a Z-order curve over the screen,
+ * in this many tiles (4 x 4), each with a carry of its own (splat.c). */
+#define PS_SPLAT_DIFFUSION_REGIONS 16
+
 /* Vertex arrays for glDrawArrays, and the precision bookkeeping of the photons
  * that went in. The carry persists across batches of the same map (clear it
  * when the map restarts); wanted/lost add up until cleared. */
@@ -146,7 +150,7 @@ typedef struct ps_splat_batch {
     size_t cap_group;
     uint64_t *order, *order_tmp; /* scratch: the diffusion's screen order (splat.c) */
     size_t cap_order, cap_order_tmp;
-    double carry[3];     /* diffusion: round-off not yet added */
+    double carry[PS_SPLAT_DIFFUSION_REGIONS][3]; /* diffusion: each tile's round-off not yet added */
     double wanted, lost; /* counter: colour asked for, and what rounding took (summed over channels) */
 } ps_splat_batch;
 
@@ -154,6 +158,11 @@ void ps_splat_batch_init(ps_splat_batch *b);
 void ps_splat_batch_free(ps_splat_batch *b);
 /* Empties the arrays; keeps carry and the counters. */
 void ps_splat_batch_clear(ps_splat_batch *b);
+/* Diffusion: forgets the round-off carried (a map that starts over). */
+void ps_splat_batch_reset_carry(ps_splat_batch *b);
+/* Diffusion: the round-off carried in channel ch, summed over the tiles
+ * (what the codes sent so far fall short of what was asked). */
+double ps_splat_batch_carry(const ps_splat_batch *b, int ch);
 
 /* Appends the splats of photons[0, count) (materials beside them). Photons on
  * a surface facing away from the eye are skipped: two-sided surfaces keep
