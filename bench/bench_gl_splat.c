@@ -7,7 +7,7 @@
  * median's ratio beside; each frame started by ps_gl_begin_frame with the
  * direct layer off, untimed, so the depth buffer holds the scene and the
  * colour buffer is black):
- *   build  ps_splat_build alone: the per-photon CPU work (one thread).
+ *   build  ps_splat_build alone: the per-photon CPU work (on every core).
  *   ours   ps_splat_build + ps_gl_draw_splats + glFinish: a whole splat frame.
  *   draw   the ps_gl_draw_splats + glFinish part of ours: our GL call on the
  *          arrays just built, without the CPU work (state changes included).
@@ -26,7 +26,7 @@
  * counted in neither rate); 10^5 is its first 10^5 photons, which in index
  * order (Halton) cover the same caustics more sparsely. Rates count splats
  * drawn. Compare ratios, not absolute numbers: these machines are noisy, and
- * llvmpipe rasterises on every core while the build runs on one. */
+ * llvmpipe and the build both use every core. */
 #include <GL/osmesa.h>
 #include <stdio.h>
 #include <math.h>
