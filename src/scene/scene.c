@@ -17,8 +17,10 @@
 ps_scene *ps_scene_alloc(void)
 {
     ps_scene *s = calloc(1, sizeof *s);
-    if (s)
+    if (s) {
         s->bounds = ps_aabb_empty();
+        s->note = PS_SOURCE_NONE;
+    }
     return s;
 }
 
@@ -64,6 +66,7 @@ static void record_edit(ps_scene *s, uint32_t object, uint32_t light, ps_vec3 v)
 }
 
 const char *ps_scene_path(const ps_scene *s) { return s->path; }
+const char *ps_scene_note(const ps_scene *s) { return ps_scene_string(s, s->note); }
 const ps_camera *ps_scene_camera(const ps_scene *s) { return &s->camera; }
 const ps_scene_defaults *ps_scene_get_defaults(const ps_scene *s) { return &s->defaults; }
 ps_aabb ps_scene_bounds(const ps_scene *s) { return s->bounds; }

@@ -66,6 +66,7 @@ struct ps_scene {
     PS_VEC(ps_light_source) light_src;
     PS_VEC(ps_scene_edit) edits;
     PS_VEC(char) strings;
+    uint32_t note; /* what the loader added, for the window (ps_scene_note), or PS_SOURCE_NONE */
 };
 
 /* The absolute form of path (realpath when it exists, else joined to the

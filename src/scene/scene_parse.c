@@ -49,6 +49,7 @@ typedef struct parser {
     char *tok[SCN_MAX_TOKENS];
     int ntok, pos;
     bool has_camera, has_image, has_photons, has_radius;
+    bool model; /* an .obj opened in place of a scene: camera and light made here (frame_model) */
     int64_t default_material; /* index, or -1 until first needed */
     /* What the statement being read records for ps_scene_write (scene_internal.h). */
     ps_object_source pending_obj;
@@ -1337,11 +1338,66 @@ static ps_status parse_one_line(void *user, char *text)
     return st == PS_OK ? record_statement(p, kw, materials, objects, lights) : st;
 }
 
+/* An .obj opened in place of a scene (contract): the camera frames the
+ * model's bounding box from the front (+z), a little above, fov 40, with the
+ * box's bounding sphere filling the view; with no emissive face, a point
+ * light above and behind the camera, bright enough that a white surface at
+ * the box's centre reflects a radiance of about 1 (irradiance pi W/m^2 per
+ * channel), named through the warning sink and kept for the window's
+ * overlay (ps_scene_note). */
+#define MODEL_ELEVATION_DEG 15.0
+#define MODEL_MARGIN 1.1         /* the sphere's radius over what just fits */
+#define MODEL_LIGHT_RAISE 0.5    /* above the eye, in bounding-sphere radii */
+static ps_status frame_model(parser *p)
+{
+    ps_scene *s = p->s;
+    ps_scene_finish(s);
+    ps_aabb b = s->bounds;
+    ps_vec3 c = ps_aabb_center(b);
+    double r = 0.5 * ps_v3_len(ps_aabb_diag(b));
+    if (!(r > 0.0) || !isfinite(r))
+        r = 1.0;
+    double half = 0.5 * DEFAULT_FOV_DEG * (PS_PI / 180.0), e = MODEL_ELEVATION_DEG * (PS_PI / 180.0);
+    double dist = MODEL_MARGIN * r / sin(half);
+    s->camera.eye = ps_v3_add(c, ps_v3(0.0, dist * sin(e), dist * cos(e)));
+    s->camera.target = c;
+    s->camera.up = ps_v3(0, 1, 0);
+    s->camera.fov_deg = DEFAULT_FOV_DEG;
+    p->has_camera = true;
+    if (s->lights.count > 0)
+        return PS_OK;
+    ps_light *l = PS_VEC_PUSH(s->lights);
+    ps_light_source *src = l ? PS_VEC_PUSH(s->light_src) : NULL;
+    ps_scene_stmt *stmt = src ? PS_VEC_PUSH(s->stmts) : NULL;
+    if (!stmt)
+        return ps_error_set(p->err, PS_ERR_NOMEM, "%s: out of memory", p->name);
+    l->type = PS_LIGHT_POINT;
+    l->line = 1;
+    l->position = ps_v3_add(s->camera.eye, ps_v3(0.0, MODEL_LIGHT_RAISE * r, 0.0));
+    double d2 = ps_v3_len2(ps_v3_sub(l->position, c));
+    /* E = P / (4 pi d^2) = pi at the centre. */
+    l->power = ps_rgb_gray(4.0 * PS_PI * PS_PI * d2);
+    if (!(ps_rgb_max(l->power) <= PS_SCENE_MAX_LIGHT_POWER))
+        return ps_error_set(p->err, PS_ERR_RANGE, "%s: the model is too large for a default light (%g W)", p->name,
+                            l->power.r);
+    *src = (ps_light_source){PS_SOURCE_NONE, {0, 0, 0}};
+    *stmt = (ps_scene_stmt){PS_STMT_LIGHT, (uint32_t)(s->lights.count - 1)};
+    char note[256];
+    snprintf(note, sizeof note, "default light 0: point at (%.3g %.3g %.3g), %.3g W (the model has no emitter)",
+             l->position.x, l->position.y, l->position.z, l->power.r);
+    if ((s->note = ps_scene_add_string(s, note)) == PS_SOURCE_NONE)
+        return ps_error_set(p->err, PS_ERR_NOMEM, "%s: out of memory", p->name);
+    ps_warn(p->warn, "%s: %s", p->name, note);
+    return PS_OK;
+}
+
 static ps_status parse_text(parser *p, const char *text, size_t len)
 {
     (void)len; /* NUL-free (checked by the caller), so the text ends at its NUL */
     ps_status st = ps_text_lines(text, p->name, SCN_LINE_MAX - 1, parse_one_line, p, &p->line, p->err);
     if (st != PS_OK)
+        return st;
+    if (p->model && (st = frame_model(p)) != PS_OK)
         return st;
     int last = p->line > 0 ? p->line : 1;
     if (!p->has_camera)
@@ -1360,7 +1416,7 @@ static ps_status parse_text(parser *p, const char *text, size_t len)
 
 /* Shared by both entry points; text has len bytes and a NUL after them. */
 static ps_status load_text(const char *text, size_t len, const char *name, const char *base_dir,
-                           const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
+                           const ps_scene_load_options *opts, bool model, ps_scene **out, ps_error *err)
 {
     *out = NULL;
     ps_error local;
@@ -1384,6 +1440,7 @@ static ps_status load_text(const char *text, size_t len, const char *name, const
     p.warn = opts ? &opts->warn : &to_stderr;
     p.err = err;
     p.default_material = -1;
+    p.model = model;
     p.s->defaults.caustic_photons = p.s->defaults.global_photons = -1; /* unset */
     int bin = ps_text_nul_line(text, len);
     ps_status st = bin ? ps_error_set(err, PS_ERR_PARSE, "%s:%d: binary data (a NUL byte), not a scene file", name, bin)
@@ -1401,7 +1458,14 @@ static ps_status load_text(const char *text, size_t len, const char *name, const
 ps_status ps_scene_load_text(const char *text, const char *name, const char *base_dir,
                              const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
 {
-    return load_text(text, strlen(text), name, base_dir, opts, out, err);
+    return load_text(text, strlen(text), name, base_dir, opts, false, out, err);
+}
+
+bool ps_scene_path_is_model(const char *path)
+{
+    size_t n = strlen(path);
+    return n > 4 && path[n - 4] == '.' && (path[n - 3] | 32) == 'o' && (path[n - 2] | 32) == 'b' &&
+           (path[n - 1] | 32) == 'j';
 }
 
 ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
@@ -1409,9 +1473,21 @@ ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_
     *out = NULL;
     char *text = NULL;
     size_t len = 0;
-    ps_status st = ps_read_file(path, SCN_MAX_BYTES, &text, &len, err);
-    if (st != PS_OK)
+    bool model = ps_scene_path_is_model(path);
+    ps_status st;
+    if (model) {
+        /* The model as a one-statement scene: `mesh "FILE"`, beside it. */
+        const char *slash = strrchr(path, '/');
+        const char *base = slash ? slash + 1 : path;
+        if (strchr(base, '"'))
+            return ps_error_set(err, PS_ERR_PARSE, "%s: a model's file name may not hold a double quote", path);
+        len = strlen(base) + sizeof "mesh \"\"\n";
+        if (!(text = malloc(len)))
+            return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
+        len = (size_t)snprintf(text, len, "mesh \"%s\"\n", base);
+    } else if ((st = ps_read_file(path, SCN_MAX_BYTES, &text, &len, err)) != PS_OK) {
         return st;
+    }
     char dir[4096];
     const char *slash = strrchr(path, '/');
     size_t dlen = slash ? (size_t)(slash - path) : 0;
@@ -1421,7 +1497,7 @@ ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_
         dlen = 0;
     memcpy(dir, path, dlen);
     dir[dlen] = '\0';
-    st = load_text(text, len, path, dir, opts, out, err);
+    st = load_text(text, len, path, dir, opts, model, out, err);
     free(text);
     return st;
 }

@@ -213,21 +213,10 @@ static char *output_dir(const char *path)
     return realpath(dir, NULL);
 }
 
-ps_status ps_scene_write(const ps_scene *scene, const char *path, ps_error *err)
+/* The statements to f, files relative to dir (absolute, resolved). */
+static ps_status write_scene(const ps_scene *scene, FILE *f, const char *dir, const char *name, ps_error *err)
 {
-    ps_error local;
-    if (!err)
-        err = &local;
-    ps_error_clear(err);
-    char *dir = output_dir(path);
-    if (!dir)
-        return ps_error_set(err, PS_ERR_IO, "%s: cannot write there: %s", path, strerror(errno));
-    ps_outfile *out = ps_outfile_open(path, err);
-    if (!out) {
-        free(dir);
-        return err->status;
-    }
-    writer w = {ps_outfile_stream(out), scene, dir, path, err, PS_OK};
+    writer w = {f, scene, dir, name, err, PS_OK};
     const ps_camera *c = &scene->camera;
     const ps_scene_defaults *d = &scene->defaults;
     fprintf(w.f, "# photosplat scene, saved from %s\n", scene->path ? scene->path : "(memory)");
@@ -252,10 +241,44 @@ ps_status ps_scene_write(const ps_scene *scene, const char *path, ps_error *err)
      * which the edits changed. */
     fprintf(w.f, "photons caustic %lld global %lld\n", (long long)d->caustic_photons, (long long)d->global_photons);
     fprintf(w.f, "radius caustic " NUM " global " NUM "\n", d->caustic_radius, d->global_radius);
+    return w.st;
+}
+
+ps_status ps_scene_write(const ps_scene *scene, const char *path, ps_error *err)
+{
+    ps_error local;
+    if (!err)
+        err = &local;
+    ps_error_clear(err);
+    char *dir = output_dir(path);
+    if (!dir)
+        return ps_error_set(err, PS_ERR_IO, "%s: cannot write there: %s", path, strerror(errno));
+    ps_outfile *out = ps_outfile_open(path, err);
+    if (!out) {
+        free(dir);
+        return err->status;
+    }
+    ps_status st = write_scene(scene, ps_outfile_stream(out), dir, path, err);
     free(dir);
-    if (w.st != PS_OK) {
+    if (st != PS_OK) {
         ps_outfile_abort(out);
-        return w.st;
+        return st;
     }
     return ps_outfile_commit(out, err);
+}
+
+ps_status ps_scene_print(const ps_scene *scene, FILE *f, ps_error *err)
+{
+    ps_error local;
+    if (!err)
+        err = &local;
+    ps_error_clear(err);
+    char *dir = realpath(".", NULL);
+    if (!dir)
+        return ps_error_set(err, PS_ERR_IO, "the current directory: %s", strerror(errno));
+    ps_status st = write_scene(scene, f, dir, "(standard output)", err);
+    free(dir);
+    if (st == PS_OK && (fflush(f) != 0 || ferror(f)))
+        st = ps_error_set(err, PS_ERR_IO, "standard output: write failed");
+    return st;
 }
