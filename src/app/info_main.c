@@ -8,6 +8,7 @@
 #include "app/cli.h"
 #include "scene/ies.h"
 #include "scene/scene.h"
+#include "scene/texture.h"
 
 static const char usage[] =
     "usage: photosplat-info SCENE.scn|MODEL.obj [--scene]\n"
@@ -65,6 +66,10 @@ static void describe(const ps_scene *s)
         }
         if (!ps_rgb_is_black(m->emission))
             printf(" emission %g %g %g", m->emission.r, m->emission.g, m->emission.b);
+        if (m->texture) {
+            const ps_texture *t = ps_scene_texture(s, m->texture - 1);
+            printf(" texture %s %dx%d", ps_texture_path(t), ps_texture_width(t), ps_texture_height(t));
+        }
         printf("\n");
     }
 

@@ -5,6 +5,7 @@
 
 #include "core/photometry.h"
 #include "scene/ies.h"
+#include "scene/texture.h"
 
 #include <inttypes.h>
 #include <stdarg.h>
@@ -39,6 +40,10 @@ void ps_scene_destroy(ps_scene *s)
     for (size_t k = 0; k < s->profiles.count; k++)
         ps_ies_destroy(s->profiles.items[k]);
     free(s->profiles.items);
+    free(s->texcoords.items);
+    for (size_t k = 0; k < s->textures.count; k++)
+        ps_texture_unref(s->textures.items[k]);
+    free(s->textures.items);
     free(s->stmts.items);
     free(s->obj_src.items);
     free(s->light_src.items);
@@ -85,6 +90,31 @@ const ps_triangle *ps_scene_triangles(const ps_scene *s, size_t *count) { VIEW(t
 const ps_object *ps_scene_objects(const ps_scene *s, size_t *count) { VIEW(objects); }
 const ps_light *ps_scene_lights(const ps_scene *s, size_t *count) { VIEW(lights); }
 const uint32_t *ps_scene_emitters(const ps_scene *s, size_t *count) { VIEW(emitters); }
+const ps_uv *ps_scene_texcoords(const ps_scene *s, size_t *count) { VIEW(texcoords); }
+const ps_texture *ps_scene_texture(const ps_scene *s, uint32_t k) { return s->textures.items[k]; }
+size_t ps_scene_texture_count(const ps_scene *s) { return s->textures.count; }
+
+bool ps_scene_uv_at(const ps_scene *s, uint32_t t, double b1, double b2, ps_uv *out)
+{
+    const ps_triangle *tr = &s->triangles.items[t];
+    if (tr->t[0] < 0) {
+        *out = (ps_uv){0.0, 0.0};
+        return false;
+    }
+    const ps_uv *a = &s->texcoords.items[tr->t[0]], *b = &s->texcoords.items[tr->t[1]],
+                *c = &s->texcoords.items[tr->t[2]];
+    double b0 = 1.0 - b1 - b2;
+    *out = (ps_uv){b0 * a->u + b1 * b->u + b2 * c->u, b0 * a->v + b1 * b->v + b2 * c->v};
+    return true;
+}
+
+ps_rgb ps_scene_albedo_at(const ps_scene *s, const ps_material *m, uint32_t triangle, double b1, double b2)
+{
+    ps_uv uv;
+    if (m->texture == 0 || triangle >= s->triangles.count || !ps_scene_uv_at(s, triangle, b1, b2, &uv))
+        return m->albedo;
+    return ps_rgb_mul(m->albedo, ps_texture_sample(s->textures.items[m->texture - 1], uv.u, uv.v));
+}
 
 static ps_vec3 tri_cross(const ps_scene *s, uint32_t t)
 {
@@ -444,6 +474,8 @@ ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err)
     DUP_VEC(lights);
     DUP_VEC(emitters);
     DUP_VEC(profiles);
+    DUP_VEC(texcoords);
+    DUP_VEC(textures);
     DUP_VEC(stmts);
     DUP_VEC(obj_src);
     DUP_VEC(light_src);
@@ -460,6 +492,10 @@ ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err)
         ps_error ignored;
         ok = ps_ies_clone(s->profiles.items[k], &c->profiles.items[k], &ignored) == PS_OK;
     }
+    if (!c->textures.items)
+        c->textures.count = 0;
+    for (size_t k = 0; k < c->textures.count; k++)
+        ps_texture_ref(c->textures.items[k]);
     if (!ok) {
         ps_scene_destroy(c); /* what was not copied is NULL */
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);

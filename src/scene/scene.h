@@ -58,6 +58,7 @@ typedef struct ps_material {
     double ior;           /* dielectric: index of refraction inside, air outside */
     ps_rgb transmittance; /* dielectric: colour of refracted light (1 = clear) */
     ps_rgb emission;      /* emitted radiance (MTL Ke), zero for non-emitters */
+    uint32_t texture;     /* MTL map_Kd: 0 none, else ps_scene_texture(s, texture - 1) times albedo */
 } ps_material;
 
 /* Mirrors and dielectrics: what caustic photons are aimed at. */
@@ -72,6 +73,7 @@ static inline int ps_material_is_specular(const ps_material *m)
 typedef struct ps_triangle {
     uint32_t v[3];   /* indices into ps_scene_positions */
     int32_t n[3];    /* indices into ps_scene_normals, or -1: use the face normal */
+    int32_t t[3];    /* indices into ps_scene_texcoords, or -1 (all three or none) */
     uint32_t material;
     uint32_t object;
 } ps_triangle;
@@ -137,6 +139,12 @@ typedef struct ps_scene_defaults {
 } ps_scene_defaults;
 
 typedef struct ps_scene ps_scene;
+struct ps_texture;
+
+/* OBJ texture coordinates (vt). */
+typedef struct ps_uv {
+    double u, v;
+} ps_uv;
 
 typedef struct ps_scene_load_options {
     ps_warn_sink warn; /* where warnings go ({NULL, NULL}: stderr) */
@@ -175,6 +183,21 @@ const ps_vec3 *ps_scene_normals(const ps_scene *s, size_t *count); /* unit lengt
 const ps_triangle *ps_scene_triangles(const ps_scene *s, size_t *count);
 const ps_object *ps_scene_objects(const ps_scene *s, size_t *count);
 const ps_light *ps_scene_lights(const ps_scene *s, size_t *count);
+const ps_uv *ps_scene_texcoords(const ps_scene *s, size_t *count);
+/* Texture k (ps_material.texture - 1), shared with the scene's clones. */
+const struct ps_texture *ps_scene_texture(const ps_scene *s, uint32_t k);
+size_t ps_scene_texture_count(const ps_scene *s);
+/* The texture coordinates at barycentric (b1, b2) of triangle t; false
+ * (and 0, 0) when the triangle has none. */
+bool ps_scene_uv_at(const ps_scene *s, uint32_t t, double b1, double b2, ps_uv *out);
+/* The diffuse albedo of material m at a surface point: its albedo, times
+ * its texture at the point's texture coordinates when it has one and the
+ * point is on a triangle with coordinates (triangle: the scene triangle, or
+ * UINT32_MAX for a sphere). The one place every renderer asks (the photon
+ * tracer's reflection, the reference renderer, the preview's splats and
+ * illumination maps). */
+ps_rgb ps_scene_albedo_at(const ps_scene *s, const ps_material *m, uint32_t triangle, double b1, double b2);
+
 /* Triangle indices of the faces of PS_LIGHT_MESH lights. */
 const uint32_t *ps_scene_emitters(const ps_scene *s, size_t *count);
 

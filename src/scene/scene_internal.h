@@ -60,6 +60,9 @@ struct ps_scene {
     PS_VEC(ps_light) lights;
     PS_VEC(uint32_t) emitters;
     PS_VEC(struct ps_ies *) profiles; /* owned: the IES lights' tables */
+    PS_VEC(ps_uv) texcoords;
+    PS_VEC(struct ps_texture *) textures; /* one reference each (texture.h) */
+    uint64_t texture_bytes;               /* planned, ps_texture_bytes summed */
     /* The source (see above): obj_src parallel to objects, light_src to lights. */
     PS_VEC(ps_scene_stmt) stmts;
     PS_VEC(ps_object_source) obj_src;

@@ -16,6 +16,7 @@
 #include "scene/ies.h"
 #include "scene/obj.h"
 #include "scene/scene_internal.h"
+#include "scene/texture.h"
 
 #define SCN_MAX_BYTES ((size_t)64 << 20)
 #define SCN_LINE_MAX 4096
@@ -488,6 +489,7 @@ static ps_status parse_quad(parser *p)
         for (int k = 0; k < 3; k++) {
             tr->v[k] = base + corners[t][k];
             tr->n[k] = -1;
+            tr->t[k] = -1;
         }
         tr->material = mat;
         tr->object = (uint32_t)(s->objects.count - 1);
@@ -520,6 +522,42 @@ static ps_status parse_sphere(parser *p)
 typedef struct warn_relay {
     const ps_warn_sink *to;
 } warn_relay;
+
+/* An MTL's map_Kd, relative to the OBJ's directory (where its MTL files
+ * are): 1 + its index in the scene's textures, shared by every material
+ * naming the same file; 0, with a warning naming it, when it cannot be read
+ * (the plain albedo then). */
+static uint32_t load_texture(parser *p, const char *obj_path, const ps_obj_material *om)
+{
+    ps_scene *s = p->s;
+    char path[4096];
+    const char *slash = strrchr(obj_path, '/');
+    /* Exporters on Windows write backslashes. */
+    char file[PS_OBJ_PATH_MAX];
+    snprintf(file, sizeof file, "%s", om->map_kd);
+    for (char *c = file; *c; c++)
+        if (*c == '\\')
+            *c = '/';
+    if (file[0] == '/' || !slash)
+        snprintf(path, sizeof path, "%s", file);
+    else
+        snprintf(path, sizeof path, "%.*s/%s", (int)(slash - obj_path), obj_path, file);
+    for (size_t k = 0; k < s->textures.count; k++)
+        if (!strcmp(ps_texture_path(s->textures.items[k]), path))
+            return (uint32_t)k + 1;
+    ps_texture *t = NULL;
+    ps_error terr;
+    ps_error_set(&terr, PS_ERR_NOMEM, "out of memory");
+    if (!PS_RESERVE(s->textures.items, s->textures.cap, s->textures.count + 1) ||
+        ps_texture_load(path, s->texture_bytes, &t, &terr) != PS_OK) {
+        ps_warn(p->warn, "%s: material '%s': texture %s not used (%s); its plain albedo instead", obj_path, om->name,
+                om->map_kd, terr.msg);
+        return 0;
+    }
+    s->textures.items[s->textures.count++] = t;
+    s->texture_bytes += ps_texture_bytes(t);
+    return (uint32_t)s->textures.count;
+}
 
 /* MTL → material, following the contract's mapping. Values the MTL format
  * allows but physics does not (Kd + Ks > 1) are scaled down with a warning:
@@ -559,6 +597,8 @@ static void map_mtl(parser *p, const char *obj_path, const ps_obj_material *om, 
         }
         m->albedo = kd;
         m->specular = ks;
+        if (om->map_kd[0])
+            m->texture = load_texture(p, obj_path, om);
         m->exponent = om->has_ns ? fmin(fmax(om->ns, 0.0), MAX_PHONG_EXPONENT) : 1.0;
     }
 }
@@ -572,6 +612,11 @@ static ps_status add_mesh_geometry(parser *p, const ps_obj_mesh *om, const ps_xf
     ps_status st = reserve_geometry(p, om->position_count, om->normal_count, om->triangle_count);
     if (st != PS_OK)
         return st;
+    if (!PS_RESERVE(s->texcoords.items, s->texcoords.cap, s->texcoords.count + om->texcoord_count))
+        return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+    uint32_t tbase = (uint32_t)s->texcoords.count;
+    for (size_t i = 0; i < om->texcoord_count; i++)
+        s->texcoords.items[s->texcoords.count++] = (ps_uv){om->texcoords[2 * i], om->texcoords[2 * i + 1]};
     uint32_t pbase = (uint32_t)s->positions.count, nbase = (uint32_t)s->normals.count;
     for (size_t i = 0; i < om->position_count; i++) {
         ps_vec3 v = ps_v3(om->positions[3 * i], om->positions[3 * i + 1], om->positions[3 * i + 2]);
@@ -598,6 +643,12 @@ static ps_status add_mesh_geometry(parser *p, const ps_obj_mesh *om, const ps_xf
             bool usable = n >= 0 && ps_v3_len2(s->normals.items[nbase + (uint32_t)n]) > 0.0;
             tr->n[c] = usable ? (int32_t)(nbase + (uint32_t)n) : -1;
         }
+        for (int c = 0; c < 3; c++) {
+            int32_t k = om->tri_t[3 * t + (mirror && c > 0 ? 3 - c : c)];
+            tr->t[c] = k >= 0 ? (int32_t)(tbase + (uint32_t)k) : -1;
+        }
+        if (tr->t[0] < 0 || tr->t[1] < 0 || tr->t[2] < 0)
+            tr->t[0] = tr->t[1] = tr->t[2] = -1;
         /* A face with some corners lacking a normal uses the face normal throughout. */
         if (tr->n[0] < 0 || tr->n[1] < 0 || tr->n[2] < 0)
             tr->n[0] = tr->n[1] = tr->n[2] = -1;
@@ -804,6 +855,12 @@ static ps_status parse_mesh(parser *p)
         /* An OBJ/MTL problem with a line of its own names that line first (and
          * the error keeps it); one without (a missing file) is the scene
          * line's problem. */
+        if (p->model) { /* the model itself: its own message, no scene line */
+            ps_error_set(p->err, st, "%s", oerr.msg);
+            if (p->err)
+                p->err->line = oerr.line;
+            return st;
+        }
         if (oerr.line > 0) {
             ps_error_set(p->err, st, "%s (mesh at %s:%d)", oerr.msg, p->name, p->line);
             if (p->err)
@@ -1364,6 +1421,9 @@ static ps_status frame_model(parser *p)
     s->camera.up = ps_v3(0, 1, 0);
     s->camera.fov_deg = DEFAULT_FOV_DEG;
     p->has_camera = true;
+    /* Photon radii from the model's size, not the default light's distance. */
+    s->defaults.caustic_radius = DEFAULT_CAUSTIC_RADIUS_FRACTION * 2.0 * r;
+    s->defaults.global_radius = DEFAULT_GLOBAL_RADIUS_FRACTION * 2.0 * r;
     if (s->lights.count > 0)
         return PS_OK;
     ps_light *l = PS_VEC_PUSH(s->lights);
