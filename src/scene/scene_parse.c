@@ -856,7 +856,12 @@ static ps_status parse_mesh(parser *p)
          * the error keeps it); one without (a missing file) is the scene
          * line's problem. */
         if (p->model) { /* the model itself: its own message, no scene line */
-            ps_error_set(p->err, st, "%s", oerr.msg);
+            size_t n = strlen(path);
+            /* A problem of the whole file ("path: no faces") at its line 1. */
+            if (oerr.line == 0 && !strncmp(oerr.msg, path, n) && !strncmp(oerr.msg + n, ": ", 2))
+                ps_error_set(p->err, st, "%s:1: %s", path, oerr.msg + n + 2);
+            else
+                ps_error_set(p->err, st, "%s", oerr.msg);
             if (p->err)
                 p->err->line = oerr.line;
             return st;
