@@ -181,7 +181,9 @@ ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_
     uint64_t vertices = count_vertices(s, o, max_edge);
     char what[96];
     snprintf(what, sizeof what, "the preview mesh of %llu triangles", (unsigned long long)(vertices / 3));
-    ps_status st = ps_memory_check(ps_memory_mul(vertices, PS_MESH_PLAN_VERTEX_BYTES), ps_scene_path(s), what, err);
+    ps_status st = ps_memory_check(
+        ps_memory_mul(vertices, PS_MESH_PLAN_VERTEX_BYTES + (b.uv ? PS_MESH_PLAN_UV_BYTES : 0)), ps_scene_path(s), what,
+        err);
     if (st != PS_OK)
         return st;
     for (size_t i = 0; i < nobj && st == PS_OK; i++) {

@@ -21,9 +21,11 @@
 /* Subdivision stops here whatever max_edge asks: 2 * 256^2 triangles a face. */
 #define PS_MESH_MAX_SPLIT 256
 
-/* What a vertex is planned at against the memory budget: its float position,
- * normal and texture coordinates, twice (the arrays grow by doubling). */
-#define PS_MESH_PLAN_VERTEX_BYTES (2 * 8 * sizeof(float))
+/* What a vertex is planned at against the memory budget: its float position
+ * and normal, twice (the arrays grow by doubling); its texture coordinates
+ * too when the scene has textures. */
+#define PS_MESH_PLAN_VERTEX_BYTES (2 * 6 * sizeof(float))
+#define PS_MESH_PLAN_UV_BYTES (2 * 2 * sizeof(float))
 
 /* A run of triangles of one object and one material. */
 typedef struct ps_mesh_range {
