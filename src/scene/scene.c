@@ -505,6 +505,46 @@ ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err)
     return PS_OK;
 }
 
+ps_status ps_scene_restore(ps_scene *s, const ps_scene *snapshot, bool *geometry, ps_error *err)
+{
+    const ps_scene *o = snapshot;
+#define SAME_COUNT(f) (s->f.count == o->f.count)
+    if (!SAME_COUNT(materials) || !SAME_COUNT(positions) || !SAME_COUNT(normals) || !SAME_COUNT(triangles) ||
+        !SAME_COUNT(objects) || !SAME_COUNT(lights) || !SAME_COUNT(emitters) || !SAME_COUNT(texcoords) ||
+        !SAME_COUNT(obj_src) || !SAME_COUNT(light_src))
+        return ps_error_set(err, PS_ERR_RANGE, "%s: not a snapshot of this scene (its sizes differ)", s->path);
+#undef SAME_COUNT
+    if (!PS_RESERVE(s->edits.items, s->edits.cap, o->edits.count))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
+    bool moved = memcmp(s->positions.items, o->positions.items, s->positions.count * sizeof *s->positions.items) != 0;
+    for (size_t k = 0; !moved && k < s->objects.count; k++)
+        moved = memcmp(&s->objects.items[k].center, &o->objects.items[k].center, sizeof(ps_vec3)) != 0;
+    if (geometry)
+        *geometry = moved;
+#define COPY(f)                                                                                           \
+    do {                                                                                                  \
+        if (s->f.count)                                                                                   \
+            memcpy(s->f.items, o->f.items, s->f.count * sizeof *s->f.items);                              \
+    } while (0)
+    COPY(materials);
+    COPY(positions);
+    COPY(normals);
+    COPY(triangles);
+    COPY(objects);
+    COPY(lights);
+    COPY(emitters);
+    COPY(light_src);
+#undef COPY
+    if (o->edits.count)
+        memcpy(s->edits.items, o->edits.items, o->edits.count * sizeof *o->edits.items);
+    s->edits.count = o->edits.count;
+    s->camera = o->camera;
+    s->defaults = o->defaults;
+    s->bounds = o->bounds;
+    ps_error_clear(err);
+    return PS_OK;
+}
+
 const char *ps_material_type_name(ps_material_type t)
 {
     switch (t) {

@@ -286,6 +286,14 @@ ps_status ps_scene_write(const ps_scene *scene, const char *path, ps_error *err)
  * (photosplat-info --scene). */
 ps_status ps_scene_print(const ps_scene *scene, FILE *f, ps_error *err);
 
+/* Makes s equal again to `snapshot`, a ps_scene_clone of s taken before
+ * some edits (undo): every array and value as the snapshot has them, bit for
+ * bit, copied into s's own arrays (edits never change their sizes), so that
+ * views returned earlier stay valid. A snapshot of another scene (other
+ * sizes) is refused with PS_ERR_RANGE and s left as it was. *geometry (may
+ * be NULL): whether any object's geometry differs. */
+ps_status ps_scene_restore(ps_scene *s, const ps_scene *snapshot, bool *geometry, ps_error *err);
+
 const char *ps_material_type_name(ps_material_type t);
 const char *ps_light_type_name(ps_light_type t);
 
