@@ -3,7 +3,8 @@
 # X server (Xvfb) as tests/cli_window.sh runs it, or skipped without one:
 # an edit is autosaved within a second to NAME.autosave.scn beside the scene,
 # so that SIGTERM a few seconds later loses nothing (the file loads, with the
-# light where the edit put it); starting again on the scene says that its
+# light where the edit put it; a scripted session autosaves only with
+# --autosave on, as here); a scripted session without it writes none; starting again on the scene says that its
 # autosave is newer and how to open it; the autosave of a read-only scene
 # directory goes to the current one.
 set -u
@@ -27,7 +28,7 @@ cp data/scenes/cornell-caustic.scn "$d/room.scn"
 printf '0.3 move light 0  0.25 1.75 0.125\n' >"$d/edit.txt"
 # The window edits, then is killed by SIGTERM with no quit and no save.
 xrun sh -c "\"$win\" \"$d/room.scn\" --size 96x96 --caustic-photons 20000 --global-photons 5000 \
-    --script \"$d/edit.txt\" >\"$d/out\" 2>\"$d/err\" & pid=\$!; sleep $wait_s; kill -TERM \$pid; wait \$pid; echo rc=\$? >\"$d/rc\""
+    --autosave on --script \"$d/edit.txt\" >\"$d/out\" 2>\"$d/err\" & pid=\$!; sleep $wait_s; kill -TERM \$pid; wait \$pid; echo rc=\$? >\"$d/rc\""
 rc=$(sed -n 's/rc=//p' "$d/rc" 2>/dev/null)
 [ -n "$rc" ] && [ "$rc" -ne 0 ] && ok || bad "SIGTERM: exit status '$rc', expected the interrupted one"
 if [ -s "$d/room.autosave.scn" ]; then
@@ -46,6 +47,13 @@ else
     bad "no autosave after the edit and SIGTERM: $(head -3 "$d/err")"
 fi
 
+# A script alone writes no autosave (tests and demos on the bundled scenes).
+cp data/scenes/cornell-caustic.scn "$d/demo.scn"
+printf '0.3 move light 0  0.25 1.75 0.125\n0.8 quit\n' >"$d/demo.txt"
+expect_success "scripted session" xrun "$win" "$d/demo.scn" --size 64x64 --caustic-photons 2000 \
+    --global-photons 500 --script "$d/demo.txt"
+[ ! -e "$d/demo.autosave.scn" ] && ok || bad "a scripted session wrote an autosave without --autosave on"
+
 # A read-only scene directory: the autosave goes to the current directory
 # (root writes anywhere: then there is nothing to show).
 if [ "$(id -u)" -ne 0 ]; then
@@ -55,7 +63,7 @@ if [ "$(id -u)" -ne 0 ]; then
     chmod a-w "$ro"
     abs_win=$(cd "$(dirname "$win")" && pwd)/photosplat
     (cd "$cli_tmp/here" && xrun sh -c "\"$abs_win\" \"$ro/lab.scn\" --size 64x64 --caustic-photons 2000 \
-        --global-photons 500 --script \"$d/edit.txt\" >/dev/null 2>&1 & pid=\$!; sleep $wait_s; kill -TERM \$pid; wait \$pid")
+        --global-photons 500 --autosave on --script \"$d/edit.txt\" >/dev/null 2>&1 & pid=\$!; sleep $wait_s; kill -TERM \$pid; wait \$pid")
     [ -s "$cli_tmp/here/lab.autosave.scn" ] && ok || bad "no autosave in the current directory for a read-only scene"
     chmod u+w "$ro"
 fi

@@ -96,6 +96,9 @@ static const char usage[] =
     "                           radius holding at the scene's photon count)\n"
     "  --radius-alpha A         the progressive schedule's alpha (default 2/3)\n"
     "  --overlay on|off         the text overlay (default on)\n"
+    "  --autosave on|off        write every edit within a second to\n"
+    "                           NAME.autosave.scn (default on; off with --script,\n"
+    "                           whose sessions are tests and demos)\n"
     "  --composite gl|cpu       where the picture is encoded for display: by GL (default),\n"
     "                           or read back and encoded on the CPU (the old way, for\n"
     "                           scripts/bench-window.sh to compare)\n"
@@ -129,6 +132,7 @@ typedef struct win_options {
     ps_preview_options p;
     const char *script;
     int overlay;
+    int autosave; /* 1 on, 0 off, -1 unset: on unless scripted */
     int64_t max_photons; /* stored photons of both maps; 0: no bound */
     int composite;       /* 1: on the GL side (the default); 0: read back and encoded on the CPU */
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM: the session ends */
@@ -203,6 +207,7 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
     /* Float layers: they take in only new photons each refresh (session.h). */
     ps_preview_options_init(&o->p, true);
     o->overlay = 1;
+    o->autosave = -1;
     o->max_photons = WIN_MAX_PHOTONS_DEFAULT;
     o->composite = 1;
     ps_status st = PS_OK;
@@ -222,6 +227,8 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
             st = ps_cli_string(&cli, &o->script, err);
         } else if (ps_cli_is(&cli, "--overlay")) {
             st = ps_cli_choice(&cli, on_off, &o->overlay, err);
+        } else if (ps_cli_is(&cli, "--autosave")) {
+            st = ps_cli_choice(&cli, on_off, &o->autosave, err);
         } else if (ps_cli_is(&cli, "--composite")) {
             static const char *const where[] = {"cpu", "gl", NULL};
             st = ps_cli_choice(&cli, where, &o->composite, err);
@@ -233,6 +240,8 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
     }
     if (st == PS_OK && !o->c.scene)
         o->c.scene = "data/scenes/cornell-caustic.scn";
+    if (o->autosave < 0)
+        o->autosave = o->script ? 0 : 1;
     return st;
 }
 
@@ -925,6 +934,7 @@ static ps_status session(app *a, ps_error *err)
     char notice[2 * PS_WORKFILE_PATH_MAX + 128];
     if (st == PS_OK)
         st = ps_work_open(&a->work, a->o.c.scene, ps_session_scene(a->session), notice, sizeof notice, err);
+    a->work.autosave_off = a->o.autosave == 0;
     if (st == PS_OK && notice[0]) {
         fprintf(stderr, "photosplat: %s\n", notice);
         say(a, notice);

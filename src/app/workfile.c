@@ -135,7 +135,7 @@ ps_status ps_work_after_update(ps_work *w, const ps_scene *scene, double now, ps
     ps_scene_destroy(w->last);
     w->last = NULL;
     w->dirty = true;
-    if (!w->pending) {
+    if (!w->pending && !w->autosave_off) {
         w->pending = true;
         w->due = now + PS_WORK_AUTOSAVE_DELAY;
     }

@@ -54,6 +54,7 @@ typedef struct ps_work {
     bool dirty;           /* edits since the last Ctrl+S */
     bool pending;         /* an autosave is due at `due` */
     bool restoring;       /* the pending edit is an undo or redo: not a new step */
+    bool autosave_off;    /* no autosave written (a scripted session) */
     double due;
     char where[PS_WORKFILE_PATH_MAX + 64]; /* the last save's report */
 } ps_work;
