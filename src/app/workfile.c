@@ -125,14 +125,16 @@ void ps_work_before_update(ps_work *w, const ps_scene *scene)
     if (w->restoring || !w->last)
         return;
     ps_error ignored;
-    /* Out of memory for the step: the edit stands, it cannot be undone. */
-    (void)ps_history_record(w->history, w->last, &ignored);
+    /* The scene after the last edit is this edit's undo step (taken over, no
+     * copy). Out of memory for the step: the edit stands, it cannot be undone. */
+    (void)ps_history_take(w->history, w->last, &ignored);
+    w->last = NULL;
 }
 
 ps_status ps_work_after_update(ps_work *w, const ps_scene *scene, double now, ps_error *err)
 {
     w->restoring = false;
-    ps_scene_destroy(w->last);
+    ps_scene_destroy(w->last); /* after an undo or redo: not taken */
     w->last = NULL;
     w->dirty = true;
     if (!w->pending && !w->autosave_off) {

@@ -85,17 +85,22 @@ static void trim(ps_history *h, uint64_t step_bytes)
     }
 }
 
+ps_status ps_history_take(ps_history *h, ps_scene *snapshot, ps_error *err)
+{
+    uint64_t bytes = ps_history_scene_bytes(snapshot);
+    ps_status st = push(&h->undo, snapshot, err); /* frees it on failure */
+    if (st != PS_OK)
+        return st;
+    clear(&h->redo);
+    trim(h, bytes);
+    return PS_OK;
+}
+
 ps_status ps_history_record(ps_history *h, const ps_scene *before, ps_error *err)
 {
     ps_scene *copy = NULL;
     ps_status st = ps_scene_clone(before, &copy, err);
-    if (st == PS_OK)
-        st = push(&h->undo, copy, err);
-    if (st != PS_OK)
-        return st;
-    clear(&h->redo);
-    trim(h, ps_history_scene_bytes(before));
-    return PS_OK;
+    return st == PS_OK ? ps_history_take(h, copy, err) : st;
 }
 
 void ps_history_forget(ps_history *h) { ps_scene_destroy(pop(&h->undo)); }

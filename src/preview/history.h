@@ -28,6 +28,9 @@ void ps_history_destroy(ps_history *h); /* accepts NULL */
 /* The scene before an edit about to be made (call it, then the edit; when the
  * edit is refused, ps_history_forget). Clears what redo could bring back. */
 ps_status ps_history_record(ps_history *h, const ps_scene *before, ps_error *err);
+/* The same with a snapshot the caller made (a ps_scene_clone), which the
+ * history takes over, even on failure. */
+ps_status ps_history_take(ps_history *h, ps_scene *snapshot, ps_error *err);
 /* Drops the last record (its edit was refused). */
 void ps_history_forget(ps_history *h);
 
