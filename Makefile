@@ -21,7 +21,7 @@ WARN := -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wpointe
 CXXWARN := -Wall -Wextra -Wshadow
 # Package flags are read when this Makefile is parsed; the `test` and `run`
 # targets install the packages first and then re-enter make, so they are there.
-PKGS := libpng tinyobjloader OpenEXR
+PKGS := libpng libjpeg tinyobjloader OpenEXR
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 TEST_CFLAGS := $(shell pkg-config --cflags cmocka 2>/dev/null)

@@ -18,6 +18,8 @@ need_cmd pkg-config pkg-config
 # Without pkg-config every pkg-config check below would fail; that is fine,
 # their packages are then simply installed (apt skips what is present).
 need_pc libpng libpng-dev
+# JPEG textures (MTL map_Kd) through libjpeg-turbo.
+need_pc libjpeg libjpeg62-turbo-dev
 need_pc tinyobjloader libtinyobjloader-dev
 need_pc cmocka libcmocka-dev
 # OpenEXR for --hdr FILE.exr (its C API, OpenEXRCore, from 3.1).
@@ -29,6 +31,8 @@ need_pc glfw3 libglfw3-dev
 need_pc gl libgl-dev
 need_cmd xvfb-run xvfb
 need_cmd xauth xauth
+# The OBJ models the loader is tested on (tests/cli_models.sh).
+[ -d /usr/share/assimp/models/OBJ ] || missing+=(assimp-testmodels)
 # The sanitizer runtimes come with gcc on Debian but may be trimmed from images.
 [ -e "$(gcc -print-file-name=libasan.so 2>/dev/null)" ] && gcc -print-file-name=libasan.so | grep -q / || missing+=(libasan8)
 [ -e "$(gcc -print-file-name=libubsan.so 2>/dev/null)" ] && gcc -print-file-name=libubsan.so | grep -q / || missing+=(libubsan1)

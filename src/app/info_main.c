@@ -1,22 +1,28 @@
 /* info_main.c: photosplat-info: load a scene and describe what it holds.
  * What `make run` shows on a machine where no preview program is built yet;
  * also the quickest way to check a scene file. */
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "app/cli.h"
 #include "scene/ies.h"
 #include "scene/scene.h"
+#include "scene/texture.h"
 
 static const char usage[] =
-    "usage: photosplat-info SCENE.scn\n"
+    "usage: photosplat-info SCENE.scn|MODEL.obj [--scene]\n"
     "\n"
     "Loads a scene (and the OBJ/MTL files it names) and prints its camera, image\n"
     "size, materials, objects, lights and photon defaults. Exit status 0 when the\n"
     "scene is valid; a malformed scene prints one line 'file:line: problem' on\n"
-    "stderr and exits with status 2.\n"
+    "stderr and exits with status 2. A MODEL.obj stands for the scene made from\n"
+    "it: camera framing it, its MTL materials and emitters, a default light when\n"
+    "it has none.\n"
     "\n"
     "options:\n"
+    "  --scene  print the scene as a .scn file instead (paths relative to the\n"
+    "           current directory), ready to save and edit\n"
     "  --help   this text\n";
 
 static void print_vec(const char *label, ps_vec3 v) { printf("%s (%g, %g, %g)", label, v.x, v.y, v.z); }
@@ -60,6 +66,10 @@ static void describe(const ps_scene *s)
         }
         if (!ps_rgb_is_black(m->emission))
             printf(" emission %g %g %g", m->emission.r, m->emission.g, m->emission.b);
+        if (m->texture) {
+            const ps_texture *t = ps_scene_texture(s, m->texture - 1);
+            printf(" texture %s %dx%d", ps_texture_path(t), ps_texture_width(t), ps_texture_height(t));
+        }
         printf("\n");
     }
 
@@ -103,10 +113,13 @@ int main(int argc, char **argv)
     ps_error err;
     ps_error_clear(&err);
     const char *scene_path = NULL;
+    bool print_scene = false;
     while (ps_cli_next(&cli)) {
         if (ps_cli_is(&cli, "--help") || ps_cli_is(&cli, "-h")) {
             fputs(usage, stdout);
             return PS_EXIT_OK;
+        } else if (ps_cli_is(&cli, "--scene")) {
+            print_scene = true;
         } else if (ps_cli_positional(&cli)) {
             if (scene_path) {
                 ps_error_set(&err, PS_ERR_PARSE, "photosplat-info: more than one scene given ('%s')", ps_cli_arg(&cli));
@@ -125,7 +138,11 @@ int main(int argc, char **argv)
     ps_scene *scene;
     if (ps_scene_load(scene_path, NULL, &scene, &err) != PS_OK)
         return ps_cli_fail(&err);
-    describe(scene);
+    ps_status st = print_scene ? ps_scene_print(scene, stdout, &err) : PS_OK;
+    if (!print_scene)
+        describe(scene);
     ps_scene_destroy(scene);
+    if (st != PS_OK)
+        return ps_cli_fail(&err);
     return PS_EXIT_OK;
 }

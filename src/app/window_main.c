@@ -17,6 +17,7 @@
 #include "app/interrupt.h"
 #include "app/options.h"
 #include "app/stats.h"
+#include "app/workfile.h"
 #include "core/fileio.h"
 #include "gl/gl_font.h"
 #include "gl/gl_render.h"
@@ -95,6 +96,9 @@ static const char usage[] =
     "                           radius holding at the scene's photon count)\n"
     "  --radius-alpha A         the progressive schedule's alpha (default 2/3)\n"
     "  --overlay on|off         the text overlay (default on)\n"
+    "  --autosave on|off        write every edit within a second to\n"
+    "                           NAME.autosave.scn (default on; off with --script,\n"
+    "                           whose sessions are tests and demos)\n"
     "  --composite gl|cpu       where the picture is encoded for display: by GL (default),\n"
     "                           or read back and encoded on the CPU (the old way, for\n"
     "                           scripts/bench-window.sh to compare)\n"
@@ -118,6 +122,8 @@ static const char help_text[] =
     "  T / Shift+T      tau up / down\n"
     "  E / Shift+E      exposure up / down\n"
     "  Space            pause tracing    V  overlay    P  screenshot\n"
+    "  Ctrl+S           save the scene (the previous file kept as NAME.scn~)\n"
+    "  Ctrl+Z / Ctrl+Shift+Z  undo / redo an edit\n"
     "  F                illuminance in false colour (lux under the cursor)\n"
     "  H                this help        Q  quit";
 
@@ -126,6 +132,7 @@ typedef struct win_options {
     ps_preview_options p;
     const char *script;
     int overlay;
+    int autosave; /* 1 on, 0 off, -1 unset: on unless scripted */
     int64_t max_photons; /* stored photons of both maps; 0: no bound */
     int composite;       /* 1: on the GL side (the default); 0: read back and encoded on the CPU */
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM: the session ends */
@@ -177,11 +184,15 @@ typedef struct app {
     char shot_path[64]; /* a screenshot asked for with P, taken after the next refresh */
     char message[PS_ERROR_MSG_MAX + 64]; /* the last action's one-line report, shown in the overlay */
     double message_time;
+    /* Save, autosave, undo (app/workfile.h); Q once more quits with unsaved edits. */
+    ps_work work;
+    bool quit_armed;
 } app;
 
 static void say(app *a, const char *text)
 {
-    snprintf(a->message, sizeof a->message, "%s", text);
+    /* Truncated to the overlay's line (a message names at most two paths). */
+    snprintf(a->message, sizeof a->message, "%.*s", (int)sizeof a->message - 1, text);
     a->message_time = ps_now_seconds();
 }
 
@@ -196,6 +207,7 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
     /* Float layers: they take in only new photons each refresh (session.h). */
     ps_preview_options_init(&o->p, true);
     o->overlay = 1;
+    o->autosave = -1;
     o->max_photons = WIN_MAX_PHOTONS_DEFAULT;
     o->composite = 1;
     ps_status st = PS_OK;
@@ -215,6 +227,8 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
             st = ps_cli_string(&cli, &o->script, err);
         } else if (ps_cli_is(&cli, "--overlay")) {
             st = ps_cli_choice(&cli, on_off, &o->overlay, err);
+        } else if (ps_cli_is(&cli, "--autosave")) {
+            st = ps_cli_choice(&cli, on_off, &o->autosave, err);
         } else if (ps_cli_is(&cli, "--composite")) {
             static const char *const where[] = {"cpu", "gl", NULL};
             st = ps_cli_choice(&cli, where, &o->composite, err);
@@ -226,6 +240,8 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
     }
     if (st == PS_OK && !o->c.scene)
         o->c.scene = "data/scenes/cornell-caustic.scn";
+    if (o->autosave < 0)
+        o->autosave = o->script ? 0 : 1;
     return st;
 }
 
@@ -334,6 +350,12 @@ static void draw_overlay(app *a)
             n += snprintf(text + n, sizeof text - (size_t)n, "illuminance: %.3g to %.3g lx (F: off)\n", a->lux_scale.lo,
                           a->lux_scale.hi);
     }
+    const char *note = ps_scene_note(scene);
+    if (note && n > 0 && (size_t)n < sizeof text)
+        n += snprintf(text + n, sizeof text - (size_t)n, "%s\n", note);
+    if (a->work.dirty && n > 0 && (size_t)n < sizeof text)
+        n += snprintf(text + n, sizeof text - (size_t)n, "* unsaved edits (Ctrl+S: %s; autosaved to %s)\n",
+                      a->work.names.save, a->work.names.autosave);
     if (a->message[0] && ps_now_seconds() - a->message_time > MESSAGE_SECONDS)
         a->message[0] = '\0';
     if (a->message[0] && n > 0 && (size_t)n < sizeof text)
@@ -680,8 +702,28 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     ps_vec3 fwd = ps_v3_sub(f.forward, ps_v3_scale(up, ps_v3_dot(f.forward, up)));
     fwd = ps_v3_len2(fwd) > 1e-12 ? ps_v3_norm(fwd) : f.up;
     ps_vec3 right = ps_v3_norm(ps_v3_cross(fwd, up));
+    bool ctrl = (mods & GLFW_MOD_CONTROL) != 0;
+    if (ctrl && (key == GLFW_KEY_S || key == GLFW_KEY_Z)) {
+        ps_status st = key == GLFW_KEY_S ? ps_work_save(&a->work, ps_session_scene(a->session), &err)
+                       : shift           ? ps_work_redo(&a->work, a->session, &err)
+                                         : ps_work_undo(&a->work, a->session, &err);
+        say(a, st != PS_OK ? err.msg : key == GLFW_KEY_S ? a->work.where : shift ? "redone" : "undone");
+        a->redraw = true;
+        return;
+    }
+    if (key != GLFW_KEY_Q)
+        a->quit_armed = false;
     switch (key) {
-    case GLFW_KEY_Q: a->quit = true; break;
+    case GLFW_KEY_Q:
+        /* Unsaved edits: the first Q only says so (the autosave holds them anyway). */
+        if (a->work.dirty && !a->quit_armed) {
+            a->quit_armed = true;
+            say(a, "unsaved edits: Q again quits without saving them, Ctrl+S saves");
+            a->redraw = true;
+        } else {
+            a->quit = true;
+        }
+        break;
     case GLFW_KEY_H: a->help = !a->help, a->redraw = true; break;
     case GLFW_KEY_V: a->overlay = !a->overlay, a->redraw = true; break;
     case GLFW_KEY_F: set_false_color(a, !a->false_color); break;
@@ -889,6 +931,14 @@ static ps_status session(app *a, ps_error *err)
     ps_status st = open_window(a, err);
     if (st == PS_OK)
         st = open_session(a, err);
+    char notice[2 * PS_WORKFILE_PATH_MAX + 128];
+    if (st == PS_OK)
+        st = ps_work_open(&a->work, a->o.c.scene, ps_session_scene(a->session), notice, sizeof notice, err);
+    a->work.autosave_off = a->o.autosave == 0;
+    if (st == PS_OK && notice[0]) {
+        fprintf(stderr, "photosplat: %s\n", notice);
+        say(a, notice);
+    }
     a->edit_time = ps_now_seconds();
     a->awaiting_edit_frame = true;
     a->redraw = true;
@@ -905,6 +955,8 @@ static ps_status session(app *a, ps_error *err)
         double wake = next;
         if (a->script && a->frames > 0 && !a->script_waiting && a->script_next < ps_script_count(a->script))
             wake = fmin(wake, a->t_first_frame + a->script_delay + ps_script_at(a->script, a->script_next)->time);
+        if (a->work.pending)
+            wake = fmin(wake, a->work.due);
         if (now < wake && !a->redraw && !ps_session_edited(a->session))
             glfwWaitEventsTimeout(wake - now);
         else
@@ -931,7 +983,10 @@ static ps_status session(app *a, ps_error *err)
         if (ps_session_edited(a->session)) {
             /* Every edit restarts the maps (thesis 4.1.4); the first refresh
              * follows at once, with whatever the first batch brings. */
+            ps_work_before_update(&a->work, ps_session_scene(a->session));
             st = apply_edits(a, err);
+            if (st == PS_OK)
+                st = ps_work_after_update(&a->work, ps_session_scene(a->session), ps_now_seconds(), err);
             a->edit_time = ps_now_seconds();
             a->awaiting_edit_frame = true;
             next = 0.0;
@@ -939,6 +994,9 @@ static ps_status session(app *a, ps_error *err)
                 break;
         }
         now = ps_now_seconds();
+        ps_error save_err;
+        if (ps_work_tick(&a->work, ps_session_scene(a->session), now, &save_err) != PS_OK)
+            say(a, save_err.msg);
         if (now >= next || a->redraw || a->shot_path[0]) {
             st = refresh(a, err);
             if (st == PS_OK && a->shot_path[0]) {
@@ -954,6 +1012,11 @@ static ps_status session(app *a, ps_error *err)
     }
     if (st == PS_OK && a->session)
         st = ps_session_status(a->session, err);
+    /* Quitting, interrupted or failed: the last edits into the autosave. */
+    ps_error save_err;
+    if (a->session && ps_work_flush(&a->work, ps_session_scene(a->session), &save_err) != PS_OK)
+        fprintf(stderr, "photosplat: %s\n", save_err.msg);
+    ps_work_close(&a->work);
     return st;
 }
 

@@ -27,7 +27,23 @@ struct ps_gl_renderer {
     int width, height;
     double view[16], proj[16];
     ps_gl_stats stats;
+    /* The scene's map_Kd textures (gl_albedo.c): GL names, and what each was made from. */
+    GLuint *albedo_tex;
+    const struct ps_texture **albedo_src;
+    size_t albedo_count;
 };
+
+/* Textures (gl_albedo.c). The lit passes and the splats use the materials'
+ * plain albedo (Kd); textured surfaces are then multiplied by their texture
+ * (the factor T, 1 elsewhere): in the layers' composite each layer times a
+ * T layer, in a single colour buffer a last pass multiplying what is there. */
+ps_status ps_gl_albedo_sync(ps_gl_renderer *r, ps_error *err); /* uploads the scene's textures once */
+void ps_gl_albedo_free(ps_gl_renderer *r);
+bool ps_gl_has_albedo(const ps_gl_renderer *r);
+/* The visible surfaces' T, unlit, against the depth drawn (GL_LEQUAL), into the bound buffer. */
+void ps_gl_draw_albedo(const ps_gl_renderer *r);
+/* The bound buffer times T (nothing when the scene has no textures). */
+void ps_gl_multiply_albedo(const ps_gl_renderer *r);
 
 /* Matrices, column-major as GL's (gl_render.c). */
 void ps_gl_mat_mul(const double a[16], const double b[16], double out[16]);

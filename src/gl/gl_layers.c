@@ -9,12 +9,16 @@
 
 /* The direct layer, a layer a map, the composite as linear floats (read back
  * by tests), and the composite encoded for display (sRGB, 8 bits). */
-enum { LAYER_DIRECT_TEX, LAYER_CAUSTIC_TEX, LAYER_GLOBAL_TEX, LAYER_FINAL_TEX, LAYER_SHOWN_TEX, LAYER_TEX_COUNT };
+/* LAYER_ALBEDO_TEX: the visible surfaces' texture factor T (gl_albedo.c),
+ * by which the composite multiplies every layer when the scene has textures. */
+enum { LAYER_DIRECT_TEX, LAYER_CAUSTIC_TEX, LAYER_GLOBAL_TEX, LAYER_FINAL_TEX, LAYER_SHOWN_TEX, LAYER_ALBEDO_TEX,
+       LAYER_TEX_COUNT };
 
 struct ps_gl_layers {
     int width, height;
     bool float_buffers;
     GLuint tex[LAYER_TEX_COUNT], fbo[LAYER_TEX_COUNT], depth_stencil;
+    bool albedo; /* LAYER_ALBEDO_TEX holds this view's T */
 };
 
 ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_layers **out, ps_error *err)
@@ -40,7 +44,7 @@ ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_l
         glBindTexture(GL_TEXTURE_2D, l->tex[i]);
         /* The linear composite is always float; the shown one is sRGB-encoded
          * 8 bits, written through GL_FRAMEBUFFER_SRGB. */
-        bool is_float = float_buffers || i == LAYER_FINAL_TEX;
+        bool is_float = float_buffers || i == LAYER_FINAL_TEX || i == LAYER_ALBEDO_TEX;
         GLint format = i == LAYER_SHOWN_TEX ? GL_SRGB8_ALPHA8 : is_float ? GL_RGBA32F : GL_RGBA8;
         glTexImage2D(GL_TEXTURE_2D, 0, format, width, height, 0, GL_RGBA, is_float ? GL_FLOAT : GL_UNSIGNED_BYTE,
                      NULL);
@@ -82,6 +86,15 @@ static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *
     ps_gl_begin_frame_shadows(r, cam, exposure, direct, shadows);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_gl_layers_clear_map(l, k);
+    l->albedo = ps_gl_has_albedo(r);
+    if (l->albedo) {
+        glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_ALBEDO_TEX]);
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glClearColor(1, 1, 1, 1);
+        glClear(GL_COLOR_BUFFER_BIT);
+        glClearColor(0, 0, 0, 0);
+        ps_gl_draw_albedo(r);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
 }
 
@@ -112,16 +125,18 @@ void ps_gl_layers_add(ps_gl_layers *l, ps_gl_renderer *r, int map, const ps_spla
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
 }
 
-/* A screen-filling quad of texture t times gain, added to what is there. */
+/* A screen-filling quad of texture t times gain, added to what is there
+ * (times texture unit 1's, the T layer, when that is enabled: both get the
+ * same coordinates). */
 static void add_texture(GLuint t, double gain)
 {
     glBindTexture(GL_TEXTURE_2D, t);
     glColor4f((GLfloat)gain, (GLfloat)gain, (GLfloat)gain, 1.0f);
     glBegin(GL_QUADS);
-    glTexCoord2f(0, 0), glVertex2f(-1, -1);
-    glTexCoord2f(1, 0), glVertex2f(1, -1);
-    glTexCoord2f(1, 1), glVertex2f(1, 1);
-    glTexCoord2f(0, 1), glVertex2f(-1, 1);
+    glMultiTexCoord2f(GL_TEXTURE1, 0, 0), glTexCoord2f(0, 0), glVertex2f(-1, -1);
+    glMultiTexCoord2f(GL_TEXTURE1, 1, 0), glTexCoord2f(1, 0), glVertex2f(1, -1);
+    glMultiTexCoord2f(GL_TEXTURE1, 1, 1), glTexCoord2f(1, 1), glVertex2f(1, 1);
+    glMultiTexCoord2f(GL_TEXTURE1, 0, 1), glTexCoord2f(0, 1), glVertex2f(-1, 1);
     glEnd();
 }
 
@@ -177,10 +192,24 @@ static void composite(ps_gl_layers *l, int target, double direct_gain, const dou
      * the sum of the layers, clamped to [0, 1], as sRGB codes. */
     if (target == LAYER_SHOWN_TEX)
         glEnable(GL_FRAMEBUFFER_SRGB);
+    if (l->albedo) {
+        /* Every layer times T, before the sum (which an 8-bit target clamps). */
+        glActiveTexture(GL_TEXTURE1);
+        glEnable(GL_TEXTURE_2D);
+        glBindTexture(GL_TEXTURE_2D, l->tex[LAYER_ALBEDO_TEX]);
+        glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+        glActiveTexture(GL_TEXTURE0);
+    }
     add_texture(l->tex[LAYER_DIRECT_TEX], direct_gain);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (map_gain[k] > 0.0)
             add_texture(l->tex[LAYER_CAUSTIC_TEX + k], map_gain[k]);
+    if (l->albedo) {
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glDisable(GL_TEXTURE_2D);
+        glActiveTexture(GL_TEXTURE0);
+    }
     glDisable(GL_FRAMEBUFFER_SRGB);
     glDisable(GL_BLEND);
     glBindTexture(GL_TEXTURE_2D, 0);

@@ -188,6 +188,8 @@ void ps_gl_draw_frame(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_se
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (f->map[k].gain > 0.0)
             ps_gl_draw_splats(r, f->map[k].batch, f->splat, f->map[k].radius, f->point_size);
+    /* All of it (lit with Kd, splats with Kd) times the surfaces' textures. */
+    ps_gl_multiply_albedo(r);
 }
 
 void ps_gl_finish(void) { glFinish(); }
@@ -221,7 +223,7 @@ ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err)
 ps_gl_scene ps_gl_scene_of(const ps_session *s)
 {
     ps_gl_scene in = {ps_session_mesh(s), ps_session_coarse_mesh(s), ps_session_materials(s), ps_session_lights(s),
-                      ps_scene_bounds(ps_session_scene(s)), ps_session_illuminance(s)};
+                      ps_scene_bounds(ps_session_scene(s)), ps_session_illuminance(s), ps_session_scene(s)};
     return in;
 }
 
@@ -236,7 +238,8 @@ static void set_inputs(ps_gl_renderer *r, const ps_gl_scene *in)
 ps_status ps_gl_renderer_set_scene(ps_gl_renderer *r, const ps_gl_scene *in, ps_error *err)
 {
     set_inputs(r, in);
-    return ps_gl_lights_reset(r, err);
+    ps_status st = ps_gl_albedo_sync(r, err);
+    return st != PS_OK ? st : ps_gl_lights_reset(r, err);
 }
 
 void ps_gl_renderer_set_kernel(ps_gl_renderer *r, const ps_kernel_texture *kernel) { ps_gl_upload_kernel(r, kernel); }
@@ -275,6 +278,7 @@ void ps_gl_renderer_destroy(ps_gl_renderer *r)
     if (!r)
         return;
     ps_gl_lights_free(r);
+    ps_gl_albedo_free(r);
     if (r->fbo)
         glDeleteFramebuffers(1, &r->fbo);
     if (r->kernel_tex)

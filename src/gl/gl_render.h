@@ -59,6 +59,7 @@ typedef struct ps_gl_scene {
     const ps_preview_lights *lights; /* GL lights and visible emitters */
     ps_aabb bounds;                  /* of geometry and lights: near and far planes */
     bool hide_emitters;              /* look through emitters (illuminance mode) */
+    const ps_scene *scene;           /* its textures (map_Kd), uploaded once; NULL: none */
 } ps_gl_scene;
 
 /* A session's meshes, lights and materials as they stand (its illuminance

@@ -78,6 +78,9 @@ ps_status ps_png_write(const ps_image *img, const char *path, float exposure, ps
  * as stored, scaled to [0,1] (code/255 or code/65535, 16-bit precision kept):
  * still sRGB-encoded, no gamma is applied. Callers decode if they need linear. */
 ps_status ps_png_read(const char *path, ps_image *out, ps_error *err);
+/* A baseline or progressive JPEG (gray or YCbCr; CMYK refused), as
+ * ps_png_read: code/255, still sRGB-encoded (textures, jpeg_io.c). */
+ps_status ps_jpeg_read(const char *path, ps_image *out, ps_error *err);
 
 /* PFM: "PF\n<w> <h>\n-1.0\n", then rows bottom to top as little-endian 32-bit
  * floats, linear, no exposure (every value written as is, NaN included). */

@@ -434,7 +434,8 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
             c->escaped++;
             return;
         }
-        const ps_material *m = &t->materials[sp.material];
+        ps_material textured;
+        const ps_material *m = ps_surface_material(ps_world_scene(w), t->materials, &sp, &textured);
         ps_vec3 d = ray.d;
         bool specular = ps_material_is_specular(m);
         if (kind == PS_MAP_CAUSTIC && bounce == 0) {

@@ -68,6 +68,9 @@ bool ps_world_intersect(const ps_world *w, ps_ray r, double tmax, ps_surface *ou
         }
         out->object = tri->object;
         out->material = tri->material;
+        out->triangle = h.prim;
+        out->b1 = h.b1;
+        out->b2 = h.b2;
     } else {
         size_t n;
         uint32_t obj = w->sphere_objects[h.prim - w->triangle_count];
@@ -76,6 +79,8 @@ bool ps_world_intersect(const ps_world *w, ps_ray r, double tmax, ps_surface *ou
         out->ns = out->ng;
         out->object = obj;
         out->material = o->material;
+        out->triangle = UINT32_MAX;
+        out->b1 = out->b2 = 0.0;
     }
     return true;
 }

@@ -25,7 +25,23 @@ typedef struct ps_surface {
     uint32_t prim;    /* accelerator primitive id */
     uint32_t object;  /* scene object index */
     uint32_t material;
+    uint32_t triangle; /* the scene triangle, UINT32_MAX on a sphere */
+    double b1, b2;     /* triangles: barycentric weights of corners 1 and 2 */
 } ps_surface;
+
+/* The material at sp with its albedo there (ps_scene_albedo_at): the
+ * scene's own material when it has no texture, else a copy in *scratch
+ * with the textured albedo. */
+static inline const ps_material *ps_surface_material(const ps_scene *s, const ps_material *materials,
+                                                     const ps_surface *sp, ps_material *scratch)
+{
+    const ps_material *m = &materials[sp->material];
+    if (m->texture == 0)
+        return m;
+    *scratch = *m;
+    scratch->albedo = ps_scene_albedo_at(s, m, sp->triangle, sp->b1, sp->b2);
+    return scratch;
+}
 
 /* Builds the accelerator over s (which must outlive the world). opt may be NULL. */
 ps_status ps_world_create(const ps_scene *s, const ps_accel_options *opt, ps_world **out, ps_error *err);

@@ -17,7 +17,8 @@
 
 typedef struct builder {
     ps_preview_mesh *m;
-    size_t cap_pos, cap_nrm, cap_ranges;
+    size_t cap_pos, cap_nrm, cap_ranges, cap_uv;
+    bool uv; /* the scene has textures: keep texture coordinates */
 } builder;
 
 ps_mesh_options ps_mesh_default_options(const ps_scene *s)
@@ -34,7 +35,8 @@ static bool reserve(builder *b, size_t vertices)
     size_t need = b->m->vertex_count + vertices;
     if (need > SIZE_MAX / 3)
         return false;
-    return PS_RESERVE(b->m->positions, b->cap_pos, 3 * need) && PS_RESERVE(b->m->normals, b->cap_nrm, 3 * need);
+    return PS_RESERVE(b->m->positions, b->cap_pos, 3 * need) && PS_RESERVE(b->m->normals, b->cap_nrm, 3 * need) &&
+           (!b->uv || PS_RESERVE(b->m->texcoords, b->cap_uv, 2 * need));
 }
 
 /* How many pieces add_triangle cuts each side of a triangle into. */
@@ -70,8 +72,12 @@ static uint64_t count_vertices(const ps_scene *s, const ps_mesh_options *o, doub
     return n;
 }
 
-static void put(builder *b, ps_vec3 p, ps_vec3 n)
+static void put(builder *b, ps_vec3 p, ps_vec3 n, ps_uv uv)
 {
+    if (b->uv) {
+        b->m->texcoords[2 * b->m->vertex_count] = (float)uv.u;
+        b->m->texcoords[2 * b->m->vertex_count + 1] = (float)(1.0 - uv.v);
+    }
     size_t k = 3 * b->m->vertex_count++;
     b->m->positions[k] = (float)p.x;
     b->m->positions[k + 1] = (float)p.y;
@@ -103,16 +109,19 @@ static void end_range(builder *b)
     r->count = b->m->vertex_count - r->first;
 }
 
-/* Barycentric point (a, b) of triangle (p0, p1, p2) with its interpolated unit normal. */
-static void corner(const ps_vec3 p[3], const ps_vec3 n[3], double a, double c, ps_vec3 *pos, ps_vec3 *nrm)
+/* Barycentric point (a, b) of triangle (p0, p1, p2) with its interpolated
+ * unit normal and texture coordinates. */
+static void corner(const ps_vec3 p[3], const ps_vec3 n[3], const ps_uv t[3], double a, double c, ps_vec3 *pos,
+                   ps_vec3 *nrm, ps_uv *uv)
 {
     double w0 = 1.0 - a - c;
+    *uv = (ps_uv){w0 * t[0].u + a * t[1].u + c * t[2].u, w0 * t[0].v + a * t[1].v + c * t[2].v};
     *pos = ps_v3_add(ps_v3_add(ps_v3_scale(p[0], w0), ps_v3_scale(p[1], a)), ps_v3_scale(p[2], c));
     *nrm = ps_v3_norm(ps_v3_add(ps_v3_add(ps_v3_scale(n[0], w0), ps_v3_scale(n[1], a)), ps_v3_scale(n[2], c)));
 }
 
 /* Cuts triangle (p, n) into split^2 similar triangles, same winding. */
-static bool add_triangle(builder *b, const ps_vec3 p[3], const ps_vec3 n[3], double max_edge)
+static bool add_triangle(builder *b, const ps_vec3 p[3], const ps_vec3 n[3], const ps_uv t[3], double max_edge)
 {
     int split = split_count(p, max_edge);
     if (!reserve(b, 3 * (size_t)split * (size_t)split))
@@ -122,17 +131,18 @@ static bool add_triangle(builder *b, const ps_vec3 p[3], const ps_vec3 n[3], dou
         for (int j = 0; i + j < split; j++) {
             /* The upright cell (i, j), and the inverted one beside it. */
             ps_vec3 q[4], m[4];
-            corner(p, n, i * inv, j * inv, &q[0], &m[0]);
-            corner(p, n, (i + 1) * inv, j * inv, &q[1], &m[1]);
-            corner(p, n, i * inv, (j + 1) * inv, &q[2], &m[2]);
-            put(b, q[0], m[0]);
-            put(b, q[1], m[1]);
-            put(b, q[2], m[2]);
+            ps_uv w[4];
+            corner(p, n, t, i * inv, j * inv, &q[0], &m[0], &w[0]);
+            corner(p, n, t, (i + 1) * inv, j * inv, &q[1], &m[1], &w[1]);
+            corner(p, n, t, i * inv, (j + 1) * inv, &q[2], &m[2], &w[2]);
+            put(b, q[0], m[0], w[0]);
+            put(b, q[1], m[1], w[1]);
+            put(b, q[2], m[2], w[2]);
             if (i + j + 1 < split) {
-                corner(p, n, (i + 1) * inv, (j + 1) * inv, &q[3], &m[3]);
-                put(b, q[1], m[1]);
-                put(b, q[3], m[3]);
-                put(b, q[2], m[2]);
+                corner(p, n, t, (i + 1) * inv, (j + 1) * inv, &q[3], &m[3], &w[3]);
+                put(b, q[1], m[1], w[1]);
+                put(b, q[3], m[3], w[3]);
+                put(b, q[2], m[2], w[2]);
             }
         }
     return true;
@@ -148,7 +158,7 @@ static bool add_sphere(builder *b, const ps_object *o, double tolerance, ps_erro
     for (uint32_t t = 0; ok && t < tm.triangle_count; t++)
         for (int k = 0; k < 3; k++) {
             uint32_t v = tm.indices[3 * t + k];
-            put(b, tm.positions[v], tm.normals[v]);
+            put(b, tm.positions[v], tm.normals[v], (ps_uv){0.0, 0.0});
         }
     ps_trimesh_free(&tm);
     if (!ok)
@@ -159,7 +169,9 @@ static bool add_sphere(builder *b, const ps_object *o, double tolerance, ps_erro
 ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_preview_mesh *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
-    builder b = {out, 0, 0, 0};
+    builder b = {out, 0, 0, 0, 0, ps_scene_texture_count(s) > 0};
+    size_t nuv;
+    const ps_uv *uvs = ps_scene_texcoords(s, &nuv);
     size_t nobj, ntri, npos, nnrm;
     const ps_object *objects = ps_scene_objects(s, &nobj);
     const ps_triangle *tris = ps_scene_triangles(s, &ntri);
@@ -169,7 +181,9 @@ ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_
     uint64_t vertices = count_vertices(s, o, max_edge);
     char what[96];
     snprintf(what, sizeof what, "the preview mesh of %llu triangles", (unsigned long long)(vertices / 3));
-    ps_status st = ps_memory_check(ps_memory_mul(vertices, PS_MESH_PLAN_VERTEX_BYTES), ps_scene_path(s), what, err);
+    ps_status st = ps_memory_check(
+        ps_memory_mul(vertices, PS_MESH_PLAN_VERTEX_BYTES + (b.uv ? PS_MESH_PLAN_UV_BYTES : 0)), ps_scene_path(s), what,
+        err);
     if (st != PS_OK)
         return st;
     for (size_t i = 0; i < nobj && st == PS_OK; i++) {
@@ -187,14 +201,16 @@ ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_
         for (uint32_t t = obj->first_triangle; t < obj->first_triangle + obj->triangle_count; t++) {
             const ps_triangle *tri = &tris[t];
             ps_vec3 p[3], n[3], face = ps_scene_triangle_normal(s, t);
+            ps_uv uv[3];
             for (int k = 0; k < 3; k++) {
                 p[k] = pos[tri->v[k]];
+                uv[k] = tri->t[k] >= 0 ? uvs[tri->t[k]] : (ps_uv){0.0, 0.0};
                 n[k] = tri->n[k] >= 0 ? nrm[tri->n[k]] : face;
                 /* Normals on the winding's side, as the ray tracers use them. */
                 if (ps_v3_dot(n[k], face) < 0.0)
                     n[k] = ps_v3_neg(n[k]);
             }
-            if (!begin_range(&b, (uint32_t)i, tri->material) || !add_triangle(&b, p, n, max_edge)) {
+            if (!begin_range(&b, (uint32_t)i, tri->material) || !add_triangle(&b, p, n, uv, max_edge)) {
                 st = PS_ERR_NOMEM;
                 break;
             }
@@ -216,6 +232,7 @@ void ps_preview_mesh_free(ps_preview_mesh *m)
         return;
     free(m->positions);
     free(m->normals);
+    free(m->texcoords);
     free(m->ranges);
     memset(m, 0, sizeof *m);
 }

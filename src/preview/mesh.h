@@ -22,8 +22,10 @@
 #define PS_MESH_MAX_SPLIT 256
 
 /* What a vertex is planned at against the memory budget: its float position
- * and normal, twice (the arrays grow by doubling). */
+ * and normal, twice (the arrays grow by doubling); its texture coordinates
+ * too when the scene has textures. */
 #define PS_MESH_PLAN_VERTEX_BYTES (2 * 6 * sizeof(float))
+#define PS_MESH_PLAN_UV_BYTES (2 * 2 * sizeof(float))
 
 /* A run of triangles of one object and one material. */
 typedef struct ps_mesh_range {
@@ -35,6 +37,10 @@ typedef struct ps_preview_mesh {
     size_t vertex_count;  /* 3 per triangle, nothing shared: ready for glDrawArrays */
     float *positions;     /* xyz per vertex */
     float *normals;       /* unit xyz per vertex, on the side of the winding's normal */
+    /* GL texture coordinates (s, t) per vertex when the scene has textures,
+     * else NULL: s = u, t = 1 - v, for textures uploaded top row first (the
+     * OBJ's v = 0 is the image's bottom); (0, 0) where a face has none. */
+    float *texcoords;
     ps_mesh_range *ranges;
     size_t range_count;
 } ps_preview_mesh;

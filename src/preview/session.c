@@ -589,6 +589,13 @@ ps_status ps_session_set_spot_angle(ps_session *s, size_t light, double degrees,
     return edited(s, ps_scene_set_spot_angle(s->scene, light, degrees, err), false);
 }
 
+ps_status ps_session_restore_scene(ps_session *s, const ps_scene *snapshot, ps_error *err)
+{
+    bool geometry = false;
+    ps_status st = ps_scene_restore(s->scene, snapshot, &geometry, err);
+    return edited(s, st, geometry);
+}
+
 bool ps_session_edited(const ps_session *s) { return s->edited; }
 uint64_t ps_session_edits(const ps_session *s) { return s->edits; }
 

@@ -213,6 +213,9 @@ ps_status ps_session_move_light(ps_session *s, size_t light, ps_vec3 position, p
 ps_status ps_session_move_object(ps_session *s, size_t object, ps_vec3 delta, ps_error *err);
 ps_status ps_session_set_light_power(ps_session *s, size_t light, ps_rgb power, ps_error *err);
 ps_status ps_session_set_spot_angle(ps_session *s, size_t light, double degrees, ps_error *err);
+/* The scene made equal to `snapshot` again (ps_scene_restore): an edit like
+ * the others, how undo and redo (preview/history.h) go back exactly. */
+ps_status ps_session_restore_scene(ps_session *s, const ps_scene *snapshot, ps_error *err);
 
 /* What ps_session_update rebuilt, for the drawing side to follow. */
 typedef struct ps_session_changes {

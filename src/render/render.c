@@ -174,7 +174,8 @@ static ps_rgb gather_ray(worker *wk, ps_ray r, ps_rng *rng, double *first_t)
         }
         if (first_t && bounce == 0)
             *first_t = sp.t;
-        const ps_material *m = &job->materials[sp.material];
+        ps_material textured;
+        const ps_material *m = ps_surface_material(job->scene, job->materials, &sp, &textured);
         bool front = ps_v3_dot(r.d, sp.ng) < 0.0;
         ps_vec3 n = front ? sp.ns : ps_v3_neg(sp.ns);
         ps_vec3 dir;
@@ -252,7 +253,8 @@ static int cache_path(worker *wk, ps_ray r, ps_ray off, bool has_off, double dis
         wk->rays++;
         has_off = ps_world_intersect(job->world, off, INFINITY, &so) && so.material == sp.material;
     }
-    const ps_material *m = &job->materials[sp.material];
+    ps_material textured;
+    const ps_material *m = ps_surface_material(job->scene, job->materials, &sp, &textured);
     bool front = ps_v3_dot(r.d, sp.ng) < 0.0;
     ps_vec3 n = front ? sp.ns : ps_v3_neg(sp.ns);
     ps_vec3 no = has_off ? (ps_v3_dot(off.d, so.ng) < 0.0 ? so.ns : ps_v3_neg(so.ns)) : n;
@@ -613,7 +615,8 @@ static ps_rgb radiance(worker *wk, ps_ray r, int depth, bool through, uint64_t k
         return wants(want, through ? PS_COMPONENT_SPECULAR : PS_COMPONENT_DIRECT) ? le : ps_rgb_gray(0.0);
     if (!hit)
         return ps_rgb_gray(0.0); /* no environment: black */
-    const ps_material *m = &job->materials[sp.material];
+    ps_material textured;
+    const ps_material *m = ps_surface_material(job->scene, job->materials, &sp, &textured);
     bool front = ps_v3_dot(r.d, sp.ng) < 0.0;
     ps_vec3 n = front ? sp.ns : ps_v3_neg(sp.ns);
     ps_vec3 wo = ps_v3_neg(r.d);

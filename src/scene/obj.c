@@ -224,7 +224,8 @@ static ps_status scan_mtl_text(prescan *ps, const char *mpath, const char *text)
             if (ntok != 2 || !ps_parse_int64(tok[1], &v) || v < 0 || v > 10)
                 st = ps_error_at(ps->err, PS_ERR_PARSE, mpath, line, "illum needs one integer from 0 to 10");
         }
-        /* Texture maps and other statements are ignored: photosplat has no textures. */
+        /* map_Kd is read by tinyobjloader (its options too); other maps and
+         * statements are ignored. */
         if (st != PS_OK)
             return st;
     }
@@ -349,6 +350,8 @@ void ps_obj_free(ps_obj_mesh *m)
     free(m->normals);
     free(m->tri_v);
     free(m->tri_n);
+    free(m->texcoords);
+    free(m->tri_t);
     free(m->tri_mat);
     free(m->materials);
     memset(m, 0, sizeof *m);

@@ -14,6 +14,7 @@
 #include "core/status.h"
 
 #define PS_OBJ_NAME_MAX 128
+#define PS_OBJ_PATH_MAX 1024
 
 /* One MTL material, with what the scene mapping needs (contract: MTL mapping). */
 typedef struct ps_obj_material {
@@ -22,6 +23,7 @@ typedef struct ps_obj_material {
     double ns, ni;
     int illum;
     int has_ns, has_ni; /* tinyobjloader silently defaults both to 1 */
+    char map_kd[PS_OBJ_PATH_MAX]; /* map_Kd's file as the MTL names it (options dropped), or "" */
 } ps_obj_material;
 
 /* A triangulated mesh. Polygons are split into fans around their first vertex
@@ -34,6 +36,9 @@ typedef struct ps_obj_mesh {
     size_t triangle_count;
     int32_t *tri_v;   /* 3 per triangle: indices into positions */
     int32_t *tri_n;   /* 3 per triangle: indices into normals, or -1 */
+    size_t texcoord_count; /* uv pairs in texcoords (OBJ vt) */
+    double *texcoords;
+    int32_t *tri_t;   /* 3 per triangle: indices into texcoords, or -1 */
     int32_t *tri_mat; /* 1 per triangle: index into materials, or -1 (none given) */
     size_t material_count;
     ps_obj_material *materials;

@@ -46,6 +46,11 @@ void fill(const tinyobj::ObjReader &reader, ps_obj_mesh *out)
     for (size_t i = 0; i < out->normal_count * 3; i++)
         out->normals[i] = attrib.normals[i];
 
+    out->texcoord_count = attrib.texcoords.size() / 2;
+    out->texcoords = alloc_array<double>(out->texcoord_count * 2);
+    for (size_t i = 0; i < out->texcoord_count * 2; i++)
+        out->texcoords[i] = attrib.texcoords[i];
+
     size_t tris = 0;
     for (const tinyobj::shape_t &shape : reader.GetShapes())
         for (unsigned char nv : shape.mesh.num_face_vertices)
@@ -53,6 +58,7 @@ void fill(const tinyobj::ObjReader &reader, ps_obj_mesh *out)
                 tris += nv - 2u;
     out->tri_v = alloc_array<int32_t>(tris * 3);
     out->tri_n = alloc_array<int32_t>(tris * 3);
+    out->tri_t = alloc_array<int32_t>(tris * 3);
     out->tri_mat = alloc_array<int32_t>(tris);
     size_t t = 0;
     for (const tinyobj::shape_t &shape : reader.GetShapes()) {
@@ -66,6 +72,7 @@ void fill(const tinyobj::ObjReader &reader, ps_obj_mesh *out)
                 for (int c = 0; c < 3; c++) {
                     out->tri_v[t * 3 + c] = idx[c].vertex_index;
                     out->tri_n[t * 3 + c] = idx[c].normal_index;
+                    out->tri_t[t * 3 + c] = idx[c].texcoord_index;
                 }
                 out->tri_mat[t] = mat;
             }
@@ -88,6 +95,7 @@ void fill(const tinyobj::ObjReader &reader, ps_obj_mesh *out)
         m.ns = mats[i].shininess;
         m.ni = mats[i].ior;
         m.illum = mats[i].illum;
+        std::snprintf(m.map_kd, sizeof m.map_kd, "%s", mats[i].diffuse_texname.c_str());
     }
 }
 

@@ -5,6 +5,7 @@
 
 #include "core/photometry.h"
 #include "scene/ies.h"
+#include "scene/texture.h"
 
 #include <inttypes.h>
 #include <stdarg.h>
@@ -17,8 +18,10 @@
 ps_scene *ps_scene_alloc(void)
 {
     ps_scene *s = calloc(1, sizeof *s);
-    if (s)
+    if (s) {
         s->bounds = ps_aabb_empty();
+        s->note = PS_SOURCE_NONE;
+    }
     return s;
 }
 
@@ -37,10 +40,38 @@ void ps_scene_destroy(ps_scene *s)
     for (size_t k = 0; k < s->profiles.count; k++)
         ps_ies_destroy(s->profiles.items[k]);
     free(s->profiles.items);
+    free(s->texcoords.items);
+    for (size_t k = 0; k < s->textures.count; k++)
+        ps_texture_unref(s->textures.items[k]);
+    free(s->textures.items);
+    free(s->stmts.items);
+    free(s->obj_src.items);
+    free(s->light_src.items);
+    free(s->edits.items);
+    free(s->strings.items);
     free(s);
 }
 
+uint32_t ps_scene_add_string(ps_scene *s, const char *text)
+{
+    size_t len = strlen(text) + 1, at = s->strings.count;
+    if (at + len >= PS_SOURCE_NONE || !PS_RESERVE(s->strings.items, s->strings.cap, at + len))
+        return PS_SOURCE_NONE;
+    memcpy(s->strings.items + at, text, len);
+    s->strings.count += len;
+    return (uint32_t)at;
+}
+
+/* Records an edit for ps_scene_write (scene_internal.h): room first, so that
+ * an edit refused for memory changes nothing. */
+static bool reserve_edit(ps_scene *s) { return PS_RESERVE(s->edits.items, s->edits.cap, s->edits.count + 1); }
+static void record_edit(ps_scene *s, uint32_t object, uint32_t light, ps_vec3 v)
+{
+    s->edits.items[s->edits.count++] = (ps_scene_edit){object, light, v};
+}
+
 const char *ps_scene_path(const ps_scene *s) { return s->path; }
+const char *ps_scene_note(const ps_scene *s) { return ps_scene_string(s, s->note); }
 const ps_camera *ps_scene_camera(const ps_scene *s) { return &s->camera; }
 const ps_scene_defaults *ps_scene_get_defaults(const ps_scene *s) { return &s->defaults; }
 ps_aabb ps_scene_bounds(const ps_scene *s) { return s->bounds; }
@@ -59,6 +90,31 @@ const ps_triangle *ps_scene_triangles(const ps_scene *s, size_t *count) { VIEW(t
 const ps_object *ps_scene_objects(const ps_scene *s, size_t *count) { VIEW(objects); }
 const ps_light *ps_scene_lights(const ps_scene *s, size_t *count) { VIEW(lights); }
 const uint32_t *ps_scene_emitters(const ps_scene *s, size_t *count) { VIEW(emitters); }
+const ps_uv *ps_scene_texcoords(const ps_scene *s, size_t *count) { VIEW(texcoords); }
+const ps_texture *ps_scene_texture(const ps_scene *s, uint32_t k) { return s->textures.items[k]; }
+size_t ps_scene_texture_count(const ps_scene *s) { return s->textures.count; }
+
+bool ps_scene_uv_at(const ps_scene *s, uint32_t t, double b1, double b2, ps_uv *out)
+{
+    const ps_triangle *tr = &s->triangles.items[t];
+    if (tr->t[0] < 0) {
+        *out = (ps_uv){0.0, 0.0};
+        return false;
+    }
+    const ps_uv *a = &s->texcoords.items[tr->t[0]], *b = &s->texcoords.items[tr->t[1]],
+                *c = &s->texcoords.items[tr->t[2]];
+    double b0 = 1.0 - b1 - b2;
+    *out = (ps_uv){b0 * a->u + b1 * b->u + b2 * c->u, b0 * a->v + b1 * b->v + b2 * c->v};
+    return true;
+}
+
+ps_rgb ps_scene_albedo_at(const ps_scene *s, const ps_material *m, uint32_t triangle, double b1, double b2)
+{
+    ps_uv uv;
+    if (m->texture == 0 || triangle >= s->triangles.count || !ps_scene_uv_at(s, triangle, b1, b2, &uv))
+        return m->albedo;
+    return ps_rgb_mul(m->albedo, ps_texture_sample(s->textures.items[m->texture - 1], uv.u, uv.v));
+}
 
 static ps_vec3 tri_cross(const ps_scene *s, uint32_t t)
 {
@@ -271,7 +327,10 @@ ps_status ps_scene_set_light_power(ps_scene *s, size_t light, ps_rgb power, ps_e
     if (ps_rgb_max(power) > PS_SCENE_MAX_LIGHT_POWER)
         return refuse(err, s, "light", light, l->line, ": power (%g %g %g) is above the %g W a light may have",
                       power.r, power.g, power.b, PS_SCENE_MAX_LIGHT_POWER);
+    if (l->type == PS_LIGHT_MESH && !reserve_edit(s))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
     if (l->type == PS_LIGHT_MESH) {
+        record_edit(s, l->object, (uint32_t)light, ps_v3(power.r, power.g, power.b));
         /* The faces are drawn and seen with their material's emission; that
          * MTL material was made for this mesh statement and emits only here. */
         uint32_t m = s->triangles.items[s->emitters.items[l->first_emitter]].material;
@@ -358,9 +417,14 @@ ps_status ps_scene_translate_object(ps_scene *s, size_t object, ps_vec3 delta, p
                           delta.x, delta.y, delta.z, i);
     }
 
+    /* A sphere is written at its centre; meshes and quads replay their moves. */
+    if (o->type != PS_OBJ_SPHERE && !reserve_edit(s))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
     /* Move it: the same sums as the checks, so the same results. */
     if (o->type == PS_OBJ_SPHERE)
         o->center = center;
+    else
+        record_edit(s, (uint32_t)object, PS_SOURCE_NONE, delta);
     for (size_t v = vlo; v <= vhi && vlo != SIZE_MAX; v++)
         s->positions.items[v] = ps_v3_add(s->positions.items[v], delta);
     ps_scene_update_object(s, (uint32_t)object);
@@ -410,6 +474,13 @@ ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err)
     DUP_VEC(lights);
     DUP_VEC(emitters);
     DUP_VEC(profiles);
+    DUP_VEC(texcoords);
+    DUP_VEC(textures);
+    DUP_VEC(stmts);
+    DUP_VEC(obj_src);
+    DUP_VEC(light_src);
+    DUP_VEC(edits);
+    DUP_VEC(strings);
 #undef DUP_VEC
     /* The tables themselves, so that a clone shares nothing with s; until
      * each is copied its slot is NULL (destroy frees only copies). */
@@ -421,11 +492,55 @@ ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err)
         ps_error ignored;
         ok = ps_ies_clone(s->profiles.items[k], &c->profiles.items[k], &ignored) == PS_OK;
     }
+    if (!c->textures.items)
+        c->textures.count = 0;
+    for (size_t k = 0; k < c->textures.count; k++)
+        ps_texture_ref(c->textures.items[k]);
     if (!ok) {
         ps_scene_destroy(c); /* what was not copied is NULL */
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
     }
     *out = c;
+    ps_error_clear(err);
+    return PS_OK;
+}
+
+ps_status ps_scene_restore(ps_scene *s, const ps_scene *snapshot, bool *geometry, ps_error *err)
+{
+    const ps_scene *o = snapshot;
+#define SAME_COUNT(f) (s->f.count == o->f.count)
+    if (!SAME_COUNT(materials) || !SAME_COUNT(positions) || !SAME_COUNT(normals) || !SAME_COUNT(triangles) ||
+        !SAME_COUNT(objects) || !SAME_COUNT(lights) || !SAME_COUNT(emitters) || !SAME_COUNT(texcoords) ||
+        !SAME_COUNT(obj_src) || !SAME_COUNT(light_src))
+        return ps_error_set(err, PS_ERR_RANGE, "%s: not a snapshot of this scene (its sizes differ)", s->path);
+#undef SAME_COUNT
+    if (!PS_RESERVE(s->edits.items, s->edits.cap, o->edits.count))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
+    bool moved = memcmp(s->positions.items, o->positions.items, s->positions.count * sizeof *s->positions.items) != 0;
+    for (size_t k = 0; !moved && k < s->objects.count; k++)
+        moved = memcmp(&s->objects.items[k].center, &o->objects.items[k].center, sizeof(ps_vec3)) != 0;
+    if (geometry)
+        *geometry = moved;
+#define COPY(f)                                                                                           \
+    do {                                                                                                  \
+        if (s->f.count)                                                                                   \
+            memcpy(s->f.items, o->f.items, s->f.count * sizeof *s->f.items);                              \
+    } while (0)
+    COPY(materials);
+    COPY(positions);
+    COPY(normals);
+    COPY(triangles);
+    COPY(objects);
+    COPY(lights);
+    COPY(emitters);
+    COPY(light_src);
+#undef COPY
+    if (o->edits.count)
+        memcpy(s->edits.items, o->edits.items, o->edits.count * sizeof *o->edits.items);
+    s->edits.count = o->edits.count;
+    s->camera = o->camera;
+    s->defaults = o->defaults;
+    s->bounds = o->bounds;
     ps_error_clear(err);
     return PS_OK;
 }

@@ -7,7 +7,9 @@
 #ifndef PS_SCENE_SCENE_H
 #define PS_SCENE_SCENE_H
 
+#include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "core/status.h"
@@ -56,6 +58,7 @@ typedef struct ps_material {
     double ior;           /* dielectric: index of refraction inside, air outside */
     ps_rgb transmittance; /* dielectric: colour of refracted light (1 = clear) */
     ps_rgb emission;      /* emitted radiance (MTL Ke), zero for non-emitters */
+    uint32_t texture;     /* MTL map_Kd: 0 none, else ps_scene_texture(s, texture - 1) times albedo */
 } ps_material;
 
 /* Mirrors and dielectrics: what caustic photons are aimed at. */
@@ -70,6 +73,7 @@ static inline int ps_material_is_specular(const ps_material *m)
 typedef struct ps_triangle {
     uint32_t v[3];   /* indices into ps_scene_positions */
     int32_t n[3];    /* indices into ps_scene_normals, or -1: use the face normal */
+    int32_t t[3];    /* indices into ps_scene_texcoords, or -1 (all three or none) */
     uint32_t material;
     uint32_t object;
 } ps_triangle;
@@ -135,12 +139,22 @@ typedef struct ps_scene_defaults {
 } ps_scene_defaults;
 
 typedef struct ps_scene ps_scene;
+struct ps_texture;
+
+/* OBJ texture coordinates (vt). */
+typedef struct ps_uv {
+    double u, v;
+} ps_uv;
 
 typedef struct ps_scene_load_options {
     ps_warn_sink warn; /* where warnings go ({NULL, NULL}: stderr) */
 } ps_scene_load_options;
 
-/* Reads a .scn file and everything it refers to. On error returns the status,
+/* Reads a .scn file and everything it refers to; or, for a path ending in
+ * .obj (any case), that model as a scene: the camera framing its bounding box
+ * from the front (+z), 15 degrees above, fov 40; its MTL materials and
+ * emitters; and when it has no emitter a default point light, named through
+ * the warning sink and by ps_scene_note. On error returns the status,
  * sets err to "file:line: problem" and *out to NULL. opts may be NULL. */
 ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_scene **out, ps_error *err);
 
@@ -151,7 +165,13 @@ ps_status ps_scene_load_text(const char *text, const char *name, const char *bas
 
 void ps_scene_destroy(ps_scene *s); /* accepts NULL */
 
+/* Whether ps_scene_load reads path as a model (it ends in .obj). */
+bool ps_scene_path_is_model(const char *path);
+
 const char *ps_scene_path(const ps_scene *s);
+/* One line on what the loader added to the file's content (a model's
+ * default light), or NULL. */
+const char *ps_scene_note(const ps_scene *s);
 const ps_camera *ps_scene_camera(const ps_scene *s);
 const ps_scene_defaults *ps_scene_get_defaults(const ps_scene *s);
 /* The box around all geometry and lights; what scene-scaled epsilons scale with. */
@@ -163,6 +183,21 @@ const ps_vec3 *ps_scene_normals(const ps_scene *s, size_t *count); /* unit lengt
 const ps_triangle *ps_scene_triangles(const ps_scene *s, size_t *count);
 const ps_object *ps_scene_objects(const ps_scene *s, size_t *count);
 const ps_light *ps_scene_lights(const ps_scene *s, size_t *count);
+const ps_uv *ps_scene_texcoords(const ps_scene *s, size_t *count);
+/* Texture k (ps_material.texture - 1), shared with the scene's clones. */
+const struct ps_texture *ps_scene_texture(const ps_scene *s, uint32_t k);
+size_t ps_scene_texture_count(const ps_scene *s);
+/* The texture coordinates at barycentric (b1, b2) of triangle t; false
+ * (and 0, 0) when the triangle has none. */
+bool ps_scene_uv_at(const ps_scene *s, uint32_t t, double b1, double b2, ps_uv *out);
+/* The diffuse albedo of material m at a surface point: its albedo, times
+ * its texture at the point's texture coordinates when it has one and the
+ * point is on a triangle with coordinates (triangle: the scene triangle, or
+ * UINT32_MAX for a sphere). The one place every renderer asks (the photon
+ * tracer's reflection, the reference renderer, the preview's splats and
+ * illumination maps). */
+ps_rgb ps_scene_albedo_at(const ps_scene *s, const ps_material *m, uint32_t triangle, double b1, double b2);
+
 /* Triangle indices of the faces of PS_LIGHT_MESH lights. */
 const uint32_t *ps_scene_emitters(const ps_scene *s, size_t *count);
 
@@ -238,6 +273,26 @@ ps_status ps_scene_translate_object(ps_scene *s, size_t object, ps_vec3 delta, p
  * window edits its copy while the photon tracer of the previous frame still
  * reads the old one. On failure (PS_ERR_NOMEM) *out is NULL. */
 ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err);
+
+/* Writes the scene, as edited, to path as a .scn file that ps_scene_load
+ * reads back to the same scene: every number (17 significant digits), every
+ * material, object and light in the same order, the files it names relative
+ * to path's directory (absolute when they share nothing below the root), the
+ * edits to meshes and quads as `move` / `light-power` keys replayed on
+ * loading. Lights are written with their flux (`power`), whatever the file
+ * gave. Atomic (core/fileio.h): on error nothing appears under path. */
+ps_status ps_scene_write(const ps_scene *scene, const char *path, ps_error *err);
+/* The same text to an open stream, files relative to the current directory
+ * (photosplat-info --scene). */
+ps_status ps_scene_print(const ps_scene *scene, FILE *f, ps_error *err);
+
+/* Makes s equal again to `snapshot`, a ps_scene_clone of s taken before
+ * some edits (undo): every array and value as the snapshot has them, bit for
+ * bit, copied into s's own arrays (edits never change their sizes), so that
+ * views returned earlier stay valid. A snapshot of another scene (other
+ * sizes) is refused with PS_ERR_RANGE and s left as it was. *geometry (may
+ * be NULL): whether any object's geometry differs. */
+ps_status ps_scene_restore(ps_scene *s, const ps_scene *snapshot, bool *geometry, ps_error *err);
 
 const char *ps_material_type_name(ps_material_type t);
 const char *ps_light_type_name(ps_light_type t);

@@ -1,5 +1,7 @@
 /* scene_parse.c: the .scn reader. One statement per line; every problem is
  * reported as "file:line: problem" and nothing half-built escapes. */
+#include <inttypes.h>
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +16,7 @@
 #include "scene/ies.h"
 #include "scene/obj.h"
 #include "scene/scene_internal.h"
+#include "scene/texture.h"
 
 #define SCN_MAX_BYTES ((size_t)64 << 20)
 #define SCN_LINE_MAX 4096
@@ -36,7 +39,6 @@
 #define DEFAULT_GLOBAL_RADIUS_FRACTION 0.025
 #define DEFAULT_FOV_DEG 40.0
 #define DEFAULT_ALBEDO 0.5
-#define DEFAULT_MATERIAL_NAME "(default)"
 
 typedef struct parser {
     ps_scene *s;
@@ -48,7 +50,12 @@ typedef struct parser {
     char *tok[SCN_MAX_TOKENS];
     int ntok, pos;
     bool has_camera, has_image, has_photons, has_radius;
+    bool model; /* an .obj opened in place of a scene: camera and light made here (frame_model) */
     int64_t default_material; /* index, or -1 until first needed */
+    /* What the statement being read records for ps_scene_write (scene_internal.h). */
+    ps_object_source pending_obj;
+    ps_light_source pending_light;
+    PS_VEC(ps_scene_edit) pending_edits; /* a mesh's or quad's `move` and `light-power` keys */
     ps_namemap *material_names; /* name -> index in s->materials; the first of a name wins */
 } parser;
 
@@ -263,7 +270,7 @@ static ps_material *add_material(parser *p, const char *name)
 static int64_t default_material(parser *p)
 {
     if (p->default_material < 0) {
-        ps_material *m = add_material(p, DEFAULT_MATERIAL_NAME);
+        ps_material *m = add_material(p, PS_DEFAULT_MATERIAL_NAME);
         if (!m)
             return -1;
         m->type = PS_MAT_DIFFUSE;
@@ -373,6 +380,42 @@ static ps_status resolve_material(parser *p, const key_vals *kv, uint32_t *out)
 
 /* ---- geometry ------------------------------------------------------------------ */
 
+/* `move DX DY DZ` (meshes, quads) and `light-power K R G B` (meshes: the
+ * statement's K-th emissive light), repeatable, in order from p->pos to the
+ * end of the line: the edits ps_scene_write saves, replayed through the edit
+ * functions once the statement is read (apply_edits), so that they give the
+ * same numbers as when they were made. */
+static ps_status parse_edits(parser *p, bool mesh)
+{
+    while (more(p)) {
+        const char *key = p->tok[p->pos++];
+        ps_scene_edit e = {0, PS_SOURCE_NONE, {0, 0, 0}};
+        double v[4];
+        ps_status st;
+        if (!strcmp(key, "move")) {
+            if ((st = read_numbers(p, "move", 3, v)) != PS_OK)
+                return st;
+            e.v = ps_v3(v[0], v[1], v[2]);
+        } else if (mesh && !strcmp(key, "light-power")) {
+            if ((st = read_numbers(p, "light-power", 4, v)) != PS_OK)
+                return st;
+            if (!(v[0] >= 0.0 && v[0] < PS_SCENE_MAX_LIGHTS && v[0] == floor(v[0])))
+                return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: mesh: light-power: %g is not a light of the mesh",
+                                    p->name, p->line, v[0]);
+            e.light = (uint32_t)v[0];
+            e.v = ps_v3(v[1], v[2], v[3]);
+        } else {
+            return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: unknown key '%s' after 'move' (expected %s)",
+                                p->name, p->line, p->tok[0], key, mesh ? "move or light-power" : "move");
+        }
+        ps_scene_edit *slot = PS_VEC_PUSH(p->pending_edits);
+        if (!slot)
+            return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        *slot = e;
+    }
+    return PS_OK;
+}
+
 static ps_object *add_object(parser *p, ps_object_type type)
 {
     if (p->s->objects.count >= PS_SCENE_MAX_OBJECTS) {
@@ -413,10 +456,19 @@ static ps_status parse_quad(parser *p)
 {
     static const key_spec spec[] = {{"corner", 3, true}, {"edge1", 3, true}, {"edge2", 3, true}, {"material", ARITY_WORD, false}};
     key_vals kv[4];
+    /* Saved edits (`move`, repeatable) follow the keys. */
+    int ntok = p->ntok, first_move = p->pos;
+    while (first_move < ntok && strcmp(p->tok[first_move], "move") != 0)
+        first_move++;
+    p->ntok = first_move;
     ps_status st = parse_keys(p, "quad", spec, 4, kv);
-    if (st != PS_OK)
+    p->ntok = ntok;
+    if (st != PS_OK || (st = parse_edits(p, false)) != PS_OK)
         return st;
     ps_vec3 c = kv_vec3(&kv[0]), e1 = kv_vec3(&kv[1]), e2 = kv_vec3(&kv[2]);
+    p->pending_obj.corner = c;
+    p->pending_obj.edge1 = e1;
+    p->pending_obj.edge2 = e2;
     uint32_t mat;
     if ((st = check_parallelogram(p, e1, e2)) != PS_OK || (st = resolve_material(p, &kv[3], &mat)) != PS_OK ||
         (st = reserve_geometry(p, 4, 0, 2)) != PS_OK)
@@ -437,6 +489,7 @@ static ps_status parse_quad(parser *p)
         for (int k = 0; k < 3; k++) {
             tr->v[k] = base + corners[t][k];
             tr->n[k] = -1;
+            tr->t[k] = -1;
         }
         tr->material = mat;
         tr->object = (uint32_t)(s->objects.count - 1);
@@ -469,6 +522,42 @@ static ps_status parse_sphere(parser *p)
 typedef struct warn_relay {
     const ps_warn_sink *to;
 } warn_relay;
+
+/* An MTL's map_Kd, relative to the OBJ's directory (where its MTL files
+ * are): 1 + its index in the scene's textures, shared by every material
+ * naming the same file; 0, with a warning naming it, when it cannot be read
+ * (the plain albedo then). */
+static uint32_t load_texture(parser *p, const char *obj_path, const ps_obj_material *om)
+{
+    ps_scene *s = p->s;
+    char path[4096];
+    const char *slash = strrchr(obj_path, '/');
+    /* Exporters on Windows write backslashes. */
+    char file[PS_OBJ_PATH_MAX];
+    snprintf(file, sizeof file, "%s", om->map_kd);
+    for (char *c = file; *c; c++)
+        if (*c == '\\')
+            *c = '/';
+    if (file[0] == '/' || !slash)
+        snprintf(path, sizeof path, "%s", file);
+    else
+        snprintf(path, sizeof path, "%.*s/%s", (int)(slash - obj_path), obj_path, file);
+    for (size_t k = 0; k < s->textures.count; k++)
+        if (!strcmp(ps_texture_path(s->textures.items[k]), path))
+            return (uint32_t)k + 1;
+    ps_texture *t = NULL;
+    ps_error terr;
+    ps_error_set(&terr, PS_ERR_NOMEM, "out of memory");
+    if (!PS_RESERVE(s->textures.items, s->textures.cap, s->textures.count + 1) ||
+        ps_texture_load(path, s->texture_bytes, &t, &terr) != PS_OK) {
+        ps_warn(p->warn, "%s: material '%s': texture %s not used (%s); its plain albedo instead", obj_path, om->name,
+                om->map_kd, terr.msg);
+        return 0;
+    }
+    s->textures.items[s->textures.count++] = t;
+    s->texture_bytes += ps_texture_bytes(t);
+    return (uint32_t)s->textures.count;
+}
 
 /* MTL → material, following the contract's mapping. Values the MTL format
  * allows but physics does not (Kd + Ks > 1) are scaled down with a warning:
@@ -508,6 +597,8 @@ static void map_mtl(parser *p, const char *obj_path, const ps_obj_material *om, 
         }
         m->albedo = kd;
         m->specular = ks;
+        if (om->map_kd[0])
+            m->texture = load_texture(p, obj_path, om);
         m->exponent = om->has_ns ? fmin(fmax(om->ns, 0.0), MAX_PHONG_EXPONENT) : 1.0;
     }
 }
@@ -521,6 +612,11 @@ static ps_status add_mesh_geometry(parser *p, const ps_obj_mesh *om, const ps_xf
     ps_status st = reserve_geometry(p, om->position_count, om->normal_count, om->triangle_count);
     if (st != PS_OK)
         return st;
+    if (!PS_RESERVE(s->texcoords.items, s->texcoords.cap, s->texcoords.count + om->texcoord_count))
+        return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+    uint32_t tbase = (uint32_t)s->texcoords.count;
+    for (size_t i = 0; i < om->texcoord_count; i++)
+        s->texcoords.items[s->texcoords.count++] = (ps_uv){om->texcoords[2 * i], om->texcoords[2 * i + 1]};
     uint32_t pbase = (uint32_t)s->positions.count, nbase = (uint32_t)s->normals.count;
     for (size_t i = 0; i < om->position_count; i++) {
         ps_vec3 v = ps_v3(om->positions[3 * i], om->positions[3 * i + 1], om->positions[3 * i + 2]);
@@ -547,6 +643,12 @@ static ps_status add_mesh_geometry(parser *p, const ps_obj_mesh *om, const ps_xf
             bool usable = n >= 0 && ps_v3_len2(s->normals.items[nbase + (uint32_t)n]) > 0.0;
             tr->n[c] = usable ? (int32_t)(nbase + (uint32_t)n) : -1;
         }
+        for (int c = 0; c < 3; c++) {
+            int32_t k = om->tri_t[3 * t + (mirror && c > 0 ? 3 - c : c)];
+            tr->t[c] = k >= 0 ? (int32_t)(tbase + (uint32_t)k) : -1;
+        }
+        if (tr->t[0] < 0 || tr->t[1] < 0 || tr->t[2] < 0)
+            tr->t[0] = tr->t[1] = tr->t[2] = -1;
         /* A face with some corners lacking a normal uses the face normal throughout. */
         if (tr->n[0] < 0 || tr->n[1] < 0 || tr->n[2] < 0)
             tr->n[0] = tr->n[1] = tr->n[2] = -1;
@@ -673,6 +775,12 @@ static ps_status parse_mesh(parser *p)
         const char *key = p->tok[p->pos++];
         double v[4];
         ps_xform step;
+        if (!strcmp(key, "move") || !strcmp(key, "light-power")) {
+            p->pos--;
+            if ((st = parse_edits(p, true)) != PS_OK)
+                return st;
+            break;
+        }
         if (!strcmp(key, "material")) {
             if (override)
                 return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: mesh: 'material' given twice", p->name, p->line);
@@ -725,10 +833,39 @@ static ps_status parse_mesh(parser *p)
     ps_obj_mesh om;
     ps_error oerr;
     st = ps_obj_load(path, &om, p->warn, &oerr);
+    if (st == PS_OK) {
+        /* The keys as written, without the edits, and the file by absolute
+         * path: what ps_scene_write writes relative to a new place. */
+        char keys[SCN_LINE_MAX] = "";
+        size_t used = 0;
+        for (int k = 2; k < p->ntok && strcmp(p->tok[k], "move") != 0 && strcmp(p->tok[k], "light-power") != 0; k++)
+            used += (size_t)snprintf(keys + used, used < sizeof keys ? sizeof keys - used : 0, "%s%s", used ? " " : "",
+                                     p->tok[k]);
+        char *abs = ps_scene_abs_path(path);
+        p->pending_obj.file = abs ? ps_scene_add_string(p->s, abs) : PS_SOURCE_NONE;
+        p->pending_obj.keys = ps_scene_add_string(p->s, keys);
+        p->pending_obj.first_light = (uint32_t)p->s->lights.count;
+        free(abs);
+        if (p->pending_obj.file == PS_SOURCE_NONE || p->pending_obj.keys == PS_SOURCE_NONE) {
+            ps_obj_free(&om);
+            return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        }
+    }
     if (st != PS_OK) {
         /* An OBJ/MTL problem with a line of its own names that line first (and
          * the error keeps it); one without (a missing file) is the scene
          * line's problem. */
+        if (p->model) { /* the model itself: its own message, no scene line */
+            size_t n = strlen(path);
+            /* A problem of the whole file ("path: no faces") at its line 1. */
+            if (oerr.line == 0 && !strncmp(oerr.msg, path, n) && !strncmp(oerr.msg + n, ": ", 2))
+                ps_error_set(p->err, st, "%s:1: %s", path, oerr.msg + n + 2);
+            else
+                ps_error_set(p->err, st, "%s", oerr.msg);
+            if (p->err)
+                p->err->line = oerr.line;
+            return st;
+        }
         if (oerr.line > 0) {
             ps_error_set(p->err, st, "%s (mesh at %s:%d)", oerr.msg, p->name, p->line);
             if (p->err)
@@ -865,6 +1002,7 @@ static ps_status parse_ies_light(parser *p, ps_light *l)
     ps_vec3 aim = kv[1].present ? kv_vec3(&kv[1]) : ps_v3(0, -1, 0);
     if ((st = check_direction(p, "aim", aim)) != PS_OK)
         return st;
+    p->pending_light.dir = aim;
     l->direction = ps_v3_norm(aim);
     l->spin_deg = kv[2].present ? kv[2].v[0] : 0.0;
     if (!(fabs(l->spin_deg) <= 360.0 * 1000.0))
@@ -889,6 +1027,15 @@ static ps_status parse_ies_light(parser *p, ps_light *l)
     ps_ies *ies = NULL;
     ps_error ierr;
     st = ps_ies_load(path, &ies, &ierr);
+    if (st == PS_OK) {
+        char *abs = ps_scene_abs_path(path);
+        p->pending_light.file = abs ? ps_scene_add_string(p->s, abs) : PS_SOURCE_NONE;
+        free(abs);
+        if (p->pending_light.file == PS_SOURCE_NONE) {
+            ps_ies_destroy(ies);
+            return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        }
+    }
     if (st != PS_OK) {
         /* As for meshes: a problem on a line of the IES file names that line. */
         const char *colon = strchr(ierr.msg, ':');
@@ -959,6 +1106,7 @@ static ps_status parse_light(parser *p)
         l.position = kv_vec3(&kv[0]);
         if ((st = check_direction(p, "direction", kv_vec3(&kv[1]))) != PS_OK)
             return st;
+        p->pending_light.dir = kv_vec3(&kv[1]);
         l.direction = ps_v3_norm(kv_vec3(&kv[1]));
         l.angle_deg = kv[2].v[0];
         if (!(l.angle_deg > 0.0 && l.angle_deg <= 90.0))
@@ -1003,6 +1151,7 @@ static ps_status parse_light(parser *p)
             return st;
         l.type = PS_LIGHT_DISC;
         l.position = kv_vec3(&kv[0]);
+        p->pending_light.dir = kv_vec3(&kv[1]);
         l.direction = ps_v3_norm(kv_vec3(&kv[1]));
         l.radius = kv[2].v[0];
         l.area = PS_PI * l.radius * l.radius;
@@ -1182,11 +1331,129 @@ static void apply_defaults(parser *p)
         d->global_radius = DEFAULT_GLOBAL_RADIUS_FRACTION * diag;
 }
 
+/* After a statement: what it made, in the source arrays ps_scene_write reads
+ * (scene_internal.h), then its saved edits applied. */
+static ps_status record_statement(parser *p, const char *kw, size_t materials, size_t objects, size_t lights)
+{
+    ps_scene *s = p->s;
+    bool ok = true;
+    if (!strcmp(kw, "material") && s->materials.count > materials) {
+        ps_scene_stmt *st = PS_VEC_PUSH(s->stmts);
+        if ((ok = st != NULL))
+            *st = (ps_scene_stmt){PS_STMT_MATERIAL, (uint32_t)materials};
+    }
+    for (size_t o = objects; ok && o < s->objects.count; o++) {
+        ps_scene_stmt *st = PS_VEC_PUSH(s->stmts);
+        ps_object_source *src = st ? PS_VEC_PUSH(s->obj_src) : NULL;
+        if ((ok = src != NULL)) {
+            *st = (ps_scene_stmt){PS_STMT_OBJECT, (uint32_t)o};
+            *src = p->pending_obj;
+        }
+    }
+    for (size_t l = lights; ok && l < s->lights.count; l++) {
+        bool own = !strcmp(kw, "light"); /* else a mesh's emissive faces */
+        ps_scene_stmt *st = own ? PS_VEC_PUSH(s->stmts) : NULL;
+        ps_light_source *src = !own || st ? PS_VEC_PUSH(s->light_src) : NULL;
+        if ((ok = src != NULL)) {
+            if (own)
+                *st = (ps_scene_stmt){PS_STMT_LIGHT, (uint32_t)l};
+            *src = own ? p->pending_light : (ps_light_source){PS_SOURCE_NONE, {0, 0, 0}};
+        }
+    }
+    if (!ok)
+        return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+    for (size_t k = 0; k < p->pending_edits.count; k++) {
+        const ps_scene_edit *e = &p->pending_edits.items[k];
+        uint32_t object = (uint32_t)(s->objects.count - 1);
+        ps_status st;
+        if (e->light == PS_SOURCE_NONE) {
+            st = ps_scene_translate_object(s, object, e->v, p->err);
+        } else {
+            size_t first = p->pending_obj.first_light, count = s->lights.count - lights;
+            if (e->light >= count)
+                return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: mesh: light-power %" PRIu32
+                                    ": the mesh has %zu emissive light%s", p->name, p->line, e->light, count,
+                                    count == 1 ? "" : "s");
+            st = ps_scene_set_light_power(s, first + e->light, ps_rgb_make(e->v.x, e->v.y, e->v.z), p->err);
+        }
+        if (st != PS_OK)
+            return st;
+    }
+    return PS_OK;
+}
+
 static ps_status parse_one_line(void *user, char *text)
 {
     parser *p = user;
     ps_status st = tokenize(p, text);
-    return st == PS_OK && p->ntok > 0 ? parse_statement(p) : st;
+    if (st != PS_OK || p->ntok == 0)
+        return st;
+    ps_scene *s = p->s;
+    size_t materials = s->materials.count, objects = s->objects.count, lights = s->lights.count;
+    memset(&p->pending_obj, 0, sizeof p->pending_obj);
+    p->pending_obj.file = p->pending_obj.keys = p->pending_obj.first_light = PS_SOURCE_NONE;
+    memset(&p->pending_light, 0, sizeof p->pending_light);
+    p->pending_light.file = PS_SOURCE_NONE;
+    p->pending_edits.count = 0;
+    const char *kw = p->tok[0];
+    st = parse_statement(p);
+    return st == PS_OK ? record_statement(p, kw, materials, objects, lights) : st;
+}
+
+/* An .obj opened in place of a scene (contract): the camera frames the
+ * model's bounding box from the front (+z), a little above, fov 40, with the
+ * box's bounding sphere filling the view; with no emissive face, a point
+ * light above and behind the camera, bright enough that a white surface at
+ * the box's centre reflects a radiance of about 1 (irradiance pi W/m^2 per
+ * channel), named through the warning sink and kept for the window's
+ * overlay (ps_scene_note). */
+#define MODEL_ELEVATION_DEG 15.0
+#define MODEL_MARGIN 1.1         /* the sphere's radius over what just fits */
+#define MODEL_LIGHT_RAISE 0.5    /* above the eye, in bounding-sphere radii */
+static ps_status frame_model(parser *p)
+{
+    ps_scene *s = p->s;
+    ps_scene_finish(s);
+    ps_aabb b = s->bounds;
+    ps_vec3 c = ps_aabb_center(b);
+    double r = 0.5 * ps_v3_len(ps_aabb_diag(b));
+    if (!(r > 0.0) || !isfinite(r))
+        r = 1.0;
+    double half = 0.5 * DEFAULT_FOV_DEG * (PS_PI / 180.0), e = MODEL_ELEVATION_DEG * (PS_PI / 180.0);
+    double dist = MODEL_MARGIN * r / sin(half);
+    s->camera.eye = ps_v3_add(c, ps_v3(0.0, dist * sin(e), dist * cos(e)));
+    s->camera.target = c;
+    s->camera.up = ps_v3(0, 1, 0);
+    s->camera.fov_deg = DEFAULT_FOV_DEG;
+    p->has_camera = true;
+    /* Photon radii from the model's size, not the default light's distance. */
+    s->defaults.caustic_radius = DEFAULT_CAUSTIC_RADIUS_FRACTION * 2.0 * r;
+    s->defaults.global_radius = DEFAULT_GLOBAL_RADIUS_FRACTION * 2.0 * r;
+    if (s->lights.count > 0)
+        return PS_OK;
+    ps_light *l = PS_VEC_PUSH(s->lights);
+    ps_light_source *src = l ? PS_VEC_PUSH(s->light_src) : NULL;
+    ps_scene_stmt *stmt = src ? PS_VEC_PUSH(s->stmts) : NULL;
+    if (!stmt)
+        return ps_error_set(p->err, PS_ERR_NOMEM, "%s: out of memory", p->name);
+    l->type = PS_LIGHT_POINT;
+    l->line = 1;
+    l->position = ps_v3_add(s->camera.eye, ps_v3(0.0, MODEL_LIGHT_RAISE * r, 0.0));
+    double d2 = ps_v3_len2(ps_v3_sub(l->position, c));
+    /* E = P / (4 pi d^2) = pi at the centre. */
+    l->power = ps_rgb_gray(4.0 * PS_PI * PS_PI * d2);
+    if (!(ps_rgb_max(l->power) <= PS_SCENE_MAX_LIGHT_POWER))
+        return ps_error_set(p->err, PS_ERR_RANGE, "%s: the model is too large for a default light (%g W)", p->name,
+                            l->power.r);
+    *src = (ps_light_source){PS_SOURCE_NONE, {0, 0, 0}};
+    *stmt = (ps_scene_stmt){PS_STMT_LIGHT, (uint32_t)(s->lights.count - 1)};
+    char note[256];
+    snprintf(note, sizeof note, "default light 0: point at (%.3g %.3g %.3g), %.3g W (the model has no emitter)",
+             l->position.x, l->position.y, l->position.z, l->power.r);
+    if ((s->note = ps_scene_add_string(s, note)) == PS_SOURCE_NONE)
+        return ps_error_set(p->err, PS_ERR_NOMEM, "%s: out of memory", p->name);
+    ps_warn(p->warn, "%s: %s", p->name, note);
+    return PS_OK;
 }
 
 static ps_status parse_text(parser *p, const char *text, size_t len)
@@ -1194,6 +1461,8 @@ static ps_status parse_text(parser *p, const char *text, size_t len)
     (void)len; /* NUL-free (checked by the caller), so the text ends at its NUL */
     ps_status st = ps_text_lines(text, p->name, SCN_LINE_MAX - 1, parse_one_line, p, &p->line, p->err);
     if (st != PS_OK)
+        return st;
+    if (p->model && (st = frame_model(p)) != PS_OK)
         return st;
     int last = p->line > 0 ? p->line : 1;
     if (!p->has_camera)
@@ -1212,7 +1481,7 @@ static ps_status parse_text(parser *p, const char *text, size_t len)
 
 /* Shared by both entry points; text has len bytes and a NUL after them. */
 static ps_status load_text(const char *text, size_t len, const char *name, const char *base_dir,
-                           const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
+                           const ps_scene_load_options *opts, bool model, ps_scene **out, ps_error *err)
 {
     *out = NULL;
     ps_error local;
@@ -1236,11 +1505,13 @@ static ps_status load_text(const char *text, size_t len, const char *name, const
     p.warn = opts ? &opts->warn : &to_stderr;
     p.err = err;
     p.default_material = -1;
+    p.model = model;
     p.s->defaults.caustic_photons = p.s->defaults.global_photons = -1; /* unset */
     int bin = ps_text_nul_line(text, len);
     ps_status st = bin ? ps_error_set(err, PS_ERR_PARSE, "%s:%d: binary data (a NUL byte), not a scene file", name, bin)
                        : parse_text(&p, text, len);
     ps_namemap_destroy(p.material_names);
+    free(p.pending_edits.items);
     if (st != PS_OK) {
         ps_scene_destroy(p.s);
         return st;
@@ -1252,7 +1523,14 @@ static ps_status load_text(const char *text, size_t len, const char *name, const
 ps_status ps_scene_load_text(const char *text, const char *name, const char *base_dir,
                              const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
 {
-    return load_text(text, strlen(text), name, base_dir, opts, out, err);
+    return load_text(text, strlen(text), name, base_dir, opts, false, out, err);
+}
+
+bool ps_scene_path_is_model(const char *path)
+{
+    size_t n = strlen(path);
+    return n > 4 && path[n - 4] == '.' && (path[n - 3] | 32) == 'o' && (path[n - 2] | 32) == 'b' &&
+           (path[n - 1] | 32) == 'j';
 }
 
 ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_scene **out, ps_error *err)
@@ -1260,9 +1538,21 @@ ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_
     *out = NULL;
     char *text = NULL;
     size_t len = 0;
-    ps_status st = ps_read_file(path, SCN_MAX_BYTES, &text, &len, err);
-    if (st != PS_OK)
+    bool model = ps_scene_path_is_model(path);
+    ps_status st;
+    if (model) {
+        /* The model as a one-statement scene: `mesh "FILE"`, beside it. */
+        const char *slash = strrchr(path, '/');
+        const char *base = slash ? slash + 1 : path;
+        if (strchr(base, '"'))
+            return ps_error_set(err, PS_ERR_PARSE, "%s: a model's file name may not hold a double quote", path);
+        len = strlen(base) + sizeof "mesh \"\"\n";
+        if (!(text = malloc(len)))
+            return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", path);
+        len = (size_t)snprintf(text, len, "mesh \"%s\"\n", base);
+    } else if ((st = ps_read_file(path, SCN_MAX_BYTES, &text, &len, err)) != PS_OK) {
         return st;
+    }
     char dir[4096];
     const char *slash = strrchr(path, '/');
     size_t dlen = slash ? (size_t)(slash - path) : 0;
@@ -1272,7 +1562,7 @@ ps_status ps_scene_load(const char *path, const ps_scene_load_options *opts, ps_
         dlen = 0;
     memcpy(dir, path, dlen);
     dir[dlen] = '\0';
-    st = load_text(text, len, path, dir, opts, out, err);
+    st = load_text(text, len, path, dir, opts, model, out, err);
     free(text);
     return st;
 }
