@@ -947,7 +947,7 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
         wk[i].reports = i == 0;
         wk[i].scratch = malloc(k * sizeof *wk[i].scratch);
         wk[i].samples = malloc((size_t)(o->cache_rays > 0 ? o->cache_rays : 1) * sizeof *wk[i].samples);
-        wk[i].tile = o->share ? malloc(tile_floats(&job) * sizeof *wk[i].tile) : NULL;
+        wk[i].tile = o->share ? calloc(tile_floats(&job), sizeof *wk[i].tile) : NULL; /* edge tiles send zeros */
         if (!wk[i].scratch || !wk[i].samples || (o->share && !wk[i].tile)) {
             for (int j = 0; j <= i; j++) {
                 free(wk[j].scratch);
