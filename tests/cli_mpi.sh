@@ -111,7 +111,7 @@ long_run() {
     [ -z "$(ls -a "$cli_tmp" | grep 'g\.png')" ] && ok || bad "$1: a temporary file remains: $(ls -a "$cli_tmp")"
 }
 long_run "rank killed" KILL rank
-expect_match "rank killed: says so" "$cli_err" 'rank 1 .*exited on signal 9'
+expect_match "rank killed: says so" "$cli_err" 'process rank [0-9]+ .*exited on signal 9'
 long_run "SIGINT" INT mpirun
 expect_match "SIGINT: rank 0 says how far" "$cli_err" '^photosplat-ref: (rank [0-9]+: )?interrupted .*; nothing written'
 expect_match "SIGINT: once" "$(grep -c 'nothing written' "$cli_tmp/err")" '^1$'
