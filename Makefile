@@ -37,7 +37,7 @@ LDOPT_asan := -fsanitize=address,undefined
 # context of its own. A program links it with exactly one GL implementation:
 # photosplat-snap with OSMesa, the window with libGL (never both: platform
 # notes). GL_PROGS lists the OSMesa programs, GL tests are tests/test_gl*.c.
-LIB_C := $(filter-out src/app/%_main.c src/gl/%,$(wildcard src/*/*.c))
+LIB_C := $(filter-out src/app/%_main.c src/gl/% src/dist/%,$(wildcard src/*/*.c))
 LIB_CXX := $(wildcard src/*/*.cpp)
 # src/gl/platform_*.c are the context backends (platform.h): each program
 # links one, platform_osmesa with OSMesa, platform_glfw with GLFW and libGL.

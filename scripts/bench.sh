@@ -39,6 +39,10 @@ done
 quick=()
 [ "${PS_BENCH_QUICK:-0}" != 0 ] && quick=(--quick)
 [ "${PS_BENCH_PREVIEW:-1}" != 0 ] && step photosplat-bench bin/photosplat-bench "${quick[@]}"
+# photosplat-ref-mpi: 2 ranks x 1 thread against 1 process x 2 threads, and
+# the phases' model of more ranks (bench/results/mpi.txt); about 2 minutes;
+# PS_BENCH_MPI=0 skips it.
+[ "${PS_BENCH_MPI:-1}" != 0 ] && step bench-mpi scripts/bench-mpi.sh
 # The window's frames per second and edit latency, under Xvfb.
 step bench-window scripts/bench-window.sh
 if [ "$found" -eq 0 ]; then

@@ -33,6 +33,10 @@ need_cmd xvfb-run xvfb
 need_cmd xauth xauth
 # The OBJ models the loader is tested on (tests/cli_models.sh).
 [ -d /usr/share/assimp/models/OBJ ] || missing+=(assimp-testmodels)
+# photosplat-ref-mpi and its tests: Open MPI (mpicc and ompi-c.pc from the -dev
+# package, mpirun from openmpi-bin).
+need_pc ompi-c libopenmpi-dev
+need_cmd mpirun openmpi-bin
 # The sanitizer runtimes come with gcc on Debian but may be trimmed from images.
 [ -e "$(gcc -print-file-name=libasan.so 2>/dev/null)" ] && gcc -print-file-name=libasan.so | grep -q / || missing+=(libasan8)
 [ -e "$(gcc -print-file-name=libubsan.so 2>/dev/null)" ] && gcc -print-file-name=libubsan.so | grep -q / || missing+=(libubsan1)

@@ -10,6 +10,7 @@
 #include "app/cli.h"
 #include "app/interrupt.h"
 #include "app/options.h"
+#include "app/ref_dist.h"
 #include "app/stats.h"
 #include "core/fileio.h"
 #include "photon/estimate.h"
@@ -19,6 +20,9 @@
 #include "image/exr_io.h"
 #include "render/render.h"
 #include "scene/scene.h"
+#ifdef PS_REF_DIST
+#include "dist/dist.h"
+#endif
 
 /* Defaults for the image: --quality default's settings (ps_render_quality),
  * then k. */
@@ -99,6 +103,7 @@ typedef struct ref_options {
     const char *out_lux, *out_false; /* --illuminance, --false-color */
     int accel;
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM */
+    const ps_ref_dist *dist;      /* NULL, or the ranks of photosplat-ref-mpi (ref_dist.h) */
 } ref_options;
 
 static ps_status parse_args(int argc, char **argv, ref_options *o, bool *help, ps_error *err)
@@ -250,6 +255,15 @@ static ps_status render_illuminance(ref_run *r, const ps_render_maps *maps, ps_r
 }
 
 
+/* Photons [0, total) of map kind into m: here, or split over the ranks. */
+static ps_status trace_map(const ref_options *o, ps_tracer *t, ps_map_kind kind, uint64_t total, uint64_t max_stored,
+                           ps_photon_map *m, ps_error *err)
+{
+    if (o->dist)
+        return o->dist->trace(o->dist->user, t, kind, total, max_stored, m, err);
+    return ps_tracer_trace(t, kind, 0, total, total, m, err);
+}
+
 /* What the image needs beyond the two maps: the kd-trees, and for final
  * gathering a global map with the direct hits and its precomputed irradiance. */
 static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_run *r, const ps_tracer_options *topt,
@@ -275,6 +289,7 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
     ro.global.max_radius = o->max_radius > 0.0 ? o->max_radius : radius[PS_MAP_GLOBAL];
     ro.irradiance_radius = ro.global.max_radius;
     ro.cancel = o->cancel;
+    ro.share = o->dist ? o->dist->share : NULL;
 
     double t0 = ps_now_seconds();
     ps_status st = ps_light_sampler_create(scene, &r->lights, err);
@@ -291,7 +306,7 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
         ps_photon_map_init(&r->full, PS_MAP_GLOBAL);
         st = ps_tracer_create(r->world, &full, &r->full_tracer, err);
         if (st == PS_OK)
-            st = ps_tracer_trace(r->full_tracer, PS_MAP_GLOBAL, 0, global_photons, global_photons, &r->full, err);
+            st = trace_map(o, r->full_tracer, PS_MAP_GLOBAL, global_photons, full.max_stored, &r->full, err);
         if (st == PS_OK)
             st = ps_kdtree_build(r->full.photons, r->full.count, &r->full_tree, err);
         if (st == PS_OK)
@@ -370,7 +385,7 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
                 ps_error_set(err, st, "photosplat-ref: out of memory");
             continue;
         }
-        st = ps_tracer_trace(r.tracer, (ps_map_kind)k, 0, want[k], want[k], &r.maps[k], err);
+        st = trace_map(o, r.tracer, (ps_map_kind)k, want[k], topt.max_stored, &r.maps[k], err);
     }
     t_trace = ps_now_seconds() - t_trace;
 
@@ -402,6 +417,17 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
      * stopped run writes none of them. */
     if (st == PS_OK && ps_cancelled(o->cancel))
         st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after the whole image, before writing it");
+    /* A distributed run: every rank has the whole result; rank 0 alone
+     * writes it and reports, once every rank has succeeded. */
+    if (o->dist) {
+        st = o->dist->agree(o->dist->user, st, err);
+        if (st == PS_OK)
+            o->dist->add_stats(o->dist->user, &rs);
+        if (!o->dist->root) {
+            ref_run_free(&r);
+            return st;
+        }
+    }
     if (st == PS_OK && !o->photons_only && o->c.out_hdr)
         st = ps_hdr_write(&r.image, o->c.out_hdr, err);
     if (st == PS_OK && !o->photons_only && (o->out_lux || o->out_false))
@@ -424,7 +450,7 @@ static ps_status run(const ref_options *o, const ps_scene *scene, ps_error *err)
     return st;
 }
 
-int main(int argc, char **argv)
+static int ref_main(int argc, char **argv, const ps_ref_dist *dist)
 {
     ps_error err;
     ps_error_clear(&err);
@@ -432,6 +458,7 @@ int main(int argc, char **argv)
     bool help = false;
     if (parse_args(argc, argv, &o, &help, &err) != PS_OK)
         return ps_cli_fail(&err);
+    o.dist = dist;
     if (help) {
         fputs(usage, stdout);
         return PS_EXIT_OK;
@@ -463,4 +490,15 @@ int main(int argc, char **argv)
     if (st == PS_ERR_INTERRUPTED)
         return ps_interrupt_fail("photosplat-ref", &err);
     return st == PS_OK ? PS_EXIT_OK : ps_cli_fail(&err);
+}
+
+/* The same program is photosplat-ref-mpi when built with PS_REF_DIST
+ * (mk/mpi.mk): src/dist starts MPI and hands ref_main its hooks. */
+int main(int argc, char **argv)
+{
+#ifdef PS_REF_DIST
+    return ps_dist_main(argc, argv, ref_main);
+#else
+    return ref_main(argc, argv, NULL);
+#endif
 }

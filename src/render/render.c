@@ -38,6 +38,7 @@ typedef struct render_job {
     int halo;
     int tiles_x, tiles;
     atomic_int next_tile, done_tiles;
+    atomic_int taken_tiles; /* shared (ps_render_share): tiles this process took */
     /* The irradiance cache (see render.h) and, while it is made, the level
      * (grid spacing) and chunk of positions being worked on. */
     ps_irrcache *irr;
@@ -57,6 +58,7 @@ typedef struct worker {
     ps_irr_sample *samples; /* a cache record's gather rays */
     uint64_t rays;
     bool reports;  /* the calling thread's: reports progress */
+    float *tile;   /* shared (ps_render_share): a finished tile's buffer */
 } worker;
 
 static size_t max_k(const ps_render_options *o) { return o->caustic.k > o->global.k ? o->caustic.k : o->global.k; }
@@ -376,7 +378,11 @@ static void *cache_worker(void *arg)
 {
     worker *wk = arg;
     render_job *job = wk->job;
-    for (int64_t i; !ps_cancelled(job->o->cancel) && (i = atomic_fetch_add(&job->next_record, 1)) < job->chunk_end;) {
+    /* Shared with other processes, this one takes every parts-th position. */
+    const ps_render_share *sh = job->o->share;
+    int64_t part = sh ? sh->part : 0, parts = sh ? sh->parts : 1;
+    for (int64_t i; !ps_cancelled(job->o->cancel) &&
+                    (i = job->chunk_begin + part + parts * atomic_fetch_add(&job->next_record, 1)) < job->chunk_end;) {
         int64_t slot = (i - job->chunk_begin) * CACHE_HITS;
         double px, py;
         cache_position(job, i, &px, &py);
@@ -427,7 +433,9 @@ static ps_status cache_build(render_job *job, worker *wk, int threads, ps_error 
         for (int64_t begin = 0; begin < job->cache_total && st == PS_OK; begin += CACHE_CHUNK) {
             job->chunk_begin = begin;
             job->chunk_end = begin + CACHE_CHUNK < job->cache_total ? begin + CACHE_CHUNK : job->cache_total;
-            atomic_store(&job->next_record, begin);
+            atomic_store(&job->next_record, 0);
+            if (o->share) /* the slots of other processes' positions stay empty until the exchange */
+                memset(job->chunk_ok, 0, CACHE_CHUNK * CACHE_HITS * sizeof *job->chunk_ok);
             pthread_t tid[MAX_THREADS];
             int started = 0;
             for (; started < threads - 1; started++)
@@ -436,6 +444,11 @@ static ps_status cache_build(render_job *job, worker *wk, int threads, ps_error 
             cache_worker(&wk[0]);
             for (int i = 0; i < started; i++)
                 pthread_join(tid[i], NULL);
+            if (o->share)
+                st = o->share->cache_exchange(o->share->user, job->chunk, job->chunk_ok,
+                                              (size_t)(job->chunk_end - begin) * CACHE_HITS, ps_cancelled(o->cancel), err);
+            if (st != PS_OK)
+                return st;
             if (ps_cancelled(o->cancel))
                 return PS_OK; /* the tiles stop at once and report it */
             for (int64_t s = 0; s < (job->chunk_end - begin) * CACHE_HITS && st == PS_OK; s++)
@@ -839,6 +852,31 @@ static bool render_tile(worker *wk, int tile)
     return true;
 }
 
+/* Floats a tile's buffer holds for ps_render_share: the filter's buffer,
+ * or the box's pixels (TILE x TILE x 3, rows cut at the image's edge). */
+static size_t tile_floats(const render_job *job)
+{
+    size_t side = (size_t)(TILE + 2 * job->halo);
+    return job->accum ? side * side * 4 : (size_t)TILE * TILE * 3;
+}
+
+/* A tile's buffer copied out (to non-NULL `out`) or in (from `in`). */
+static void tile_copy(render_job *job, int tile, float *out, const float *in)
+{
+    if (job->accum) {
+        float *buf = tile_buffer(job, tile);
+        memcpy(out ? out : buf, out ? buf : in, tile_floats(job) * sizeof *buf);
+        return;
+    }
+    int x0 = tile % job->tiles_x * TILE, y0 = tile / job->tiles_x * TILE;
+    int w = x0 + TILE < job->o->width ? TILE : job->o->width - x0;
+    for (int y = y0; y < y0 + TILE && y < job->o->height; y++) {
+        float *px = ps_image_at(job->img, x0, y);
+        size_t at = (size_t)(y - y0) * TILE * 3;
+        memcpy(out ? out + at : px, out ? px : in + at, (size_t)w * 3 * sizeof *px);
+    }
+}
+
 /* Takes tiles until none are left. The calling thread's worker (`reports`)
  * also reports progress between its tiles. */
 static void *render_worker(void *arg)
@@ -848,13 +886,19 @@ static void *render_worker(void *arg)
     for (;;) {
         if (ps_cancelled(job->o->cancel))
             break; /* between tiles: every finished tile is whole */
-        int t = atomic_fetch_add(&job->next_tile, 1);
-        if (t >= job->tiles)
+        const ps_render_share *sh = job->o->share;
+        int t = sh ? sh->next_tile(sh->user) : atomic_fetch_add(&job->next_tile, 1);
+        if (t < 0 || t >= job->tiles)
             break;
+        if (sh)
+            atomic_fetch_add(&job->taken_tiles, 1);
         if (!render_tile(wk, t))
             break;
         int done = atomic_fetch_add(&job->done_tiles, 1) + 1;
-        if (wk->reports && job->o->progress)
+        if (sh) { /* the share reports the progress of every process */
+            tile_copy(job, t, wk->tile, NULL);
+            sh->tile_done(sh->user, t, wk->tile);
+        } else if (wk->reports && job->o->progress)
             job->o->progress(job->o->progress_user, (double)done / job->tiles);
     }
     atomic_fetch_add(&job->rays, wk->rays);
@@ -885,6 +929,7 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     job.tiles = job.tiles_x * ((o->height + TILE - 1) / TILE);
     atomic_init(&job.next_tile, 0);
     atomic_init(&job.done_tiles, 0);
+    atomic_init(&job.taken_tiles, 0);
     atomic_init(&job.rays, 0);
     if (o->filter != PS_FILTER_BOX) {
         job.halo = filter_halo(o->filter);
@@ -905,10 +950,12 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
         wk[i].reports = i == 0;
         wk[i].scratch = malloc(k * sizeof *wk[i].scratch);
         wk[i].samples = malloc((size_t)(o->cache_rays > 0 ? o->cache_rays : 1) * sizeof *wk[i].samples);
-        if (!wk[i].scratch || !wk[i].samples) {
+        wk[i].tile = o->share ? calloc(tile_floats(&job), sizeof *wk[i].tile) : NULL; /* edge tiles send zeros */
+        if (!wk[i].scratch || !wk[i].samples || (o->share && !wk[i].tile)) {
             for (int j = 0; j <= i; j++) {
                 free(wk[j].scratch);
                 free(wk[j].samples);
+                free(wk[j].tile);
             }
             free(job.accum);
             ps_image_destroy(out);
@@ -933,10 +980,13 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
         free(job.chunk_ok);
     }
     t_cache = ps_now_seconds() - t_cache;
+    if (st == PS_OK && o->share)
+        st = o->share->tiles_begin(o->share->user, o, job.tiles, tile_floats(&job), err);
     if (st != PS_OK) {
         for (int i = 0; i < threads; i++) {
             free(wk[i].scratch);
             free(wk[i].samples);
+            free(wk[i].tile);
         }
         ps_irrcache_destroy(job.irr);
         free(job.accum);
@@ -952,19 +1002,38 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     for (int i = 0; i < threads; i++) {
         free(wk[i].scratch);
         free(wk[i].samples);
+        free(wk[i].tile);
     }
     int done = atomic_load(&job.done_tiles);
+    uint64_t rays = atomic_load(&job.rays);
+    if (o->share) {
+        /* Every tile this process took is done unless it was stopped; the
+         * share says whether all of them are, everywhere. */
+        bool complete = done == atomic_load(&job.taken_tiles) && !ps_cancelled(o->cancel);
+        st = o->share->tiles_end(o->share->user, complete, &rays, err);
+        if (st == PS_OK && o->share->assemble)
+            for (int t = 0; t < job.tiles; t++) {
+                const float *data = o->share->tile_data(o->share->user, t);
+                if (data)
+                    tile_copy(&job, t, NULL, data);
+            }
+        done = st == PS_OK ? job.tiles : 0;
+    }
     if (stats) {
         stats->cache_records = job.irr ? ps_irrcache_count(job.irr) : 0;
         stats->cache_seconds = t_cache;
-        stats->rays = atomic_load(&job.rays);
+        stats->rays = rays;
         stats->seconds = ps_now_seconds() - t0;
         stats->fraction = (double)done / job.tiles;
     }
     ps_irrcache_destroy(job.irr);
-    if (job.accum && done == job.tiles)
+    if (job.accum && done == job.tiles && (!o->share || o->share->assemble))
         resolve_filter(&job);
     free(job.accum);
+    if (st != PS_OK) { /* a shared render: another process stopped or failed */
+        ps_image_destroy(out);
+        return st;
+    }
     if (done < job.tiles) { /* only the cancel flag stops workers early */
         ps_image_destroy(out);
         return ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.0f %% of the image",

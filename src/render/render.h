@@ -24,6 +24,7 @@
 #include "photon/estimate.h"
 #include "photon/kdtree.h"
 #include "photon/world.h"
+#include "render/irrcache.h"
 
 typedef enum ps_component {
     PS_COMPONENT_ALL,
@@ -87,7 +88,42 @@ typedef struct ps_render_maps {
     const ps_kdtree *irradiance; /* irradiance precomputed at the full map's photons */
 } ps_render_maps;
 
-typedef struct ps_render_options {
+typedef struct ps_render_options ps_render_options;
+
+/* A render shared with other processes (a distributed run: src/dist supplies
+ * these; NULL in one process). The image is the same bytes as one process
+ * makes, because every piece is made by the same code from the same inputs
+ * and joined in the same order:
+ * - the irradiance cache: each chunk's positions are split, position i of a
+ *   chunk to process (i - begin) mod parts == part; cache_exchange then gives
+ *   every process every process's records of the chunk (ok[s] marks a record
+ *   in slot s), and each adds them in slot order as one process does;
+ * - the tiles: handed out by next_tile; a finished one's buffer (tile_floats
+ *   floats) goes to tile_done; where `assemble`, after tiles_end, tile_data
+ *   gives the buffer of every tile made elsewhere (NULL: made here), and only
+ *   there is the image whole on return.
+ * Every hook but next_tile and tile_done is called from the render's calling
+ * thread; those two from any worker thread, so they must be thread-safe. */
+typedef struct ps_render_share {
+    void *user;
+    int part, parts;
+    bool assemble;
+    /* After this process's positions of a chunk; `cancelled`: this process
+     * was stopped. PS_ERR_INTERRUPTED (or another process's error) ends the
+     * render on every process. */
+    ps_status (*cache_exchange)(void *user, ps_irr_record *chunk, bool *ok, size_t slots, bool cancelled,
+                                ps_error *err);
+    /* Before the tiles; progress and cancel come from o. */
+    ps_status (*tiles_begin)(void *user, const ps_render_options *o, int tiles, size_t tile_floats, ps_error *err);
+    int (*next_tile)(void *user); /* -1: none left for this process */
+    void (*tile_done)(void *user, int tile, const float *data);
+    /* After this process's workers: `complete` when every tile it took is
+     * done; *rays in: this process's rays, out: every process's. */
+    ps_status (*tiles_end)(void *user, bool complete, uint64_t *rays, ps_error *err);
+    const float *(*tile_data)(void *user, int tile);
+} ps_render_share;
+
+struct ps_render_options {
     int width, height;
     int spp;                 /* eye samples per pixel (stratified) */
     int light_samples;       /* shadow rays per area light per eye sample */
@@ -120,7 +156,9 @@ typedef struct ps_render_options {
     /* NULL, or a flag that stops the render between tiles: PS_ERR_INTERRUPTED,
      * *out destroyed, stats->fraction the part finished. */
     const ps_cancel_flag *cancel;
-} ps_render_options;
+    /* NULL, or the other processes this render is shared with (above). */
+    const ps_render_share *share;
+};
 
 typedef struct ps_render_stats {
     uint64_t rays;
