@@ -448,6 +448,12 @@ void ps_illummap_colors(ps_illummap *m, const ps_material *materials, double sca
     *back = m->back;
 }
 
+void ps_illummap_colors_last(const ps_illummap *m, const float **front, const float **back)
+{
+    *front = m->front;
+    *back = m->back;
+}
+
 size_t ps_illummap_lobe(const ps_illummap *m, const ps_photon **photons, const uint16_t **materials,
                         const uint32_t **objects)
 {

@@ -137,6 +137,8 @@ ps_rgb ps_illummap_albedo(const ps_material *mat);
  * valid until the next call or destroy. Clears the changed flag. */
 void ps_illummap_colors(ps_illummap *m, const ps_material *materials, double scale, const float **front,
                         const float **back);
+/* The arrays as the last ps_illummap_colors left them. */
+void ps_illummap_colors_last(const ps_illummap *m, const float **front, const float **back);
 
 /* The lobe list: the photons (of those added) on glossy surfaces, as
  * parallel arrays for ps_splat_build. */
