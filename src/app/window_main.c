@@ -113,6 +113,7 @@ static const char help_text[] =
     "  + / -            selected light's power x/÷ 1.25\n"
     "  [ / ]            selected spot's angle -/+ 2 degrees\n"
     "  S  splat mode     K  kernel        C  precision mode\n"
+    "  M                global layer: splats / illumination maps\n"
     "  1 2 3            direct, caustic, global layer on/off\n"
     "  R / Shift+R      splat radius up / down\n"
     "  T / Shift+T      tau up / down\n"
@@ -698,6 +699,12 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         ps_session_set_precision(a->session, (ps_precision)((set->precision + 1) % PS_PRECISION_COUNT));
         a->redraw = true;
         break;
+    case GLFW_KEY_M:
+        if (ps_session_set_global_layer(a->session, (ps_global_layer)((set->global_layer + 1) % PS_GLOBAL_LAYER_COUNT),
+                                        &err) != PS_OK)
+            say(a, err.msg);
+        a->redraw = true;
+        break;
     case GLFW_KEY_1: set_layers(a, set->layers ^ PS_LAYER_DIRECT); break;
     case GLFW_KEY_2: set_layers(a, set->layers ^ PS_LAYER_CAUSTIC); break;
     case GLFW_KEY_3: set_layers(a, set->layers ^ PS_LAYER_GLOBAL); break;
@@ -845,6 +852,7 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
         case PS_SET_EXPOSURE: ps_session_set_exposure(s, act->number); return PS_OK;
         case PS_SET_PAUSE: ps_session_set_paused(s, act->choice != 0); return PS_OK;
         case PS_SET_FALSE_COLOR: set_false_color(a, act->choice != 0); return PS_OK;
+        case PS_SET_GLOBAL_LAYER: return ps_session_set_global_layer(s, (ps_global_layer)act->choice, err);
         }
         return PS_OK;
     }
