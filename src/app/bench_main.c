@@ -57,7 +57,7 @@ static const char usage[] =
     "                     scenes in data/scenes)\n"
     "  --size WxH         image size of every run (default 256x256)\n"
     "  --budgets LIST     checkpoint seconds (default 0.05,0.1,0.2,0.5,1,2,5,10)\n"
-    "  --quick            the four main configurations only, budgets up to 2 s\n"
+    "  --quick            the six main configurations only, budgets up to 2 s\n"
     "  --threads N        tracing and rendering threads (default: all cores)\n"
     "  --replot           run nothing: remake bench.md and the plots from OUT/bench.csv\n"
     "                     (the scenes and budgets must be the run's)\n"
