@@ -9,6 +9,7 @@
 #include "core/memory.h"
 
 #include "preview/illummap.h"
+#include "preview/session.h"
 #include "preview/mesh.h"
 #include "rig.h"
 
@@ -261,12 +262,108 @@ static void refuses_over_budget(void **state)
     close_fixture(&f);
 }
 
+/* ---- through the session ------------------------------------------------------- */
+
+static ps_session *open_session(ps_scene *scene, bool incremental, ps_radius_schedule schedule)
+{
+    ps_session_settings set = ps_session_default_settings(scene);
+    set.caps[PS_MAP_CAUSTIC] = 5000;
+    set.caps[PS_MAP_GLOBAL] = 40000;
+    set.seed = 9;
+    set.threads = 2;
+    set.float_buffer = set.incremental = incremental;
+    set.radius_schedule = schedule;
+    set.global_layer = PS_GLOBAL_MAPS;
+    ps_session *s;
+    ps_error err;
+    if (ps_session_create(scene, &set, &s, &err) != PS_OK)
+        fail_msg("session: %s", err.msg);
+    if (ps_session_trace_all(s, &err) != PS_OK)
+        fail_msg("trace: %s", err.msg);
+    return s;
+}
+
+/* Refreshes until everything is shown; the number of refreshes. */
+static int settle(ps_session *s, const ps_camera_frame *cam)
+{
+    int n = 0;
+    ps_error err;
+    do {
+        ps_session_frame f;
+        if (ps_session_refresh(s, cam, &f, &err) != PS_OK)
+            fail_msg("refresh: %s", err.msg);
+        bool shown = (ps_session_get_settings(s)->layers & PS_LAYER_GLOBAL) != 0;
+        assert_true(shown == (f.imap_front != NULL));
+        ps_session_drawn(s, 0.001);
+        n++;
+    } while (!ps_session_settled(s) && n < 1000);
+    return n;
+}
+
+/* The session's maps: every photon once, at the schedule's level for the
+ * photons emitted; the same sums from incremental refreshes as from one
+ * whole refresh; other settings and edits start them over. */
+static void session_fills_the_maps(void **state)
+{
+    (void)state;
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 32, 32);
+    for (int sched = 0; sched < PS_RADIUS_SCHEDULE_COUNT; sched++) {
+        ps_session *inc = open_session(scene, true, (ps_radius_schedule)sched);
+        ps_session *whole = open_session(scene, false, (ps_radius_schedule)sched);
+        int n_inc = settle(inc, &cam), n_whole = settle(whole, &cam);
+        const ps_illummap *a = ps_session_illummap(inc), *b = ps_session_illummap(whole);
+        size_t stored = ps_session_maps(inc)[PS_MAP_GLOBAL].count;
+        printf("session, %s radius: %d incremental refreshes, %d whole; %zu photons, radius %.4f\n",
+               ps_radius_schedule_name((ps_radius_schedule)sched), n_inc, n_whole, stored, ps_illummap_radius(a));
+        assert_true(n_inc > 1);
+        assert_int_equal(ps_illummap_count(a), stored);
+        assert_int_equal(ps_illummap_count(b), stored);
+        double want = ps_illummap_level_radius(a, ps_session_get_settings(inc)->radius[PS_MAP_GLOBAL],
+                                               ps_session_radius(inc, PS_MAP_GLOBAL));
+        assert_true(ps_illummap_radius(a) == want && ps_illummap_radius(b) == want);
+        for (size_t i = 0; i < ps_illummap_sample_count(a); i++)
+            for (int side = 0; side < 2; side++) {
+                ps_rgb ea = ps_illummap_irradiance(a, i, side, NULL, NULL, NULL);
+                ps_rgb eb = ps_illummap_irradiance(b, i, side, NULL, NULL, NULL);
+                if (memcmp(&ea, &eb, sizeof ea) != 0)
+                    fail_msg("sample %zu side %d: %g incremental, %g whole", i, side, ea.g, eb.g);
+            }
+        /* Hidden, the layer waits for nothing; shown again, it refreshes. */
+        ps_session_set_layers(inc, PS_LAYER_DIRECT | PS_LAYER_CAUSTIC);
+        settle(inc, &cam);
+        ps_session_set_layers(inc, PS_LAYER_ALL);
+        /* Splats and back: new maps, filled again. */
+        assert_int_equal(ps_session_set_global_layer(inc, PS_GLOBAL_SPLATS, &err), PS_OK);
+        assert_null(ps_session_illummap(inc));
+        ps_session_frame f;
+        assert_int_equal(ps_session_refresh(inc, &cam, &f, &err), PS_OK);
+        assert_null(f.imap_front);
+        assert_int_equal(ps_session_set_global_layer(inc, PS_GLOBAL_MAPS, &err), PS_OK);
+        assert_int_equal(ps_illummap_count(ps_session_illummap(inc)), 0);
+        settle(inc, &cam);
+        assert_int_equal(ps_illummap_count(ps_session_illummap(inc)), stored);
+        /* An edit restarts the maps from photon 0. */
+        assert_int_equal(ps_session_move_object(inc, 0, ps_v3(0.0, 0.01, 0.0), &err), PS_OK);
+        ps_session_changes ch;
+        assert_int_equal(ps_session_update(inc, &ch, &err), PS_OK);
+        assert_int_equal(ps_illummap_count(ps_session_illummap(inc)), 0);
+        ps_session_destroy(inc);
+        ps_session_destroy(whole);
+    }
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(furnace_is_uniform),   cmocka_unit_test(box_flux_is_the_photons),
         cmocka_unit_test(batches_do_not_matter), cmocka_unit_test(colours_are_radiance),
         cmocka_unit_test(radius_levels),        cmocka_unit_test(refuses_over_budget),
+        cmocka_unit_test(session_fills_the_maps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

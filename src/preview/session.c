@@ -444,6 +444,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         if (k == PS_MAP_GLOBAL && s->imap) {
             if (s->set.layers & PS_LAYER_GLOBAL)
                 st = imap_refresh(s, &maps[k], cam, out, err);
+            else /* not shown: nothing waits (showing it is a new view) */
+                s->drawn[k] = maps[k].count;
             continue;
         }
         ps_splat_batch *b = &s->batch[k];
