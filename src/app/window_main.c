@@ -94,6 +94,8 @@ static const char usage[] =
     "                           fixed; progressive: r^2 ~ n^(alpha-1), the given\n"
     "                           radius holding at the scene's photon count)\n"
     "  --radius-alpha A         the progressive schedule's alpha (default 2/3)\n"
+    "  --global-layer splats|maps  the global map as splats or as illumination maps\n"
+    "                           on the surfaces (default splats; key M)\n"
     "  --overlay on|off         the text overlay (default on)\n"
     "  --composite gl|cpu       where the picture is encoded for display: by GL (default),\n"
     "                           or read back and encoded on the CPU (the old way, for\n"
@@ -297,13 +299,14 @@ static void draw_overlay(app *a)
     int n = snprintf(text, sizeof text,
                      "caustic %llu/%llu  global %llu/%llu  %s\n"
                      "%.3g photons/s  %.1f fps  tau %.3g s  frame %.0f ms\n"
-                     "%s splats  %s kernel  r %.3g/%.3g  layers %s%s%s  %s  exposure %.3g\n",
+                     "%s splats  %s kernel  r %.3g/%.3g  layers %s%s%s  global %s  %s  exposure %.3g\n",
                      (unsigned long long)ce, (unsigned long long)set->caps[0], (unsigned long long)ge,
                      (unsigned long long)set->caps[1], state, rate, a->fps, set->tau, 1000.0 * a->frame_seconds,
                      ps_splat_mode_name(set->splat), ps_kernel_name(set->kernel),
                      ps_session_radius(a->session, PS_MAP_CAUSTIC), ps_session_radius(a->session, PS_MAP_GLOBAL),
                      set->layers & PS_LAYER_DIRECT ? "D" : "-", set->layers & PS_LAYER_CAUSTIC ? "C" : "-",
-                     set->layers & PS_LAYER_GLOBAL ? "G" : "-", float_layers ? "float" : ps_precision_name(set->precision),
+                     set->layers & PS_LAYER_GLOBAL ? "G" : "-", ps_global_layer_name(set->global_layer),
+                     float_layers ? "float" : ps_precision_name(set->precision),
                      set->exposure);
     if (!float_layers && n > 0 && (size_t)n < sizeof text)
         n += snprintf(text + n, sizeof text - (size_t)n, "error counter: %.1f %% of the last refresh rounded away%s\n",
