@@ -46,22 +46,21 @@ typedef struct fixture {
     ps_photon_map photons;
 } fixture;
 
-static fixture open_fixture(const char *text, uint64_t n)
+/* Into *fp, which must stay put: the map points at its mesh. */
+static void open_fixture_at(fixture *f, const char *text, uint64_t n)
 {
-    fixture f;
-    memset(&f, 0, sizeof f);
+    memset(f, 0, sizeof *f);
     ps_tracer_options to = ps_tracer_default_options();
     to.seed = 3;
     to.threads = 2;
-    f.r = rig_make(text, ".", &to, PS_ACCEL_OCTREE);
+    f->r = rig_make(text, ".", &to, PS_ACCEL_OCTREE);
     ps_error err;
-    ps_mesh_options mo = ps_mesh_default_options(f.r.scene);
-    if (ps_preview_mesh_build(f.r.scene, &mo, &f.mesh, &err) != PS_OK)
+    ps_mesh_options mo = ps_mesh_default_options(f->r.scene);
+    if (ps_preview_mesh_build(f->r.scene, &mo, &f->mesh, &err) != PS_OK)
         fail_msg("mesh: %s", err.msg);
-    if (ps_illummap_create(f.r.scene, &f.mesh, PS_KERNEL_CONE, &f.map, &err) != PS_OK)
+    if (ps_illummap_create(f->r.scene, &f->mesh, PS_KERNEL_CONE, &f->map, &err) != PS_OK)
         fail_msg("illummap: %s", err.msg);
-    f.photons = rig_trace(&f.r, PS_MAP_GLOBAL, n);
-    return f;
+    f->photons = rig_trace(&f->r, PS_MAP_GLOBAL, n);
 }
 
 static void close_fixture(fixture *f)
@@ -87,7 +86,8 @@ static void furnace_is_uniform(void **state)
 {
     (void)state;
     const uint64_t n = 400000;
-    fixture f = open_fixture(FURNACE, n);
+    fixture f;
+    open_fixture_at(&f, FURNACE, n);
     update(&f, f.photons.count, 0.3);
     double want = RHO * PHI / (4.0 * PS_PI * R * R * (1.0 - RHO));
     double sum = 0.0, area_sum = 0.0, lo = INFINITY, hi = 0.0, outside = 0.0;
@@ -121,7 +121,8 @@ static void furnace_is_uniform(void **state)
 static void box_flux_is_the_photons(void **state)
 {
     (void)state;
-    fixture f = open_fixture(BOX, 100000);
+    fixture f;
+    open_fixture_at(&f, BOX, 100000);
     update(&f, f.photons.count, 0.1);
     ps_rgb flux = ps_rgb_gray(0.0);
     for (size_t s = 0; s < ps_illummap_sample_count(f.map); s++)
@@ -153,14 +154,20 @@ static void box_flux_is_the_photons(void **state)
     close_fixture(&f);
 }
 
-/* The same photons in any batches give the same bytes; another radius
+/* The same photons in any batches and on any number of threads give the
+ * same bytes; another radius
  * rebuilds from photon 0 to the same bytes as a map built at that radius. */
 static void batches_do_not_matter(void **state)
 {
     (void)state;
-    fixture f = open_fixture(BOX, 30000);
-    fixture g = open_fixture(BOX, 30000);
+    fixture f;
+    open_fixture_at(&f, BOX, 30000);
+    fixture g;
+    open_fixture_at(&g, BOX, 30000);
     size_t n = f.photons.count;
+    ps_error err;
+    assert_int_equal(ps_illummap_set_threads(f.map, 1, &err), PS_OK);
+    assert_int_equal(ps_illummap_set_threads(g.map, 3, &err), PS_OK);
     update(&f, n, 0.15);
     size_t steps[] = {1, 7, 1000, n / 3, n / 2 + 5, n};
     for (size_t i = 0; i < sizeof steps / sizeof *steps; i++)
@@ -188,7 +195,8 @@ static void batches_do_not_matter(void **state)
 static void colours_are_radiance(void **state)
 {
     (void)state;
-    fixture f = open_fixture(BOX, 20000);
+    fixture f;
+    open_fixture_at(&f, BOX, 20000);
     update(&f, f.photons.count, 0.15);
     size_t nmat;
     const ps_material *mats = ps_scene_materials(f.r.scene, &nmat);
@@ -232,7 +240,8 @@ static void colours_are_radiance(void **state)
 static void radius_levels(void **state)
 {
     (void)state;
-    fixture f = open_fixture(BOX, 10);
+    fixture f;
+    open_fixture_at(&f, BOX, 10);
     double r0 = 0.1;
     assert_near(ps_illummap_level_radius(f.map, r0, 0.1), 0.1, 1e-15);
     assert_near(ps_illummap_level_radius(f.map, r0, 0.12), 0.1 * sqrt(2.0), 1e-15);
@@ -252,7 +261,8 @@ static void radius_levels(void **state)
 static void refuses_over_budget(void **state)
 {
     (void)state;
-    fixture f = open_fixture(BOX, 10);
+    fixture f;
+    open_fixture_at(&f, BOX, 10);
     setenv(PS_MEMORY_LIMIT_ENV, "1M", 1);
     ps_illummap *m;
     ps_error err;

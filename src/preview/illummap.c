@@ -2,12 +2,14 @@
 #include "preview/illummap.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/array.h"
 #include "core/memory.h"
+#include "photon/tracer.h"
 
 const char *const ps_global_layer_names[PS_GLOBAL_LAYER_COUNT + 1] = {"splats", "maps", NULL};
 
@@ -19,6 +21,35 @@ const char *ps_global_layer_name(ps_global_layer g)
 #define NO_SAMPLE UINT32_MAX
 /* Both sides' irradiance, rgb each. */
 #define SUMS 6
+
+/* What the search reads of a sample, in bucket order. */
+typedef struct grid_item {
+    float pos[3], nrm[3];
+    uint32_t obj, sample;
+    uint64_t cell; /* the cell's packed coordinates */
+} grid_item;
+
+/* One photon's shares: entries [first, first + count) of its worker's list. */
+typedef struct photon_shares {
+    size_t first;
+    uint32_t count;
+    bool lost;
+} photon_shares;
+
+/* A worker of the gather: photons [begin, end) of the chunk, each photon's
+ * samples (side in the top bit) and weights g_s / sum_t g_t A_t. */
+typedef struct gather {
+    struct ps_illummap *m;
+    const ps_photon *photons;
+    const uint32_t *objects;
+    size_t begin, end;
+    photon_shares *shares;
+    size_t cap_shares;
+    uint32_t *sample;
+    double *weight;
+    size_t count, cap_sample, cap_weight;
+    bool failed;
+} gather;
 
 struct ps_illummap {
     const ps_preview_mesh *mesh;
@@ -34,9 +65,12 @@ struct ps_illummap {
     uint32_t *vsample; /* fine-mesh vertex -> sample, or NO_SAMPLE (no diffuse reflection) */
     float *front, *back;
     /* The grid: cubic cells of side `radius`, hashed into `buckets` (a power
-     * of two) lists; first[b]..first[b + 1] index items. */
+     * of two) lists; first[b]..first[b + 1] index items, which copy what the
+     * search reads of each sample, bucket by bucket, so that one bucket's
+     * candidates lie together in memory. */
     size_t buckets;
-    uint32_t *first, *items;
+    uint32_t *first;
+    struct grid_item *items;
     double radius;      /* the level the sums are at; 0: empty */
     size_t count;       /* photons added */
     bool changed;
@@ -47,10 +81,9 @@ struct ps_illummap {
     uint16_t *lobe_mat;
     uint32_t *lobe_obj;
     size_t lobe_n, cap_ph, cap_mat, cap_obj;
-    /* Scratch: one photon's samples (side in the top bit) and weights. */
-    uint32_t *nb;
-    double *nbw;
-    size_t cap_nb, cap_nbw;
+    /* The gather's workers (one a thread) and its chunk's per-photon results. */
+    int threads;
+    struct gather *workers;
 };
 
 ps_rgb ps_illummap_albedo(const ps_material *mat)
@@ -207,11 +240,38 @@ ps_status ps_illummap_create(const ps_scene *scene, const ps_preview_mesh *mesh,
         if (!m->sum || !m->first || !m->items)
             st = ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for the illumination maps", ps_scene_path(scene));
     }
+    if (st == PS_OK)
+        st = ps_illummap_set_threads(m, 0, err);
     if (st != PS_OK) {
         ps_illummap_destroy(m);
         return st;
     }
     *out = m;
+    return PS_OK;
+}
+
+static void free_workers(ps_illummap *m)
+{
+    for (int t = 0; m->workers && t < m->threads; t++) {
+        free(m->workers[t].shares);
+        free(m->workers[t].sample);
+        free(m->workers[t].weight);
+    }
+    free(m->workers);
+    m->workers = NULL;
+}
+
+ps_status ps_illummap_set_threads(ps_illummap *m, int threads, ps_error *err)
+{
+    if (threads <= 0)
+        threads = ps_online_cores();
+    threads = threads < 1 ? 1 : threads > PS_ILLUM_MAX_THREADS ? PS_ILLUM_MAX_THREADS : threads;
+    gather *w = calloc((size_t)threads, sizeof *w);
+    if (!w)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the illumination maps' threads");
+    free_workers(m);
+    m->workers = w;
+    m->threads = threads;
     return PS_OK;
 }
 
@@ -232,8 +292,7 @@ void ps_illummap_destroy(ps_illummap *m)
     free(m->lobe_ph);
     free(m->lobe_mat);
     free(m->lobe_obj);
-    free(m->nb);
-    free(m->nbw);
+    free_workers(m);
     free(m);
 }
 
@@ -273,31 +332,43 @@ static cell3 cell_of(double x, double y, double z, double inv)
     return c;
 }
 
-static size_t bucket_of(cell3 c, size_t buckets)
+/* 21 bits a coordinate: a scene 10^6 radii across before two cells share a key. */
+static uint64_t cell_key(cell3 c)
 {
-    uint64_t h = (uint64_t)c.x * 73856093ull ^ (uint64_t)c.y * 19349663ull ^ (uint64_t)c.z * 83492791ull;
-    h ^= h >> 31;
-    h *= 0x9e3779b97f4a7c15ull;
-    return (size_t)(h >> 20) & (buckets - 1);
+    const uint64_t mask = (1u << 21) - 1;
+    return ((uint64_t)c.x & mask) << 42 | ((uint64_t)c.y & mask) << 21 | ((uint64_t)c.z & mask);
+}
+
+static size_t bucket_of(uint64_t key, size_t buckets)
+{
+    uint64_t h = key * 0x9e3779b97f4a7c15ull;
+    h ^= h >> 29;
+    h *= 0xbf58476d1ce4e5b9ull;
+    return (size_t)(h >> 32) & (buckets - 1);
 }
 
 /* Cells of side radius: every sample within radius of a point lies in the
- * 27 cells around the point's. */
+ * 27 cells around the point's. Items bucket by bucket, in sample order
+ * within one: a fixed order. */
 static void build_grid(ps_illummap *m, double radius)
 {
     double inv = 1.0 / radius;
     memset(m->first, 0, (m->buckets + 1) * sizeof *m->first);
     for (size_t s = 0; s < m->samples; s++) {
         const float *p = m->pos + 3 * s;
-        m->first[bucket_of(cell_of(p[0], p[1], p[2], inv), m->buckets) + 1]++;
+        m->first[bucket_of(cell_key(cell_of(p[0], p[1], p[2], inv)), m->buckets) + 1]++;
     }
     for (size_t b = 0; b < m->buckets; b++)
         m->first[b + 1] += m->first[b];
-    /* Filled in sample order, each bucket's list ascending: a fixed order. */
     for (size_t s = 0; s < m->samples; s++) {
         const float *p = m->pos + 3 * s;
-        size_t b = bucket_of(cell_of(p[0], p[1], p[2], inv), m->buckets);
-        m->items[m->first[b]++] = (uint32_t)s;
+        uint64_t key = cell_key(cell_of(p[0], p[1], p[2], inv));
+        grid_item *it = &m->items[m->first[bucket_of(key, m->buckets)]++];
+        memcpy(it->pos, p, sizeof it->pos);
+        memcpy(it->nrm, m->nrm + 3 * s, sizeof it->nrm);
+        it->obj = m->obj[s];
+        it->sample = (uint32_t)s;
+        it->cell = key;
     }
     /* first[b] now holds the end of bucket b: shift back. */
     for (size_t b = m->buckets; b > 0; b--)
@@ -307,60 +378,123 @@ static void build_grid(ps_illummap *m, double radius)
 
 /* ---- adding photons --------------------------------------------------------------- */
 
-static ps_status add_photon(ps_illummap *m, const ps_photon *ph, uint32_t object, ps_error *err)
+/* One photon's shares into its worker's lists (false: out of memory). */
+static bool gather_photon(gather *g, const ps_photon *ph, uint32_t object, photon_shares *out)
 {
+    const ps_illummap *m = g->m;
     double r = m->radius, r2 = r * r, inv = 1.0 / r;
     ps_vec3 p = ps_photon_position(ph), n = ps_photon_normal(ph);
     cell3 c = cell_of(p.x, p.y, p.z, inv);
-    size_t k = 0;
+    out->first = g->count;
+    out->count = 0;
+    out->lost = false;
     double total = 0.0;
     for (int dx = -1; dx <= 1; dx++)
         for (int dy = -1; dy <= 1; dy++)
             for (int dz = -1; dz <= 1; dz++) {
                 cell3 cc = {c.x + dx, c.y + dy, c.z + dz};
-                size_t b = bucket_of(cc, m->buckets);
+                uint64_t key = cell_key(cc);
+                size_t b = bucket_of(key, m->buckets);
                 for (uint32_t i = m->first[b]; i < m->first[b + 1]; i++) {
-                    uint32_t s = m->items[i];
-                    if (m->obj[s] != object)
+                    const grid_item *it = &m->items[i];
+                    /* Other cells sharing this bucket: each sample counts in its own cell only. */
+                    if (it->obj != object || it->cell != key)
                         continue;
-                    const float *q = m->pos + 3 * s;
-                    double ex = q[0] - p.x, ey = q[1] - p.y, ez = q[2] - p.z;
+                    double ex = it->pos[0] - p.x, ey = it->pos[1] - p.y, ez = it->pos[2] - p.z;
                     double d2 = ex * ex + ey * ey + ez * ez;
                     if (d2 >= r2)
                         continue;
-                    /* Other cells sharing this bucket: each sample counts in its own cell only. */
-                    cell3 sc = cell_of(q[0], q[1], q[2], inv);
-                    if (sc.x != cc.x || sc.y != cc.y || sc.z != cc.z)
-                        continue;
-                    const float *sn = m->nrm + 3 * s;
-                    double cs = sn[0] * n.x + sn[1] * n.y + sn[2] * n.z;
+                    double cs = it->nrm[0] * n.x + it->nrm[1] * n.y + it->nrm[2] * n.z;
                     if (fabs(cs) < PS_ILLUM_MIN_COS)
                         continue;
-                    double g = ps_kernel_profile(m->kernel, sqrt(d2) * inv);
-                    if (!(g > 0.0))
+                    double w = ps_kernel_profile(m->kernel, sqrt(d2) * inv);
+                    if (!(w > 0.0))
                         continue;
-                    if (!PS_RESERVE(m->nb, m->cap_nb, k + 1) || !PS_RESERVE(m->nbw, m->cap_nbw, k + 1))
-                        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the illumination maps' estimate");
-                    m->nb[k] = s | (cs < 0.0 ? 0x80000000u : 0u);
-                    m->nbw[k] = g;
-                    total += g * m->area[s];
-                    k++;
+                    size_t k = g->count;
+                    if (!PS_RESERVE(g->sample, g->cap_sample, k + 1) || !PS_RESERVE(g->weight, g->cap_weight, k + 1))
+                        return false;
+                    g->sample[k] = it->sample | (cs < 0.0 ? 0x80000000u : 0u);
+                    g->weight[k] = w;
+                    total += w * m->area[it->sample];
+                    g->count++;
+                    out->count++;
                 }
             }
-    ps_rgb power = ps_photon_power(ph);
     if (!(total > 0.0)) {
-        m->lost = ps_rgb_add(m->lost, power);
-        return PS_OK;
+        g->count = out->first;
+        out->count = 0;
+        out->lost = true;
+        return true;
     }
-    /* E_s += Phi w_s / A_s = Phi g_s / sum_t g_t A_t. */
+    /* w_s / A_s = g_s / sum_t g_t A_t. */
     double scale = 1.0 / total;
-    for (size_t j = 0; j < k; j++) {
-        uint32_t s = m->nb[j] & 0x7fffffffu;
-        double *e = m->sum + SUMS * s + ((m->nb[j] & 0x80000000u) ? 3 : 0);
-        double w = m->nbw[j] * scale;
-        e[0] += power.r * w;
-        e[1] += power.g * w;
-        e[2] += power.b * w;
+    for (size_t j = out->first; j < g->count; j++)
+        g->weight[j] *= scale;
+    return true;
+}
+
+static void *gather_range(void *arg)
+{
+    gather *g = arg;
+    g->count = 0;
+    g->failed = !PS_RESERVE(g->shares, g->cap_shares, g->end - g->begin + 1);
+    for (size_t i = g->begin; i < g->end && !g->failed; i++)
+        g->failed = !gather_photon(g, &g->photons[i], g->objects[i], &g->shares[i - g->begin]);
+    return NULL;
+}
+
+/* Photons [begin, end) added: their shares gathered on the workers, each a
+ * contiguous range, then summed here in photon order, so that the sums are
+ * the same bytes for any number of threads. */
+static ps_status add_photons(ps_illummap *m, const ps_photon *photons, const uint32_t *objects, size_t begin,
+                             size_t end, ps_error *err)
+{
+    size_t n = end - begin;
+    int threads = m->threads;
+    if ((size_t)threads > n / PS_ILLUM_MIN_PHOTONS_A_THREAD)
+        threads = (int)(n / PS_ILLUM_MIN_PHOTONS_A_THREAD);
+    if (threads < 1)
+        threads = 1;
+    pthread_t tid[PS_ILLUM_MAX_THREADS];
+    bool started[PS_ILLUM_MAX_THREADS] = {false};
+    for (int t = 0; t < threads; t++) {
+        gather *g = &m->workers[t];
+        g->m = m;
+        g->photons = photons;
+        g->objects = objects;
+        g->begin = begin + n * (size_t)t / (size_t)threads;
+        g->end = begin + n * (size_t)(t + 1) / (size_t)threads;
+        if (t > 0)
+            started[t] = pthread_create(&tid[t], NULL, gather_range, g) == 0;
+    }
+    gather_range(&m->workers[0]);
+    for (int t = 1; t < threads; t++) {
+        if (started[t])
+            pthread_join(tid[t], NULL);
+        else
+            gather_range(&m->workers[t]); /* no thread to be had: here */
+    }
+    for (int t = 0; t < threads; t++)
+        if (m->workers[t].failed)
+            return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the illumination maps' estimate");
+    for (int t = 0; t < threads; t++) {
+        const gather *g = &m->workers[t];
+        for (size_t i = g->begin; i < g->end; i++) {
+            const photon_shares *sh = &g->shares[i - g->begin];
+            ps_rgb power = ps_photon_power(&photons[i]);
+            if (sh->lost) {
+                m->lost = ps_rgb_add(m->lost, power);
+                continue;
+            }
+            for (size_t j = sh->first; j < sh->first + sh->count; j++) {
+                uint32_t s = g->sample[j] & 0x7fffffffu;
+                double *e = m->sum + SUMS * s + ((g->sample[j] & 0x80000000u) ? 3 : 0);
+                double w = g->weight[j];
+                e[0] += power.r * w;
+                e[1] += power.g * w;
+                e[2] += power.b * w;
+            }
+        }
     }
     return PS_OK;
 }
@@ -377,18 +511,22 @@ ps_status ps_illummap_update(ps_illummap *m, const ps_photon *photons, const uin
     }
     if (!(m->radius > 0.0))
         return PS_OK;
-    for (size_t i = m->count; i < count; i++) {
-        uint16_t mat = materials[i];
-        ps_status st = add_photon(m, &photons[i], objects[i], err);
-        if (st == PS_OK && mat < m->material_count && m->scene_materials[mat].type == PS_MAT_GLOSSY) {
+    /* Chunk by chunk: the workers' lists stay a chunk's size. */
+    for (size_t i = m->count; i < count; i += PS_ILLUM_CHUNK) {
+        size_t e = count - i > PS_ILLUM_CHUNK ? i + PS_ILLUM_CHUNK : count;
+        ps_status st = add_photons(m, photons, objects, i, e, err);
+        for (size_t j = i; j < e && st == PS_OK; j++) {
+            uint16_t mat = materials[j];
+            if (mat >= m->material_count || m->scene_materials[mat].type != PS_MAT_GLOSSY)
+                continue;
             size_t need = m->lobe_n + 1;
             if (!PS_RESERVE(m->lobe_ph, m->cap_ph, need) || !PS_RESERVE(m->lobe_mat, m->cap_mat, need) ||
                 !PS_RESERVE(m->lobe_obj, m->cap_obj, need))
                 st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the illumination maps' glossy photons");
             else {
-                m->lobe_ph[m->lobe_n] = photons[i];
+                m->lobe_ph[m->lobe_n] = photons[j];
                 m->lobe_mat[m->lobe_n] = mat;
-                m->lobe_obj[m->lobe_n] = objects[i];
+                m->lobe_obj[m->lobe_n] = objects[j];
                 m->lobe_n++;
             }
         }
@@ -396,7 +534,7 @@ ps_status ps_illummap_update(ps_illummap *m, const ps_photon *photons, const uin
             ps_illummap_reset(m, m->kernel);
             return st;
         }
-        (*added)++;
+        *added += e - i;
     }
     m->count = count > m->count ? count : m->count;
     if (*added)

@@ -84,8 +84,16 @@ const char *ps_global_layer_name(ps_global_layer g);
 #define PS_ILLUM_MAX_SAMPLES ((size_t)1 << 24)
 /* What a fine-mesh vertex is planned at against the memory budget: its
  * sample index and two colours, and at most one sample of position, normal,
- * object, area, two sides' sums and the grid's two words. */
-#define PS_ILLUM_PLAN_VERTEX_BYTES (sizeof(uint32_t) + 8 * sizeof(float) + 6 * sizeof(float) + 12 + 6 * sizeof(double) + 8)
+ * object, area, two sides' sums, the grid's two words and its 40-byte item. */
+#define PS_ILLUM_PLAN_VERTEX_BYTES (sizeof(uint32_t) + 8 * sizeof(float) + 6 * sizeof(float) + 12 + 6 * sizeof(double) + 8 + 40)
+
+/* The gather runs on every core in contiguous ranges of a chunk of photons
+ * (at least PS_ILLUM_MIN_PHOTONS_A_THREAD each), and the shares it found are
+ * summed in photon order on the calling thread: the same bytes for any
+ * number of cores. */
+#define PS_ILLUM_CHUNK 16384
+#define PS_ILLUM_MIN_PHOTONS_A_THREAD 1024
+#define PS_ILLUM_MAX_THREADS 64
 
 typedef struct ps_illummap ps_illummap;
 
@@ -96,6 +104,10 @@ typedef struct ps_illummap ps_illummap;
 ps_status ps_illummap_create(const ps_scene *scene, const ps_preview_mesh *mesh, ps_kernel kernel, ps_illummap **out,
                              ps_error *err);
 void ps_illummap_destroy(ps_illummap *m); /* accepts NULL */
+
+/* The gather's threads (0: one a core; at most PS_ILLUM_MAX_THREADS); the
+ * sums do not depend on it. PS_ERR_NOMEM leaves it as it was. */
+ps_status ps_illummap_set_threads(ps_illummap *m, int threads, ps_error *err);
 
 /* Empties the map (new photons from 0, or another kernel). */
 void ps_illummap_reset(ps_illummap *m, ps_kernel kernel);

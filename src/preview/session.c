@@ -194,7 +194,10 @@ static ps_status imap_make(ps_session *s, ps_error *err)
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for %zu materials", ps_scene_path(s->scene), n);
     s->imap_emitted = 0;
     s->lobe_drawn = 0;
-    return ps_illummap_create(s->scene, &s->mesh, s->set.kernel, &s->imap, err);
+    ps_status st = ps_illummap_create(s->scene, &s->mesh, s->set.kernel, &s->imap, err);
+    if (st == PS_OK)
+        st = ps_illummap_set_threads(s->imap, s->set.threads, err);
+    return st;
 }
 
 ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_session **out, ps_error *err)
