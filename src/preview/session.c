@@ -46,6 +46,8 @@ struct ps_session {
      * the global map, imap_emitted emitted, whatever the view; lobe_drawn of
      * their glossy photons are in the global layer since the last new view. */
     ps_illummap *imap;
+    double imap_budget;    /* incremental: photons the maps take in a refresh, from their own
+                            * rate (their redraw is a fixed cost, not the photons') */
     uint64_t imap_emitted;
     size_t lobe_drawn;
     ps_material *lobe_mats;
@@ -194,6 +196,7 @@ static ps_status imap_make(ps_session *s, ps_error *err)
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for %zu materials", ps_scene_path(s->scene), n);
     s->imap_emitted = 0;
     s->lobe_drawn = 0;
+    s->imap_budget = PS_SESSION_BUDGET_START;
     ps_status st = ps_illummap_create(s->scene, &s->mesh, s->set.kernel, &s->imap, err);
     if (st == PS_OK)
         st = ps_illummap_set_threads(s->imap, s->set.threads, err);
@@ -310,9 +313,17 @@ static bool same_camera(const ps_camera_frame *a, const ps_camera_frame *b)
  * emitted): whole batches as the feed handed them over; incremental, at most
  * the budget beyond `from`, but at least one batch. *emitted: the photons
  * emitted for that prefix, which its splats are scaled by. Under the lock. */
+static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t from_emitted, double budget,
+                            uint64_t *emitted);
 static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emitted, uint64_t *emitted)
 {
-    double budget = s->moving ? s->budget * PS_SESSION_MOVING_SHARE : s->budget;
+    return prefix_within(s, k, from, from_emitted, s->moving ? s->budget * PS_SESSION_MOVING_SHARE : s->budget,
+                         emitted);
+}
+
+static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t from_emitted, double budget,
+                            uint64_t *emitted)
+{
     size_t n;
     const ps_feed_mark *m = ps_feed_marks(s->feed, (ps_map_kind)k, &n);
     size_t end = from;
@@ -357,19 +368,23 @@ static ps_status imap_refresh(ps_session *s, const ps_photon_map *m, const ps_ca
     b->carry[0] = b->carry[1] = b->carry[2] = 0.0;
     b->wanted = b->lost = 0.0;
     uint64_t emitted;
-    size_t end = prefix(s, k, ps_illummap_count(s->imap), s->imap_emitted, &emitted);
+    size_t end = prefix_within(s, k, ps_illummap_count(s->imap), s->imap_emitted, s->imap_budget, &emitted);
     if (emitted == 0)
         return PS_OK;
     size_t added;
     double level = ps_illummap_level_radius(s->imap, s->set.radius[k], radius_at(s, k, emitted));
+    double t0 = ps_now_seconds();
     ps_status st = ps_illummap_update(s->imap, m->photons, m->materials, m->objects, end, level, &added, err);
     if (st != PS_OK)
         return st;
+    if (inc && added > 0) {
+        double rate = (double)added / fmax(ps_now_seconds() - t0, 1e-6);
+        s->imap_budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * s->set.splat_share / PS_MAP_COUNT);
+    }
     s->imap_emitted = emitted;
     s->drawn[k] = end;
     s->drawn_emitted[k] = emitted;
     out->emitted[k] = emitted;
-    out->splats += added;
     double scale = inc ? 1.0 : exposure(s) * (double)s->set.caps[k] / (double)emitted;
     /* The lobes: the glossy photons not yet in this view's layer. */
     const ps_photon *lp;
