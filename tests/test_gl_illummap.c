@@ -64,7 +64,7 @@ static ps_image draw(bool layers, int threads, double *lo, double *hi)
     int refreshes = 0;
     do {
         assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
-        assert_non_null(f.imap_front);
+        assert_non_null(f.imap_colors);
         assert_true(f.imap_redraw);
         if (l)
             ps_gl_layers_draw(l, gl, &cam, &f);

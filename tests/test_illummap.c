@@ -303,7 +303,7 @@ static int settle(ps_session *s, const ps_camera_frame *cam)
         if (ps_session_refresh(s, cam, &f, &err) != PS_OK)
             fail_msg("refresh: %s", err.msg);
         bool shown = (ps_session_get_settings(s)->layers & PS_LAYER_GLOBAL) != 0;
-        assert_true(shown == (f.imap_front != NULL));
+        assert_true(shown == (f.imap_colors != NULL));
         ps_session_drawn(s, 0.001);
         n++;
     } while (!ps_session_settled(s) && n < 1000);
@@ -351,7 +351,7 @@ static void session_fills_the_maps(void **state)
         assert_null(ps_session_illummap(inc));
         ps_session_frame f;
         assert_int_equal(ps_session_refresh(inc, &cam, &f, &err), PS_OK);
-        assert_null(f.imap_front);
+        assert_null(f.imap_colors);
         assert_int_equal(ps_session_set_global_layer(inc, PS_GLOBAL_MAPS, &err), PS_OK);
         assert_int_equal(ps_illummap_count(ps_session_illummap(inc)), 0);
         settle(inc, &cam);

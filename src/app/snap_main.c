@@ -248,7 +248,7 @@ static ps_status write_layers(snap_run *s, const char *prefix, ps_error *err)
         } else {
             ps_gl_begin_frame(s->gl, &s->cam, f->direct_exposure, layer < 0 && f->direct);
             if (layer == PS_MAP_GLOBAL)
-                ps_gl_draw_illummap(s->gl, f->imap_front, f->imap_back);
+                ps_gl_draw_illummap(s->gl, f->imap_colors);
             if (layer >= 0)
                 ps_gl_draw_splats(s->gl, f->map[layer].batch, f->splat, f->map[layer].radius, f->point_size);
             st = ps_platform_read(s->platform, &img, err);

@@ -3,14 +3,14 @@
  * (irradiance times albedo / pi times the gain, made GL-free by
  * ps_illummap_colors), Gouraud-interpolated, no lighting, added to what is
  * there where the depth prepass says the surface shows. Two-sided surfaces
- * carry a value a side: front faces (the winding's) get the front colours,
- * back faces the back ones, by culling the other face in each pass. */
+ * carry a value a side; the colours given are already the side each
+ * triangle shows this view (ps_illummap_view_colors), so one pass draws both. */
 #include "gl/gl_internal.h"
 
-void ps_gl_draw_illummap(ps_gl_renderer *r, const float *front, const float *back)
+void ps_gl_draw_illummap(ps_gl_renderer *r, const float *colors)
 {
     const ps_preview_mesh *m = r->in.mesh;
-    if (!front || !back || m->vertex_count == 0)
+    if (!colors || m->vertex_count == 0)
         return;
     glMatrixMode(GL_PROJECTION);
     glLoadMatrixd(r->proj);
@@ -28,14 +28,8 @@ void ps_gl_draw_illummap(ps_gl_renderer *r, const float *front, const float *bac
     glEnableClientState(GL_VERTEX_ARRAY);
     glEnableClientState(GL_COLOR_ARRAY);
     glVertexPointer(3, GL_FLOAT, 0, m->positions);
-    glEnable(GL_CULL_FACE);
-    glFrontFace(GL_CCW);
-    for (int side = 0; side < 2; side++) {
-        glCullFace(side == 0 ? GL_BACK : GL_FRONT);
-        glColorPointer(4, GL_FLOAT, 0, side == 0 ? front : back);
-        glDrawArrays(GL_TRIANGLES, 0, (GLsizei)m->vertex_count);
-    }
-    glDisable(GL_CULL_FACE);
+    glColorPointer(4, GL_FLOAT, 0, colors);
+    glDrawArrays(GL_TRIANGLES, 0, (GLsizei)m->vertex_count);
     glDisableClientState(GL_COLOR_ARRAY);
     glDisableClientState(GL_VERTEX_ARRAY);
     glDisable(GL_BLEND);

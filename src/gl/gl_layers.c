@@ -99,13 +99,13 @@ static void clear_imap(ps_gl_layers *l)
 static void draw_imap(ps_gl_layers *l, ps_gl_renderer *r, const ps_session_frame *f)
 {
     clear_imap(l);
-    if (!f->imap_front)
+    if (!f->imap_colors)
         return;
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_IMAP_TEX]);
     glViewport(0, 0, l->width, l->height);
-    ps_gl_draw_illummap(r, f->imap_front, f->imap_back);
+    ps_gl_draw_illummap(r, f->imap_colors);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     l->imap_drawn = true;
 }
@@ -187,7 +187,7 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
             ps_gl_layers_clear_map(l, k);
         ps_gl_layers_add(l, r, k, f->map[k].batch, f->splat, f->map[k].radius, f->point_size);
     }
-    if (f->imap_front ? f->imap_redraw || !l->imap_drawn : l->imap_drawn)
+    if (f->imap_colors ? f->imap_redraw || !l->imap_drawn : l->imap_drawn)
         draw_imap(l, r, f);
 }
 

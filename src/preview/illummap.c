@@ -63,7 +63,7 @@ struct ps_illummap {
     double *area;
     double *sum;
     uint32_t *vsample; /* fine-mesh vertex -> sample, or NO_SAMPLE (no diffuse reflection) */
-    float *front, *back;
+    float *front, *back, *view;
     /* The grid: cubic cells of side `radius`, hashed into `buckets` (a power
      * of two) lists; first[b]..first[b + 1] index items, which copy what the
      * search reads of each sample, bucket by bucket, so that one bucket's
@@ -224,7 +224,8 @@ ps_status ps_illummap_create(const ps_scene *scene, const ps_preview_mesh *mesh,
     m->vsample = malloc(n1 * sizeof *m->vsample);
     m->front = calloc(4 * n1, sizeof *m->front);
     m->back = calloc(4 * n1, sizeof *m->back);
-    st = m->pos && m->nrm && m->obj && m->area && m->vsample && m->front && m->back ? PS_OK : PS_ERR_NOMEM;
+    m->view = calloc(4 * n1, sizeof *m->view);
+    st = m->pos && m->nrm && m->obj && m->area && m->vsample && m->front && m->back && m->view ? PS_OK : PS_ERR_NOMEM;
     if (st != PS_OK)
         ps_error_set(err, st, "%s: out of memory for the illumination maps", ps_scene_path(scene));
     double diag = ps_v3_len(ps_aabb_diag(ps_scene_bounds(scene)));
@@ -287,6 +288,7 @@ void ps_illummap_destroy(ps_illummap *m)
     free(m->vsample);
     free(m->front);
     free(m->back);
+    free(m->view);
     free(m->first);
     free(m->items);
     free(m->lobe_ph);
@@ -586,10 +588,17 @@ void ps_illummap_colors(ps_illummap *m, const ps_material *materials, double sca
     *back = m->back;
 }
 
-void ps_illummap_colors_last(const ps_illummap *m, const float **front, const float **back)
+const float *ps_illummap_view_colors(ps_illummap *m, ps_vec3 eye)
 {
-    *front = m->front;
-    *back = m->back;
+    const ps_preview_mesh *mesh = m->mesh;
+    for (size_t v = 0; v + 2 < mesh->vertex_count; v += 3) {
+        const float *p = mesh->positions + 3 * v;
+        ps_vec3 p0 = ps_v3(p[0], p[1], p[2]), p1 = ps_v3(p[3], p[4], p[5]), p2 = ps_v3(p[6], p[7], p[8]);
+        ps_vec3 n = ps_v3_cross(ps_v3_sub(p1, p0), ps_v3_sub(p2, p0));
+        const float *src = ps_v3_dot(ps_v3_sub(eye, p0), n) > 0.0 ? m->front : m->back;
+        memcpy(m->view + 4 * v, src + 4 * v, 12 * sizeof *src);
+    }
+    return m->view;
 }
 
 size_t ps_illummap_lobe(const ps_illummap *m, const ps_photon **photons, const uint16_t **materials,

@@ -83,9 +83,9 @@ const char *ps_global_layer_name(ps_global_layer g);
  * size cap (16 M samples; the default scenes have about 10^5). */
 #define PS_ILLUM_MAX_SAMPLES ((size_t)1 << 24)
 /* What a fine-mesh vertex is planned at against the memory budget: its
- * sample index and two colours, and at most one sample of position, normal,
+ * sample index and three colours (front, back, the view's), and at most one sample of position, normal,
  * object, area, two sides' sums, the grid's two words and its 40-byte item. */
-#define PS_ILLUM_PLAN_VERTEX_BYTES (sizeof(uint32_t) + 8 * sizeof(float) + 6 * sizeof(float) + 12 + 6 * sizeof(double) + 8 + 40)
+#define PS_ILLUM_PLAN_VERTEX_BYTES (sizeof(uint32_t) + 12 * sizeof(float) + 6 * sizeof(float) + 12 + 6 * sizeof(double) + 8 + 40)
 
 /* The gather runs on every core in contiguous ranges of a chunk of photons
  * (at least PS_ILLUM_MIN_PHOTONS_A_THREAD each), and the shares it found are
@@ -149,8 +149,12 @@ ps_rgb ps_illummap_albedo(const ps_material *mat);
  * valid until the next call or destroy. Clears the changed flag. */
 void ps_illummap_colors(ps_illummap *m, const ps_material *materials, double scale, const float **front,
                         const float **back);
-/* The arrays as the last ps_illummap_colors left them. */
-void ps_illummap_colors_last(const ps_illummap *m, const float **front, const float **back);
+/* One RGBA a vertex for a view from eye: each triangle takes the colours of
+ * the side the eye sees (the front's where (eye - p0) . ((p1 - p0) x (p2 -
+ * p0)) > 0, the face GL culls as front with GL_CCW, else the back's), from
+ * the last ps_illummap_colors. So GL draws both sides in one pass. Owned by
+ * the map. */
+const float *ps_illummap_view_colors(ps_illummap *m, ps_vec3 eye);
 
 /* The lobe list: the photons (of those added) on glossy surfaces, as
  * parallel arrays for ps_splat_build. */

@@ -49,6 +49,9 @@ struct ps_session {
     double imap_budget;    /* incremental: photons the maps take in a refresh, from their own
                             * rate (their redraw is a fixed cost, not the photons') */
     uint64_t imap_emitted;
+    double imap_scale;
+    const float *imap_view;      /* the view's colours, as last made */           /* what the maps' colours were last made with ... */
+    const ps_material *imap_mats;/* ... (colours are remade only when these or the maps change) */
     size_t lobe_drawn;
     ps_material *lobe_mats;
 };
@@ -197,6 +200,8 @@ static ps_status imap_make(ps_session *s, ps_error *err)
     s->imap_emitted = 0;
     s->lobe_drawn = 0;
     s->imap_budget = PS_SESSION_BUDGET_START;
+    s->imap_scale = -1.0; /* colours to make */
+    s->imap_view = NULL;
     ps_status st = ps_illummap_create(s->scene, &s->mesh, s->set.kernel, &s->imap, err);
     if (st == PS_OK)
         st = ps_illummap_set_threads(s->imap, s->set.threads, err);
@@ -413,11 +418,19 @@ static ps_status imap_refresh(ps_session *s, const ps_photon_map *m, const ps_ca
         out->splats += b->splats;
     }
     s->lobe_drawn = nl;
-    out->imap_redraw = out->new_view || ps_illummap_changed(s->imap) || !inc;
+    /* The colours follow the maps, the scale and the materials; which side
+     * each triangle shows follows the view. */
+    bool recolour = ps_illummap_changed(s->imap) || scale != s->imap_scale || ps_session_materials(s) != s->imap_mats;
+    if (recolour) {
+        const float *front, *back;
+        ps_illummap_colors(s->imap, ps_session_materials(s), scale, &front, &back);
+        s->imap_scale = scale;
+        s->imap_mats = ps_session_materials(s);
+    }
+    out->imap_redraw = recolour || out->new_view || !inc;
     if (out->imap_redraw)
-        ps_illummap_colors(s->imap, ps_session_materials(s), scale, &out->imap_front, &out->imap_back);
-    else
-        ps_illummap_colors_last(s->imap, &out->imap_front, &out->imap_back);
+        s->imap_view = ps_illummap_view_colors(s->imap, cam->eye);
+    out->imap_colors = s->imap_view;
     return st;
 }
 
@@ -532,8 +545,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         l->radius = s->splat_radius[k];
         l->gain = !shown ? 0.0 : inc ? exposure(s) * (double)s->set.caps[k] / (double)out->emitted[k] : 1.0;
     }
-    if (out->imap_front && out->map[PS_MAP_GLOBAL].gain == 0.0)
-        out->imap_front = out->imap_back = NULL;
+    if (out->imap_colors && out->map[PS_MAP_GLOBAL].gain == 0.0)
+        out->imap_colors = NULL;
     return PS_OK;
 }
 

@@ -165,12 +165,12 @@ typedef struct ps_session_frame {
     uint64_t emitted[PS_MAP_COUNT]; /* the photons emitted that this picture shows */
     size_t splats;           /* splats built this refresh */
     double round_off;        /* 8 bits: the fraction of this refresh's splat energy rounded away */
-    /* --global-layer maps: the global map's illumination maps as colours of
-     * the fine mesh's vertices (ps_illummap_colors, times the gain the
-     * splats get: 1 in incremental layers, exposure N / n in whole ones),
-     * front and back faces; NULL when not shown. map[PS_MAP_GLOBAL]'s batch
-     * then holds only the glossy lobes' splats. */
-    const float *imap_front, *imap_back;
+    /* --global-layer maps: the global map's illumination maps as one RGBA
+     * colour a fine-mesh vertex for this view (ps_illummap_view_colors: each
+     * triangle the side the eye sees), times the gain the splats get (1 in
+     * incremental layers, exposure N / n in whole ones); NULL when not shown.
+     * map[PS_MAP_GLOBAL]'s batch then holds only the glossy lobes' splats. */
+    const float *imap_colors;
     bool imap_redraw;        /* the colours are new (or the view): draw the maps again */
 } ps_session_frame;
 
