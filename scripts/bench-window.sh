@@ -66,3 +66,23 @@ run moves 1000000 "1 move light 0 0.5 1.9 0" "2 move light 0 -0.5 1.9 0" "3 move
 printf '| %s | %.3f | %.3f | %.3f | 0.1 |\n' "$(stat_of edits "$tmp/moves.json")" \
     "$(stat_of edit_to_frame_seconds_mean "$tmp/moves.json")" "$(stat_of edit_to_frame_seconds_max "$tmp/moves.json")" \
     "$(stat_of edit_to_frame_seconds_mean "$tmp/moves-cpu.json")"
+
+# The global layer as splats and as illumination maps (--global-layer maps),
+# GL composite, 10^6 caustic + 2.5*10^5 global photons: refining with the
+# view still, and orbiting over the full maps (every photon drawn each frame
+# as splats; the maps redrawn as one mesh pass).
+echo
+echo "| global layer | view | fps | frames | emitted by the end |"
+echo "| --- | --- | ---: | ---: | ---: |"
+for layer in splats maps; do
+    for view in still orbit-full; do
+        if [ $view = still ]; then lines=("4.5 quit"); else mapfile -t lines < <(full_orbit_lines); fi
+        printf '%s\n' "${lines[@]}" >"$tmp/g-$layer-$view.txt"
+        xvfb-run -a -s "-screen 0 1024x768x24" bin/photosplat "$scene" --size 512x512 --exposure 0.3 --overlay off \
+            --caustic-photons 1000000 --global-photons 250000 --global-layer $layer \
+            --script "$tmp/g-$layer-$view.txt" --stats "$tmp/g-$layer-$view.json" >/dev/null
+        f=$tmp/g-$layer-$view.json
+        printf '| %s | %s | %.1f | %s | %s |\n' $layer $view "$(stat_of fps "$f")" "$(stat_of frames "$f")" \
+            "$(($(stat_of emitted_caustic "$f") + $(stat_of emitted_global "$f")))"
+    done
+done

@@ -90,8 +90,8 @@ EOF
 expect_success "bench: tiny" "$bench" --quick --size 24x24 --budgets 0.05,0.3 --scenes "$cli_tmp/tiny.scn:0.5" \
     --out "$cli_tmp/b" --bin "$bin" --threads 1
 expect_match "bench: rendered the references" "$cli_out" 'reference specular'
-# 4 main configurations x 2 checkpoints, each with finite errors below 1.
-[ "$(tail -n +2 "$cli_tmp/b/bench.csv" | wc -l)" = 8 ] && ok || bad "bench.csv: not 8 rows"
+# 6 main configurations x 2 checkpoints, each with finite errors below 1.
+[ "$(tail -n +2 "$cli_tmp/b/bench.csv" | wc -l)" = 12 ] && ok || bad "bench.csv: not 12 rows"
 awk -F, 'NR > 1 { for (i = 13; i <= NF; i++) if (!($i >= 0 && $i < 10)) { print "column " i ": " $i; bad = 1 } } END { exit bad }' \
     "$cli_tmp/b/bench.csv" && ok || bad "bench.csv has errors out of range"
 grep -q '^| triangles float progressive |' "$cli_tmp/b/bench.md" && ok || bad "bench.md lacks a table row"

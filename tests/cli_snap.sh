@@ -145,4 +145,24 @@ for mode in points triangles; do
     awk_true "$emitted < $n" && ok || bad "$mode: the counter let all $emitted photons through"
 done
 
+# --global-layer maps: the global layer as illumination maps. Its picture is
+# the splats' within the kernels' difference (mean within 5 %), the same
+# bytes for 1 and 2 tracing threads, and progressive refreshes (float
+# layers, scaled in the composite) end at one whole frame (scaled in the
+# colours) but for float rounding.
+expect_usage_error "bad global layer" "$snap" "$scene" -o "$cli_tmp/x.png" --global-layer texels
+maps=("$scene" --size 64x64 --caustic-photons 20000 --global-photons 20000 --layers global --color-depth float)
+expect_success "maps" "$snap" "${maps[@]}" --global-layer maps --hdr "$cli_tmp/gm1.pfm" --threads 1 \
+    --stats "$cli_tmp/gm.json"
+grep -q '"global_maps": 1' "$cli_tmp/gm.json" && ok || bad "stats do not say global_maps"
+expect_success "maps, 2 threads" "$snap" "${maps[@]}" --global-layer maps --hdr "$cli_tmp/gm2.pfm" --threads 2
+cmp -s "$cli_tmp/gm1.pfm" "$cli_tmp/gm2.pfm" && ok || bad "maps: 1 and 2 threads differ"
+expect_success "maps, progressive" "$snap" "${maps[@]}" --global-layer maps --hdr "$cli_tmp/gmp.pfm" --time 30 \
+    --tau 0.02
+rel=$("$bin/photosplat-compare" "$cli_tmp/gmp.pfm" "$cli_tmp/gm1.pfm" | sed -n 's/.*relmse=\([^ ]*\).*/\1/p')
+awk_true "$rel < 1e-8" && ok || bad "maps: progressive refreshes differ from one whole frame: relMSE $rel"
+expect_success "splats" "$snap" "${maps[@]}" --hdr "$cli_tmp/gs.pfm"
+ms=$(mean_of "$cli_tmp/gs.pfm") mm=$(mean_of "$cli_tmp/gm1.pfm")
+awk_true "($mm - $ms)^2 < (0.05 * $ms)^2 && $ms > 0.01" && ok || bad "maps' mean $mm is not the splats' $ms"
+
 cli_summary

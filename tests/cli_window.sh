@@ -90,6 +90,17 @@ rmse=$("$bin/photosplat-compare" "$cli_tmp/same-w.png" "$cli_tmp/same-c.png" | s
 echo "GL-encoded against CPU-encoded window: rmse $rmse"
 awk_true "$rmse < 1.0 / 255" && ok || bad "the GL composite differs from the CPU one: rmse $rmse"
 
+# The global layer as illumination maps (key M; a script's set global-layer):
+# switched on at 0.3 s, the window's picture once all photons are in is
+# photosplat-snap --global-layer maps's.
+printf '0.3 set global-layer maps\n0.4 wait done\n1.5 screenshot %s\n1.6 quit\n' "$cli_tmp/maps-w.png" >"$cli_tmp/maps.txt"
+expect_success "window maps" xrun "$win" "$scene" "${same[@]}" --overlay off --script "$cli_tmp/maps.txt"
+expect_success "snap maps" "$bin/photosplat-snap" "$scene" "${same[@]}" --color-depth float --global-layer maps \
+    -o "$cli_tmp/maps-s.png"
+rmse=$("$bin/photosplat-compare" "$cli_tmp/maps-w.png" "$cli_tmp/maps-s.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
+echo "window against photosplat-snap, global layer as maps: rmse $rmse"
+awk_true "$rmse < 2.0 / 255" && ok || bad "maps: the window and photosplat-snap differ: rmse $rmse"
+
 # Illuminance in false colour (key F; a script's set false-color): a picture of
 # its own (the lux in it are test_gl_illuminance's), and off again the normal
 # picture comes back, the photons kept.

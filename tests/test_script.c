@@ -404,11 +404,13 @@ static const bad_case BAD[] = {
      "s.txt:1: move object: index '99999999999999999999' must be an integer in [0, 4294967295]"},
     /* set */
     {"0 set\n", PS_ERR_PARSE,
-     "s.txt:1: set: expected a setting (splat, layers, kernel, radius, tau, precision, exposure, pause or false-color)"},
+     "s.txt:1: set: expected a setting (splat, layers, kernel, radius, tau, precision, exposure, pause, "
+     "false-color or global-layer)"},
     {"0 set gamma 2\n", PS_ERR_PARSE,
      "s.txt:1: set: unknown setting 'gamma' (expected splat, layers, kernel, radius, tau, precision, exposure, "
-     "pause or false-color)"},
+     "pause, false-color or global-layer)"},
     {"0 set false-color maybe\n", PS_ERR_PARSE, "s.txt:1: set false-color: 'maybe' is not on or off"},
+    {"0 set global-layer texels\n", PS_ERR_PARSE, "s.txt:1: set global-layer: 'texels' is not splats or maps"},
     {"0 quit\n0 quit\n0 quit\n0 set splat quads\n", PS_ERR_PARSE,
      "s.txt:4: set splat: 'quads' is not points, triangles or sprites"},
     {"0 set splat\n", PS_ERR_PARSE, "s.txt:1: set splat: expected one of points, triangles or sprites"},

@@ -57,7 +57,7 @@ static const char usage[] =
     "                     scenes in data/scenes)\n"
     "  --size WxH         image size of every run (default 256x256)\n"
     "  --budgets LIST     checkpoint seconds (default 0.05,0.1,0.2,0.5,1,2,5,10)\n"
-    "  --quick            the four main configurations only, budgets up to 2 s\n"
+    "  --quick            the six main configurations only, budgets up to 2 s\n"
     "  --threads N        tracing and rendering threads (default: all cores)\n"
     "  --replot           run nothing: remake bench.md and the plots from OUT/bench.csv\n"
     "                     (the scenes and budgets must be the run's)\n"
@@ -100,30 +100,40 @@ static const double default_budgets[] = {0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10};
 
 /* What a snapshot run varies. The first BENCH_MAIN_CONFIGS are the main
  * curves (the accurate splats, 8-bit with diffusion as the thesis, the float
- * buffer, each with both radius schedules); the rest compare modes. */
+ * buffer, each with both radius schedules, and the float buffer with the
+ * global layer as illumination maps); the rest compare modes. */
 typedef struct bench_config {
     ps_splat_mode splat;
     ps_color_depth depth;
     ps_precision precision;
     ps_radius_schedule schedule;
+    ps_global_layer global;
 } bench_config;
 
 static const bench_config configs[] = {
-    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
-    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_PROGRESSIVE},
-    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
-    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_PROGRESSIVE},
-    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_NONE, PS_RADIUS_FIXED},
-    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_COUNTER, PS_RADIUS_FIXED},
-    {PS_SPLAT_POINTS, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
-    {PS_SPLAT_POINTS, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
-    {PS_SPLAT_SPRITES, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
-    {PS_SPLAT_SPRITES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED, PS_GLOBAL_SPLATS},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_PROGRESSIVE, PS_GLOBAL_SPLATS},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED, PS_GLOBAL_SPLATS},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_PROGRESSIVE, PS_GLOBAL_SPLATS},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED, PS_GLOBAL_MAPS},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_PROGRESSIVE, PS_GLOBAL_MAPS},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_NONE, PS_RADIUS_FIXED, PS_GLOBAL_SPLATS},
+    {PS_SPLAT_TRIANGLES, PS_COLOR_DEPTH_8, PS_PRECISION_COUNTER, PS_RADIUS_FIXED, PS_GLOBAL_SPLATS},
+    {PS_SPLAT_POINTS, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED, PS_GLOBAL_SPLATS},
+    {PS_SPLAT_POINTS, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED, PS_GLOBAL_SPLATS},
+    {PS_SPLAT_SPRITES, PS_COLOR_DEPTH_8, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED, PS_GLOBAL_SPLATS},
+    {PS_SPLAT_SPRITES, PS_COLOR_DEPTH_FLOAT, PS_PRECISION_DIFFUSION, PS_RADIUS_FIXED, PS_GLOBAL_SPLATS},
 };
 /* The buffer as the CSV and labels say it. */
 static const char *depth_label(ps_color_depth d) { return d == PS_COLOR_DEPTH_FLOAT ? "float" : "8-bit"; }
 #define BENCH_CONFIGS (sizeof configs / sizeof configs[0])
-#define BENCH_MAIN_CONFIGS 4
+#define BENCH_MAIN_CONFIGS 6
+/* The splat column: the mode, and "+maps" where the global layer is maps. */
+static const char *splat_label(const bench_config *k)
+{
+    static const char *const maps[PS_SPLAT_MODE_COUNT] = {"points+maps", "triangles+maps", "sprites+maps"};
+    return k->global == PS_GLOBAL_MAPS ? maps[k->splat] : ps_splat_mode_name(k->splat);
+}
 
 /* Progressive caps: far more photons than a run can trace in the longest
  * budget, so that time, not the cap, ends refinement. Multiples of the
@@ -589,9 +599,9 @@ static void config_label(size_t c, char *buf, size_t size)
 {
     const bench_config *k = &configs[c];
     if (k->depth == PS_COLOR_DEPTH_FLOAT)
-        snprintf(buf, size, "%s float %s", ps_splat_mode_name(k->splat), ps_radius_schedule_name(k->schedule));
+        snprintf(buf, size, "%s float %s", splat_label(k), ps_radius_schedule_name(k->schedule));
     else
-        snprintf(buf, size, "%s 8-bit %s %s", ps_splat_mode_name(k->splat), ps_precision_name(k->precision),
+        snprintf(buf, size, "%s 8-bit %s %s", splat_label(k), ps_precision_name(k->precision),
                  ps_radius_schedule_name(k->schedule));
 }
 
@@ -691,7 +701,8 @@ static ps_status snapshots(bench_state *b, int si, char refs[BENCH_LAYERS][PATH_
                     "--global-photons", gp, "--splat", (char *)ps_splat_mode_name(k->splat),
                     "--color-depth", (char *)ps_color_depth_name(k->depth), "--precision",
                     (char *)ps_precision_name(k->precision), "--radius-schedule",
-                    (char *)ps_radius_schedule_name(k->schedule),
+                    (char *)ps_radius_schedule_name(k->schedule), "--global-layer",
+                    (char *)ps_global_layer_name(k->global),
                     /* all cores unless told: snap's own default */
                     o->threads > 0 ? "--threads" : NULL, threads, NULL};
     st = run_checked(args, NULL, 0, err);
@@ -739,7 +750,7 @@ static ps_status write_csv(const bench_state *b, const char *path, ps_error *err
         const bench_config *k = &configs[r->config];
         char name[256];
         fprintf(fp, "%s,%s,%s,%s,%s,%d,%.6g,%.4f,%llu,%llu,%.6g,%.6g", stem(b->o->scenes[r->scene].path, name, sizeof name),
-                ps_splat_mode_name(k->splat), depth_label(k->depth), ps_precision_name(k->precision),
+                splat_label(k), depth_label(k->depth), ps_precision_name(k->precision),
                 ps_radius_schedule_name(k->schedule), r->checkpoint,
                 r->requested, r->seconds, (unsigned long long)r->emitted[0], (unsigned long long)r->emitted[1],
                 r->radius[0], r->radius[1]);
@@ -998,7 +1009,7 @@ static ps_status read_csv(bench_state *b, const char *path, ps_error *err)
         }
         for (size_t c = 0; c < BENCH_CONFIGS; c++) {
             const bench_config *k = &configs[c];
-            if (!strcmp(ps_splat_mode_name(k->splat), splat) && !strcmp(depth_label(k->depth), buffer) &&
+            if (!strcmp(splat_label(k), splat) && !strcmp(depth_label(k->depth), buffer) &&
                 !strcmp(ps_precision_name(k->precision), precision) &&
                 !strcmp(ps_radius_schedule_name(k->schedule), schedule))
                 r.config = (int)c;

@@ -177,6 +177,7 @@ ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_pre
     set.stencil_clip = o->stencil_clip;
     set.radius_schedule = o->radius_schedule;
     set.radius_alpha = o->radius_alpha;
+    set.global_layer = o->global_layer;
     set.exposure = c->exposure;
     set.tau = o->tau;
     set.shadow_size = o->shadows ? PS_SHADOW_SIZE_DEFAULT : 0;
@@ -209,6 +210,7 @@ TYPED_CHOICE(choose_depth, ps_color_depth)
 TYPED_CHOICE(choose_precision, ps_precision)
 TYPED_CHOICE(choose_schedule, ps_radius_schedule)
 TYPED_CHOICE(choose_bool, bool)
+TYPED_CHOICE(choose_global, ps_global_layer)
 #undef TYPED_CHOICE
 
 bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_status *st, ps_error *err)
@@ -237,6 +239,8 @@ bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_
         *st = choose_bool(cli, on_off, &o->stencil_clip, err);
     else if (ps_cli_is(cli, "--radius-schedule"))
         *st = choose_schedule(cli, ps_radius_schedule_names, &o->radius_schedule, err);
+    else if (ps_cli_is(cli, "--global-layer"))
+        *st = choose_global(cli, ps_global_layer_names, &o->global_layer, err);
     else if (ps_cli_is(cli, "--radius-alpha"))
         *st = ps_cli_double(cli, 0.01, 1.0, &o->radius_alpha, err);
     else if (ps_cli_is(cli, "--layers")) {

@@ -49,6 +49,7 @@ typedef struct ps_preview_options {
     unsigned layers;          /* PS_LAYER_* bits (all) */
     ps_radius_schedule radius_schedule; /* fixed */
     double radius_alpha;      /* progressive schedule's alpha (2/3) */
+    ps_global_layer global_layer; /* splats (the thesis) or illumination maps */
 } ps_preview_options;
 
 /* float_depth: whether the colour depth defaults to float (the window) or

@@ -59,6 +59,8 @@ static const char usage[] =
     "                           r^2 ~ n^(alpha-1), the given radius holding at the\n"
     "                           scene's photon count (default fixed)\n"
     "  --radius-alpha A         the progressive schedule's alpha in (0, 1] (default 2/3)\n"
+    "  --global-layer splats|maps  the global map as splats, or as illumination maps\n"
+    "                           on the surfaces (glossy lobes still splatted) (default splats)\n"
     "  --hdr-layers PREFIX      also each layer alone, linear: PREFIX-direct.pfm,\n"
     "                           PREFIX-caustic.pfm, PREFIX-global.pfm\n"
     "  --checkpoints T1,T2,...  progressive mode: at each of these seconds, write the\n"
@@ -245,6 +247,8 @@ static ps_status write_layers(snap_run *s, const char *prefix, ps_error *err)
             st = read_picture(s, layer < 0, map, &img, err);
         } else {
             ps_gl_begin_frame(s->gl, &s->cam, f->direct_exposure, layer < 0 && f->direct);
+            if (layer == PS_MAP_GLOBAL)
+                ps_gl_draw_illummap(s->gl, f->imap_colors);
             if (layer >= 0)
                 ps_gl_draw_splats(s->gl, f->map[layer].batch, f->splat, f->map[layer].radius, f->point_size);
             st = ps_platform_read(s->platform, &img, err);
@@ -497,6 +501,7 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
     ps_stats_add(&rs, "counter_stopped_at_photons", (double)counter_at);
     ps_stats_add(&rs, "counter_threshold", o->p.counter_threshold);
     ps_stats_add(&rs, "radius_progressive", o->p.radius_schedule == PS_RADIUS_PROGRESSIVE ? 1.0 : 0.0);
+    ps_stats_add(&rs, "global_maps", o->p.global_layer == PS_GLOBAL_MAPS ? 1.0 : 0.0);
     ps_stats_add(&rs, "luminous_flux_lm", ps_scene_total_lumens(ps_session_scene(s->session)));
     if (o->c.stats) {
         ps_status st = ps_stats_write(o->c.stats, &rs, err);

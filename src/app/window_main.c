@@ -95,6 +95,8 @@ static const char usage[] =
     "                           fixed; progressive: r^2 ~ n^(alpha-1), the given\n"
     "                           radius holding at the scene's photon count)\n"
     "  --radius-alpha A         the progressive schedule's alpha (default 2/3)\n"
+    "  --global-layer splats|maps  the global map as splats or as illumination maps\n"
+    "                           on the surfaces (default splats; key M)\n"
     "  --overlay on|off         the text overlay (default on)\n"
     "  --autosave on|off        write every edit within a second to\n"
     "                           NAME.autosave.scn (default on; off with --script,\n"
@@ -117,6 +119,7 @@ static const char help_text[] =
     "  + / -            selected light's power x/÷ 1.25\n"
     "  [ / ]            selected spot's angle -/+ 2 degrees\n"
     "  S  splat mode     K  kernel        C  precision mode\n"
+    "  M                global layer: splats / illumination maps\n"
     "  1 2 3            direct, caustic, global layer on/off\n"
     "  R / Shift+R      splat radius up / down\n"
     "  T / Shift+T      tau up / down\n"
@@ -312,13 +315,14 @@ static void draw_overlay(app *a)
     int n = snprintf(text, sizeof text,
                      "caustic %llu/%llu  global %llu/%llu  %s\n"
                      "%.3g photons/s  %.1f fps  tau %.3g s  frame %.0f ms\n"
-                     "%s splats  %s kernel  r %.3g/%.3g  layers %s%s%s  %s  exposure %.3g\n",
+                     "%s splats  %s kernel  r %.3g/%.3g  layers %s%s%s  global %s  %s  exposure %.3g\n",
                      (unsigned long long)ce, (unsigned long long)set->caps[0], (unsigned long long)ge,
                      (unsigned long long)set->caps[1], state, rate, a->fps, set->tau, 1000.0 * a->frame_seconds,
                      ps_splat_mode_name(set->splat), ps_kernel_name(set->kernel),
                      ps_session_radius(a->session, PS_MAP_CAUSTIC), ps_session_radius(a->session, PS_MAP_GLOBAL),
                      set->layers & PS_LAYER_DIRECT ? "D" : "-", set->layers & PS_LAYER_CAUSTIC ? "C" : "-",
-                     set->layers & PS_LAYER_GLOBAL ? "G" : "-", float_layers ? "float" : ps_precision_name(set->precision),
+                     set->layers & PS_LAYER_GLOBAL ? "G" : "-", ps_global_layer_name(set->global_layer),
+                     float_layers ? "float" : ps_precision_name(set->precision),
                      set->exposure);
     if (!float_layers && n > 0 && (size_t)n < sizeof text)
         n += snprintf(text + n, sizeof text - (size_t)n, "error counter: %.1f %% of the last refresh rounded away%s\n",
@@ -740,6 +744,12 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         ps_session_set_precision(a->session, (ps_precision)((set->precision + 1) % PS_PRECISION_COUNT));
         a->redraw = true;
         break;
+    case GLFW_KEY_M:
+        if (ps_session_set_global_layer(a->session, (ps_global_layer)((set->global_layer + 1) % PS_GLOBAL_LAYER_COUNT),
+                                        &err) != PS_OK)
+            say(a, err.msg);
+        a->redraw = true;
+        break;
     case GLFW_KEY_1: set_layers(a, set->layers ^ PS_LAYER_DIRECT); break;
     case GLFW_KEY_2: set_layers(a, set->layers ^ PS_LAYER_CAUSTIC); break;
     case GLFW_KEY_3: set_layers(a, set->layers ^ PS_LAYER_GLOBAL); break;
@@ -887,6 +897,7 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
         case PS_SET_EXPOSURE: ps_session_set_exposure(s, act->number); return PS_OK;
         case PS_SET_PAUSE: ps_session_set_paused(s, act->choice != 0); return PS_OK;
         case PS_SET_FALSE_COLOR: set_false_color(a, act->choice != 0); return PS_OK;
+        case PS_SET_GLOBAL_LAYER: return ps_session_set_global_layer(s, (ps_global_layer)act->choice, err);
         }
         return PS_OK;
     }

@@ -7,16 +7,28 @@
 
 
 
-/* The direct layer, a layer a map, the composite as linear floats (read back
- * by tests), and the composite encoded for display (sRGB, 8 bits). */
-/* LAYER_ALBEDO_TEX: the visible surfaces' texture factor T (gl_albedo.c),
- * by which the composite multiplies every layer when the scene has textures. */
-enum { LAYER_DIRECT_TEX, LAYER_CAUSTIC_TEX, LAYER_GLOBAL_TEX, LAYER_FINAL_TEX, LAYER_SHOWN_TEX, LAYER_ALBEDO_TEX,
-       LAYER_TEX_COUNT };
+/* The direct layer, a layer a map, the global map's illumination maps
+ * (--global-layer maps: redrawn whole when they change, beside the global
+ * layer's lobe splats, which accumulate), the composite as linear floats
+ * (read back by tests), and the composite encoded for display (sRGB, 8
+ * bits). LAYER_ALBEDO_TEX: the visible surfaces' texture factor T
+ * (gl_albedo.c), by which the composite multiplies every layer when the
+ * scene has textures. */
+enum {
+    LAYER_DIRECT_TEX,
+    LAYER_CAUSTIC_TEX,
+    LAYER_GLOBAL_TEX,
+    LAYER_IMAP_TEX,
+    LAYER_FINAL_TEX,
+    LAYER_SHOWN_TEX,
+    LAYER_ALBEDO_TEX,
+    LAYER_TEX_COUNT
+};
 
 struct ps_gl_layers {
     int width, height;
     bool float_buffers;
+    bool imap_drawn; /* LAYER_IMAP_TEX holds maps (else it is black and not composited) */
     GLuint tex[LAYER_TEX_COUNT], fbo[LAYER_TEX_COUNT], depth_stencil;
     bool albedo; /* LAYER_ALBEDO_TEX holds this view's T */
 };
@@ -76,6 +88,33 @@ void ps_gl_layers_destroy(ps_gl_layers *l)
     free(l);
 }
 
+static void clear_imap(ps_gl_layers *l)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_IMAP_TEX]);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    l->imap_drawn = false;
+}
+
+/* The illumination maps drawn again into their layer (gl_illummap.c). */
+static void draw_imap(ps_gl_layers *l, ps_gl_renderer *r, const ps_session_frame *f)
+{
+    clear_imap(l);
+    if (!f->imap_colors)
+        return;
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_IMAP_TEX]);
+    glViewport(0, 0, l->width, l->height);
+    ps_gl_draw_illummap(r, f->imap_colors);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    l->imap_drawn = true;
+}
+
 /* A new view, the direct layer's shadows as said. */
 static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
                      bool shadows)
@@ -95,6 +134,7 @@ static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *
         glClearColor(0, 0, 0, 0);
         ps_gl_draw_albedo(r);
     }
+    clear_imap(l);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
 }
 
@@ -163,6 +203,8 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
             ps_gl_layers_clear_map(l, k);
         ps_gl_layers_add(l, r, k, f->map[k].batch, f->splat, f->map[k].radius, f->point_size);
     }
+    if (f->imap_colors ? f->imap_redraw || !l->imap_drawn : l->imap_drawn)
+        draw_imap(l, r, f);
 }
 
 /* direct * direct_gain + sum of map * map_gain into layer `target`. */
@@ -204,6 +246,8 @@ static void composite(ps_gl_layers *l, int target, double direct_gain, const dou
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (map_gain[k] > 0.0)
             add_texture(l->tex[LAYER_CAUSTIC_TEX + k], map_gain[k]);
+    if (l->imap_drawn && map_gain[PS_MAP_GLOBAL] > 0.0)
+        add_texture(l->tex[LAYER_IMAP_TEX], map_gain[PS_MAP_GLOBAL]);
     if (l->albedo) {
         glActiveTexture(GL_TEXTURE1);
         glBindTexture(GL_TEXTURE_2D, 0);

@@ -185,6 +185,7 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
 void ps_gl_draw_frame(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f)
 {
     ps_gl_begin_frame(r, cam, f->direct_exposure, f->direct);
+    ps_gl_draw_illummap(r, f->imap_colors);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (f->map[k].gain > 0.0)
             ps_gl_draw_splats(r, f->map[k].batch, f->splat, f->map[k].radius, f->point_size);

@@ -2,6 +2,8 @@
  * as "file:line: problem" and nothing half-built escapes. */
 #include "preview/script.h"
 
+#include "preview/illummap.h"
+
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -52,6 +54,7 @@ static const choice_list SPLAT_CHOICES = {ps_splat_mode_names, PS_SPLAT_MODE_COU
 static const choice_list KERNEL_CHOICES = {ps_kernel_names, PS_KERNEL_COUNT, "box, cone, gauss or epanechnikov"};
 static const choice_list PRECISION_CHOICES = {ps_precision_names, PS_PRECISION_COUNT, "none, diffusion or counter"};
 static const choice_list PAUSE_CHOICES = {PAUSE_NAMES, 2, "on or off"};
+static const choice_list GLOBAL_CHOICES = {ps_global_layer_names, PS_GLOBAL_LAYER_COUNT, "splats or maps"};
 
 /* ---- words ------------------------------------------------------------------- */
 
@@ -191,9 +194,9 @@ static ps_status parse_layers(parser *p, ps_script_action *a, const char *list)
 static ps_status parse_set(parser *p, ps_script_action *a)
 {
     static const char *const SETTINGS[] = {"splat",     "layers",   "kernel", "radius",     "tau",
-                                           "precision", "exposure", "pause",  "false-color"};
+                                           "precision", "exposure", "pause",  "false-color", "global-layer"};
     enum { SETTING_COUNT = sizeof SETTINGS / sizeof SETTINGS[0] };
-    static const char *const SAID = "splat, layers, kernel, radius, tau, precision, exposure, pause or false-color";
+    static const char *const SAID = "splat, layers, kernel, radius, tau, precision, exposure, pause, false-color or global-layer";
     if (p->nword < 3)
         return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "set: expected a setting (%s)", SAID);
     int k = 0;
@@ -214,6 +217,7 @@ static ps_status parse_set(parser *p, ps_script_action *a)
     case PS_SET_PRECISION: choices = &PRECISION_CHOICES; break;
     case PS_SET_PAUSE:
     case PS_SET_FALSE_COLOR: choices = &PAUSE_CHOICES; break;
+    case PS_SET_GLOBAL_LAYER: choices = &GLOBAL_CHOICES; break;
     case PS_SET_LAYERS:
         if (nargs != 1)
             return wrong_count(p, what, "one comma list of direct, caustic, global");

@@ -76,7 +76,8 @@ typedef enum ps_script_setting {
     PS_SET_PRECISION,
     PS_SET_EXPOSURE,
     PS_SET_PAUSE,
-    PS_SET_FALSE_COLOR /* the window's illuminance in false colour, key F */
+    PS_SET_FALSE_COLOR, /* the window's illuminance in false colour, key F */
+    PS_SET_GLOBAL_LAYER /* splats or maps (ps_global_layer_names), key M */
 } ps_script_setting;
 
 /* Bits of ps_script_action.layers. */
@@ -95,7 +96,7 @@ typedef struct ps_script_action {
     double number2;      /* set radius: the global radius, or 0 when not given */
     ps_script_setting setting; /* set */
     /* set splat/kernel/precision: the ps_splat_mode, ps_kernel or
-     * ps_precision value, read through their name tables (ps_splat_mode_names,
+     * ps_precision value (set global-layer: the ps_global_layer), read through their name tables (ps_splat_mode_names,
      * ps_kernel_names, ps_precision_names); set pause and false-color: 1 on, 0 off. */
     int choice;
     unsigned layers;     /* set layers: PS_LAYER_* bits (preview/layers.h) */

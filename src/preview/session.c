@@ -42,6 +42,18 @@ struct ps_session {
     uint64_t counter_at;
     double splat_seconds;
     uint64_t refreshes;
+    /* --global-layer maps (illummap.h): the maps hold photons [0, count) of
+     * the global map, imap_emitted emitted, whatever the view; lobe_drawn of
+     * their glossy photons are in the global layer since the last new view. */
+    ps_illummap *imap;
+    double imap_budget;    /* incremental: photons the maps take in a refresh, from their own
+                            * rate (their redraw is a fixed cost, not the photons') */
+    uint64_t imap_emitted;
+    double imap_scale;
+    const float *imap_view;      /* the view's colours, as last made */           /* what the maps' colours were last made with ... */
+    const ps_material *imap_mats;/* ... (colours are remade only when these or the maps change) */
+    size_t lobe_drawn;
+    ps_material *lobe_mats;
 };
 
 ps_session_settings ps_session_default_settings(const ps_scene *scene)
@@ -165,8 +177,34 @@ static ps_status new_feed(ps_session *s, ps_error *err)
         s->drawn[k] = 0;
         s->drawn_emitted[k] = 0;
     }
+    if (s->imap)
+        ps_illummap_reset(s->imap, s->set.kernel);
+    s->imap_emitted = 0;
+    s->lobe_drawn = 0;
     s->counter_stopped = false;
     s->view_dirty = true;
+    return st;
+}
+
+/* The illumination maps of the fine mesh, and the lobe splats' materials. */
+static ps_status imap_make(ps_session *s, ps_error *err)
+{
+    size_t n;
+    ps_scene_materials(s->scene, &n);
+    ps_illummap_destroy(s->imap);
+    s->imap = NULL;
+    free(s->lobe_mats);
+    s->lobe_mats = calloc(n ? n : 1, sizeof *s->lobe_mats);
+    if (!s->lobe_mats)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for %zu materials", ps_scene_path(s->scene), n);
+    s->imap_emitted = 0;
+    s->lobe_drawn = 0;
+    s->imap_budget = PS_SESSION_BUDGET_START;
+    s->imap_scale = -1.0; /* colours to make */
+    s->imap_view = NULL;
+    ps_status st = ps_illummap_create(s->scene, &s->mesh, s->set.kernel, &s->imap, err);
+    if (st == PS_OK)
+        st = ps_illummap_set_threads(s->imap, s->set.threads, err);
     return st;
 }
 
@@ -193,6 +231,8 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
         st = build_lights(s, err);
     if (st == PS_OK)
         st = new_feed(s, err);
+    if (st == PS_OK && set->global_layer == PS_GLOBAL_MAPS)
+        st = imap_make(s, err);
     if (st != PS_OK) {
         ps_session_destroy(s);
         return st;
@@ -214,6 +254,8 @@ void ps_session_destroy(ps_session *s)
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_splat_batch_free(&s->batch[k]);
     free(s->white);
+    ps_illummap_destroy(s->imap);
+    free(s->lobe_mats);
     free(s);
 }
 
@@ -276,9 +318,17 @@ static bool same_camera(const ps_camera_frame *a, const ps_camera_frame *b)
  * emitted): whole batches as the feed handed them over; incremental, at most
  * the budget beyond `from`, but at least one batch. *emitted: the photons
  * emitted for that prefix, which its splats are scaled by. Under the lock. */
+static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t from_emitted, double budget,
+                            uint64_t *emitted);
 static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emitted, uint64_t *emitted)
 {
-    double budget = s->moving ? s->budget * PS_SESSION_MOVING_SHARE : s->budget;
+    return prefix_within(s, k, from, from_emitted, s->moving ? s->budget * PS_SESSION_MOVING_SHARE : s->budget,
+                         emitted);
+}
+
+static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t from_emitted, double budget,
+                            uint64_t *emitted)
+{
     size_t n;
     const ps_feed_mark *m = ps_feed_marks(s->feed, (ps_map_kind)k, &n);
     size_t end = from;
@@ -306,6 +356,82 @@ static double radius_at(const ps_session *s, int k, uint64_t emitted)
     int64_t scene_n = k == PS_MAP_CAUSTIC ? d->caustic_photons : d->global_photons;
     uint64_t n0 = scene_n > 0 ? (uint64_t)scene_n : s->set.caps[k];
     return ps_splat_radius_at(s->set.radius_schedule, s->set.radius[k], n0, emitted, s->set.radius_alpha);
+}
+
+/* The global map with --global-layer maps (illummap.h), under the lock: the
+ * maps brought to the prefix the budget allows (the maps do not depend on
+ * the view, so they go on from their own count), at the schedule's radius
+ * level; the glossy photons' lobes splatted as the other layers' photons
+ * are; the colours remade when the maps or the view changed. */
+static ps_status imap_refresh(ps_session *s, const ps_photon_map *m, const ps_camera_frame *cam, ps_session_frame *out,
+                              ps_error *err)
+{
+    const int k = PS_MAP_GLOBAL;
+    bool inc = incremental(s);
+    ps_splat_batch *b = &s->batch[k];
+    ps_splat_batch_clear(b);
+    ps_splat_batch_reset_carry(b);
+    b->wanted = b->lost = 0.0;
+    uint64_t emitted;
+    size_t end = prefix_within(s, k, ps_illummap_count(s->imap), s->imap_emitted, s->imap_budget, &emitted);
+    if (emitted == 0)
+        return PS_OK;
+    size_t added;
+    double level = ps_illummap_level_radius(s->imap, s->set.radius[k], radius_at(s, k, emitted));
+    double t0 = ps_now_seconds();
+    ps_status st = ps_illummap_update(s->imap, m->photons, m->materials, m->objects, end, level, &added, err);
+    if (st != PS_OK)
+        return st;
+    if (inc && added > 0) {
+        double rate = (double)added / fmax(ps_now_seconds() - t0, 1e-6);
+        s->imap_budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * s->set.splat_share / PS_MAP_COUNT);
+    }
+    s->imap_emitted = emitted;
+    s->drawn[k] = end;
+    s->drawn_emitted[k] = emitted;
+    out->emitted[k] = emitted;
+    double scale = inc ? 1.0 : exposure(s) * (double)s->set.caps[k] / (double)emitted;
+    /* The lobes: the glossy photons not yet in this view's layer. */
+    const ps_photon *lp;
+    const uint16_t *lm;
+    const uint32_t *lo;
+    size_t nl = ps_illummap_lobe(s->imap, &lp, &lm, &lo), from = inc ? s->lobe_drawn : 0;
+    s->splat_radius[k] = radius_at(s, k, emitted);
+    if (nl > from && !s->illuminance) {
+        size_t nmat;
+        ps_scene_materials(s->scene, &nmat);
+        ps_illummap_lobe_materials(ps_session_materials(s), nmat, s->lobe_mats);
+        ps_splat_params p;
+        memset(&p, 0, sizeof p);
+        p.mode = s->set.splat;
+        p.radius = s->splat_radius[k];
+        p.kernel_mean = s->kernel.mean;
+        p.kernel_extent = s->kernel.extent;
+        p.scale = scale;
+        p.point_size = s->set.point_size;
+        p.precision = s->set.precision;
+        p.levels = float_splats(s) ? 0 : 255;
+        p.materials = s->lobe_mats;
+        p.objects = s->set.stencil_clip ? lo + from : NULL;
+        p.cam = *cam;
+        st = ps_splat_build(lp + from, lm + from, nl - from, &p, b, err);
+        out->splats += b->splats;
+    }
+    s->lobe_drawn = nl;
+    /* The colours follow the maps, the scale and the materials; which side
+     * each triangle shows follows the view. */
+    bool recolour = ps_illummap_changed(s->imap) || scale != s->imap_scale || ps_session_materials(s) != s->imap_mats;
+    if (recolour) {
+        const float *front, *back;
+        ps_illummap_colors(s->imap, ps_session_materials(s), scale, &front, &back);
+        s->imap_scale = scale;
+        s->imap_mats = ps_session_materials(s);
+    }
+    out->imap_redraw = recolour || out->new_view || !inc;
+    if (out->imap_redraw)
+        s->imap_view = ps_illummap_view_colors(s->imap, cam->eye);
+    out->imap_colors = s->imap_view;
+    return st;
 }
 
 ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_session_frame *out, ps_error *err)
@@ -343,7 +469,16 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     ps_status st = PS_OK;
     ps_feed_lock(s->feed);
     const ps_photon_map *maps = ps_feed_maps(s->feed);
+    if (out->new_view)
+        s->lobe_drawn = 0;
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
+        if (k == PS_MAP_GLOBAL && s->imap) {
+            if (s->set.layers & PS_LAYER_GLOBAL)
+                st = imap_refresh(s, &maps[k], cam, out, err);
+            else /* not shown: nothing waits (showing it is a new view) */
+                s->drawn[k] = maps[k].count;
+            continue;
+        }
         ps_splat_batch *b = &s->batch[k];
         ps_splat_batch_clear(b);
         /* A whole refresh is built afresh, so its round-off carry starts at 0:
@@ -410,6 +545,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         l->radius = s->splat_radius[k];
         l->gain = !shown ? 0.0 : inc ? exposure(s) * (double)s->set.caps[k] / (double)out->emitted[k] : 1.0;
     }
+    if (out->imap_colors && out->map[PS_MAP_GLOBAL].gain == 0.0)
+        out->imap_colors = NULL;
     return PS_OK;
 }
 
@@ -495,6 +632,10 @@ ps_status ps_session_set_kernel(ps_session *s, ps_kernel kernel, ps_error *err)
     s->kernel = t;
     s->set.kernel = kernel;
     s->view_dirty = true;
+    if (s->imap) {
+        ps_illummap_reset(s->imap, kernel);
+        s->imap_emitted = 0;
+    }
     return PS_OK;
 }
 
@@ -521,6 +662,27 @@ void ps_session_set_radius(ps_session *s, ps_map_kind k, double radius)
 }
 
 void ps_session_set_tau(ps_session *s, double tau) { s->set.tau = tau; }
+
+ps_status ps_session_set_global_layer(ps_session *s, ps_global_layer g, ps_error *err)
+{
+    if (g == PS_GLOBAL_MAPS && !s->imap) {
+        ps_status st = imap_make(s, err);
+        if (st != PS_OK)
+            return st;
+    }
+    if (g == PS_GLOBAL_SPLATS) {
+        /* The splats start over from photon 0 in the next view; the maps go. */
+        ps_illummap_destroy(s->imap);
+        s->imap = NULL;
+    }
+    s->set.global_layer = g;
+    s->drawn[PS_MAP_GLOBAL] = 0;
+    s->drawn_emitted[PS_MAP_GLOBAL] = 0;
+    s->view_dirty = true;
+    return PS_OK;
+}
+
+const ps_illummap *ps_session_illummap(const ps_session *s) { return s->imap; }
 
 ps_status ps_session_set_illuminance(ps_session *s, bool on, ps_error *err)
 {
@@ -606,8 +768,14 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
      * caustic cones follow lights and objects. */
     free_maps(s);
     ps_status st = PS_OK;
-    if (s->geometry_edited)
+    if (s->geometry_edited) {
+        /* The maps' samples are the fine mesh's vertices: made again with it. */
+        ps_illummap_destroy(s->imap);
+        s->imap = NULL;
         st = build_geometry(s, err);
+        if (st == PS_OK && s->set.global_layer == PS_GLOBAL_MAPS)
+            st = imap_make(s, err);
+    }
     /* The first picture after the edit as soon as after loading. */
     s->area_side = s->set.progressive_lights ? 1 : PS_PREVIEW_AREA_SIDE;
     s->lights_pending = false;

@@ -37,6 +37,7 @@
 #include "photon/estimate.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
+#include "preview/illummap.h"
 #include "preview/layers.h"
 #include "preview/lights.h"
 #include "preview/mesh.h"
@@ -96,6 +97,8 @@ typedef struct ps_session_settings {
                                     * refreshes (after loading and after each edit), so
                                     * that the first picture does not wait for all their
                                     * shadow cubes; else all from the start */
+    ps_global_layer global_layer;  /* the global layer as splats or as illumination maps
+                                    * (illummap.h) with only the glossy lobes splatted */
 } ps_session_settings;
 
 /* Defaults: the scene's photon counts and radii, every layer, triangles, the
@@ -162,6 +165,13 @@ typedef struct ps_session_frame {
     uint64_t emitted[PS_MAP_COUNT]; /* the photons emitted that this picture shows */
     size_t splats;           /* splats built this refresh */
     double round_off;        /* 8 bits: the fraction of this refresh's splat energy rounded away */
+    /* --global-layer maps: the global map's illumination maps as one RGBA
+     * colour a fine-mesh vertex for this view (ps_illummap_view_colors: each
+     * triangle the side the eye sees), times the gain the splats get (1 in
+     * incremental layers, exposure N / n in whole ones); NULL when not shown.
+     * map[PS_MAP_GLOBAL]'s batch then holds only the glossy lobes' splats. */
+    const float *imap_colors;
+    bool imap_redraw;        /* the colours are new (or the view): draw the maps again */
 } ps_session_frame;
 
 /* Builds this refresh's splats for camera cam (a camera unlike the last
@@ -190,6 +200,11 @@ void ps_session_set_exposure(ps_session *s, double exposure);
 /* Map k's r0; radius <= 0 leaves it. */
 void ps_session_set_radius(ps_session *s, ps_map_kind k, double radius);
 void ps_session_set_tau(ps_session *s, double tau);
+/* Splats or illumination maps for the global layer; the maps are made (and
+ * checked against the memory budget) when first asked for. */
+ps_status ps_session_set_global_layer(ps_session *s, ps_global_layer g, ps_error *err);
+/* The illumination maps (NULL unless --global-layer maps). */
+const ps_illummap *ps_session_illummap(const ps_session *s);
 
 /* Illuminance mode (for lux: --illuminance, the window's false colour): every
  * surface drawn as white Lambertian (albedo 1, ps_session_materials), so that

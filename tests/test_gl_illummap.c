@@ -1,0 +1,152 @@
+/* test_gl_illummap.c: the global layer drawn as illumination maps
+ * (--global-layer maps) shows the maps' value times albedo / pi: inside the
+ * furnace sphere (albedo 0.5, a point light at its centre) every pixel of the
+ * global layer lies between the least and the most of the maps' values, the
+ * picture's mean is the closed form's rho^2 Phi / (4 pi^2 R^2 (1 - rho)),
+ * through the window's float layers and through snap's single 8-bit frame;
+ * and the picture is the same bytes for 1 and 2 tracing threads. */
+#include "test.h"
+
+#include <GL/osmesa.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_render.h"
+#include "preview/session.h"
+#include "scene/scene.h"
+
+#define SIDE 48
+#define RHO 0.5
+#define PHI 100.0
+#define EXPOSURE 0.4
+
+static const char *const FURNACE = "camera eye 0 0.2 0.3 target 0.3 0 -1 fov 70\n"
+                                   "material wall diffuse albedo 0.5 0.5 0.5\n"
+                                   "sphere center 0 0 0 radius 1 material wall\n"
+                                   "light point position 0 0 0 power 100 100 100\n"
+                                   "photons caustic 0 global 200000\n"
+                                   "radius caustic 0.02 global 0.3\n";
+
+/* The global layer of the furnace through the maps; *lo, *hi: the least and
+ * most of the maps' inside values as drawn (times albedo / pi and exposure). */
+static ps_image draw(bool layers, int threads, double *lo, double *hi)
+{
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load_text(FURNACE, "furnace.scn", "", NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_session_settings set = ps_session_default_settings(scene);
+    set.threads = threads;
+    set.seed = 1;
+    set.float_buffer = layers;
+    set.incremental = layers;
+    set.exposure = EXPOSURE;
+    set.layers = PS_LAYER_GLOBAL;
+    set.global_layer = PS_GLOBAL_MAPS;
+    ps_session *s;
+    if (ps_session_create(scene, &set, &s, &err) != PS_OK)
+        fail_msg("session: %s", err.msg);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    assert_non_null(ctx);
+    uint8_t *buffer = malloc(4 * SIDE * SIDE);
+    assert_true(OSMesaMakeCurrent(ctx, buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
+    ps_gl_options go = {true, false, 0};
+    ps_gl_scene gs = ps_gl_scene_of(s);
+    ps_gl_renderer *gl;
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
+    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), SIDE, SIDE);
+    ps_session_frame f;
+    ps_gl_layers *l = NULL;
+    if (layers)
+        assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &l, &err), PS_OK);
+    /* Incremental refreshes add a budget's worth at a time: until all are in. */
+    int refreshes = 0;
+    do {
+        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+        assert_non_null(f.imap_colors);
+        assert_true(f.imap_redraw);
+        if (l)
+            ps_gl_layers_draw(l, gl, &cam, &f);
+        ps_session_drawn(s, 0.01);
+        refreshes++;
+    } while (ps_illummap_count(ps_session_illummap(s)) < ps_session_maps(s)[PS_MAP_GLOBAL].count);
+    assert_true(layers ? refreshes > 1 : refreshes == 1);
+    /* No lobes: nothing glossy. */
+    assert_int_equal(f.map[PS_MAP_GLOBAL].batch->vertex_count, 0);
+    const ps_illummap *m = ps_session_illummap(s);
+    assert_int_equal(ps_illummap_count(m), ps_session_maps(s)[PS_MAP_GLOBAL].count);
+    double gain = layers ? f.map[PS_MAP_GLOBAL].gain : 1.0;
+    double scale = layers ? 1.0 : EXPOSURE; /* caps = emitted: N / n = 1 */
+    *lo = INFINITY, *hi = 0.0;
+    for (size_t i = 0; i < ps_illummap_sample_count(m); i++) {
+        double v = ps_illummap_irradiance(m, i, 1, NULL, NULL, NULL).g * RHO / PS_PI * scale * gain;
+        *lo = fmin(*lo, v), *hi = fmax(*hi, v);
+    }
+    ps_image img;
+    if (layers) {
+        double gains[PS_MAP_COUNT] = {f.map[0].gain, f.map[1].gain};
+        assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, gains, &img, &err), PS_OK);
+        ps_gl_layers_destroy(l);
+    } else {
+        ps_gl_draw_frame(gl, &cam, &f);
+        assert_int_equal(ps_gl_read(gl, &img, &err), PS_OK);
+    }
+    ps_gl_renderer_destroy(gl);
+    OSMesaDestroyContext(ctx);
+    free(buffer);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+    return img;
+}
+
+static void check(const ps_image *img, double lo, double hi, double tol, const char *what)
+{
+    double want = RHO * RHO * PHI / (4.0 * PS_PI * PS_PI * (1.0 - RHO)) * EXPOSURE, sum = 0.0;
+    size_t n = 3 * (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n; i++) {
+        sum += img->rgb[i];
+        if (!(img->rgb[i] >= lo - tol && img->rgb[i] <= hi + tol))
+            fail_msg("%s: pixel value %g outside the maps' %g .. %g", what, img->rgb[i], lo, hi);
+    }
+    printf("%s: global layer mean %.5f, closed form %.5f, maps %.5f .. %.5f\n", what, sum / (double)n, want, lo, hi);
+    assert_near(sum / (double)n, want, 0.03 * want);
+}
+
+static void layers_show_the_maps(void **state)
+{
+    (void)state;
+    double lo, hi;
+    ps_image img = draw(true, 2, &lo, &hi);
+    check(&img, lo, hi, 1e-5, "float layers");
+    ps_image_destroy(&img);
+}
+
+static void whole_frame_shows_the_maps(void **state)
+{
+    (void)state;
+    double lo, hi;
+    ps_image img = draw(false, 2, &lo, &hi);
+    check(&img, lo, hi, 0.6 / 255.0, "8-bit frame");
+    ps_image_destroy(&img);
+}
+
+static void threads_do_not_matter(void **state)
+{
+    (void)state;
+    double lo, hi;
+    ps_image a = draw(true, 1, &lo, &hi), b = draw(true, 2, &lo, &hi);
+    assert_memory_equal(a.rgb, b.rgb, 3 * sizeof(float) * SIDE * SIDE);
+    ps_image_destroy(&a);
+    ps_image_destroy(&b);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(layers_show_the_maps),
+        cmocka_unit_test(whole_frame_shows_the_maps),
+        cmocka_unit_test(threads_do_not_matter),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
