@@ -830,6 +830,15 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
     case PS_SCRIPT_QUIT:
         a->quit = true;
         return PS_OK;
+    case PS_SCRIPT_DUMP_PHOTONS: {
+        const ps_photon_map *maps = ps_session_lock_maps(s);
+        ps_status st = ps_write_photon_dump(act->path, maps, err);
+        ps_session_unlock_maps(s);
+        return st;
+    }
+    case PS_SCRIPT_SAVE_SCENE:
+        return ps_error_set(err, PS_ERR_PARSE, "%s:%d: save scene: not available in this build", a->o.script,
+                            act->line);
     case PS_SCRIPT_SET:
         a->redraw = true;
         switch (act->setting) {
@@ -1020,7 +1029,7 @@ int main(int argc, char **argv)
     ps_status st = ps_check_outputs(&a.o.c, &err);
     for (size_t i = 0; st == PS_OK && a.script && i < ps_script_count(a.script); i++) {
         const ps_script_action *act = ps_script_at(a.script, i);
-        if (act->kind == PS_SCRIPT_SCREENSHOT)
+        if (act->path)
             st = ps_check_output_path(act->path, &err);
     }
     if (st == PS_OK)

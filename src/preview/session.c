@@ -8,6 +8,7 @@
 
 #include "core/clock.h"
 #include "preview/feed.h"
+#include "preview/repair.h"
 
 struct ps_session {
     ps_scene *scene;
@@ -42,6 +43,13 @@ struct ps_session {
     uint64_t counter_at;
     double splat_seconds;
     uint64_t refreshes;
+    /* Selective repair (repair.h): the scene the maps were traced for, the
+     * box path records are quantised in, what the last edit kept. */
+    ps_repair_state traced;
+    ps_aabb record_box;
+    bool repaired;         /* the feed goes on from a repair: no first round to prime */
+    uint64_t feed_gen;     /* the feed's generation the drawn prefixes belong to */
+    ps_feed_repair_count repair;
 };
 
 ps_session_settings ps_session_default_settings(const ps_scene *scene)
@@ -66,6 +74,7 @@ ps_session_settings ps_session_default_settings(const ps_scene *scene)
     set.tau = 0.1;
     set.splat_share = PS_SESSION_SPLAT_TIME_SHARE;
     set.shadow_size = PS_SHADOW_SIZE_DEFAULT;
+    set.repair = true;
     return set;
 }
 
@@ -133,6 +142,8 @@ static ps_status new_tracer(ps_session *s, ps_error *err)
     to.threads = s->set.threads;
     to.cancel = s->set.cancel;
     to.max_stored = s->set.max_map_photons;
+    to.records = s->set.repair;
+    to.record_box = s->record_box;
     return ps_tracer_create(s->world, &to, &s->tracer, err);
 }
 
@@ -167,6 +178,7 @@ static ps_status new_feed(ps_session *s, ps_error *err)
     }
     s->counter_stopped = false;
     s->view_dirty = true;
+    s->feed_gen = 0;
     return st;
 }
 
@@ -184,7 +196,10 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
         ps_splat_batch_init(&s->batch[k]);
         s->splat_radius[k] = set->radius[k];
     }
+    s->record_box = ps_repair_record_box(scene);
     ps_status st = build_geometry(s, err);
+    if (st == PS_OK)
+        st = ps_repair_state_take(scene, ps_world_epsilon(s->world), &s->traced, err);
     if (st == PS_OK)
         st = new_tracer(s, err);
     if (st == PS_OK)
@@ -214,6 +229,7 @@ void ps_session_destroy(ps_session *s)
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_splat_batch_free(&s->batch[k]);
     free(s->white);
+    ps_repair_state_free(&s->traced);
     free(s);
 }
 
@@ -224,7 +240,9 @@ ps_status ps_session_trace_all(ps_session *s, ps_error *err) { return ps_feed_ru
 ps_status ps_session_start(ps_session *s, bool held, ps_error *err)
 {
     s->started = true;
-    ps_status st = ps_feed_prime(s->feed, err);
+    /* After a repair the kept photons are the first picture: the thread
+     * retraces the rest. */
+    ps_status st = s->repaired ? PS_OK : ps_feed_prime(s->feed, err);
     if (st != PS_OK)
         return st;
     s->first_pending = held;
@@ -324,6 +342,17 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         s->view_dirty = true;
     }
     out->moving = s->moving;
+    ps_feed_lock(s->feed);
+    uint64_t gen = ps_feed_generation(s->feed);
+    if (gen != s->feed_gen) {
+        /* The feed put a map back in index order: a drawn prefix that was
+         * not all of it is other photons now. */
+        s->feed_gen = gen;
+        for (int k = 0; k < PS_MAP_COUNT; k++)
+            if (s->drawn[k] != ps_feed_maps(s->feed)[k].count)
+                s->view_dirty = true;
+    }
+    ps_feed_unlock(s->feed);
     if (s->lights_pending) {
         s->lights_pending = false;
         ps_status lst = build_lights(s, err);
@@ -462,7 +491,7 @@ bool ps_session_settled(ps_session *s)
     if (s->user_paused || s->counter_stopped)
         return true;
     ps_feed_lock(s->feed);
-    bool over = ps_feed_ended(s->feed);
+    bool over = ps_feed_ended(s->feed) && ps_feed_generation(s->feed) == s->feed_gen;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         over = over && s->drawn[k] >= ps_feed_maps(s->feed)[k].count;
     ps_feed_unlock(s->feed);
@@ -595,9 +624,13 @@ uint64_t ps_session_edits(const ps_session *s) { return s->edits; }
 ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error *err)
 {
     changes->geometry = s->geometry_edited;
-    /* Every edit restarts both maps from photon 0 (thesis 4.1.4): the tracer's
-     * caustic cones follow lights and objects. */
-    free_maps(s);
+    /* The old maps and tracer stay until the repair has taken what the edits
+     * left unchanged (repair.h); what it cannot, starts over from photon 0. */
+    ps_feed *old = s->feed;
+    ps_tracer *old_tracer = s->tracer;
+    s->feed = NULL;
+    s->tracer = NULL;
+    ps_feed_stop(old);
     ps_status st = PS_OK;
     if (s->geometry_edited)
         st = build_geometry(s, err);
@@ -608,8 +641,30 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
         st = build_lights(s, err);
     if (st == PS_OK)
         st = new_tracer(s, err);
-    if (st == PS_OK)
+    s->repaired = false;
+    memset(&s->repair, 0, sizeof s->repair);
+    if (st == PS_OK) {
+        ps_feed *f = NULL;
+        st = ps_repair_feed(old, old_tracer, s->tracer, &s->traced, s->scene, ps_world_epsilon(s->world), &f,
+                            &s->repaired, err);
+        if (st == PS_OK && s->repaired) {
+            s->feed = f;
+            s->repair = ps_feed_repair_counts(f);
+            for (int k = 0; k < PS_MAP_COUNT; k++)
+                s->drawn[k] = 0, s->drawn_emitted[k] = 0;
+            s->counter_stopped = false;
+            s->view_dirty = true;
+            s->feed_gen = 0;
+        }
+    }
+    ps_feed_destroy(old);
+    ps_tracer_destroy(old_tracer);
+    if (st == PS_OK && !s->feed)
         st = new_feed(s, err);
+    if (st == PS_OK) {
+        ps_repair_state_free(&s->traced);
+        st = ps_repair_state_take(s->scene, ps_world_epsilon(s->world), &s->traced, err);
+    }
     s->edited = s->geometry_edited = false;
     /* The first batch is traced here and the thread held until the first
      * refresh has drawn it: that refresh then has every core. */
@@ -648,3 +703,21 @@ void ps_session_get_counts(ps_session *s, ps_session_counts *out)
 }
 
 const ps_photon_map *ps_session_maps(const ps_session *s) { return ps_feed_maps(s->feed); }
+
+const ps_photon_map *ps_session_lock_maps(ps_session *s)
+{
+    ps_feed_lock(s->feed);
+    return ps_feed_maps(s->feed);
+}
+
+void ps_session_unlock_maps(ps_session *s) { ps_feed_unlock(s->feed); }
+
+void ps_session_repair_counts(const ps_session *s, bool *repaired, uint64_t kept[PS_MAP_COUNT],
+                              uint64_t retraced[PS_MAP_COUNT])
+{
+    *repaired = s->repaired;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        kept[k] = s->repair.kept[k];
+        retraced[k] = s->repair.retraced[k];
+    }
+}
