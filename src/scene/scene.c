@@ -37,7 +37,30 @@ void ps_scene_destroy(ps_scene *s)
     for (size_t k = 0; k < s->profiles.count; k++)
         ps_ies_destroy(s->profiles.items[k]);
     free(s->profiles.items);
+    free(s->stmts.items);
+    free(s->obj_src.items);
+    free(s->light_src.items);
+    free(s->edits.items);
+    free(s->strings.items);
     free(s);
+}
+
+uint32_t ps_scene_add_string(ps_scene *s, const char *text)
+{
+    size_t len = strlen(text) + 1, at = s->strings.count;
+    if (at + len >= PS_SOURCE_NONE || !PS_RESERVE(s->strings.items, s->strings.cap, at + len))
+        return PS_SOURCE_NONE;
+    memcpy(s->strings.items + at, text, len);
+    s->strings.count += len;
+    return (uint32_t)at;
+}
+
+/* Records an edit for ps_scene_write (scene_internal.h): room first, so that
+ * an edit refused for memory changes nothing. */
+static bool reserve_edit(ps_scene *s) { return PS_RESERVE(s->edits.items, s->edits.cap, s->edits.count + 1); }
+static void record_edit(ps_scene *s, uint32_t object, uint32_t light, ps_vec3 v)
+{
+    s->edits.items[s->edits.count++] = (ps_scene_edit){object, light, v};
 }
 
 const char *ps_scene_path(const ps_scene *s) { return s->path; }
@@ -271,7 +294,10 @@ ps_status ps_scene_set_light_power(ps_scene *s, size_t light, ps_rgb power, ps_e
     if (ps_rgb_max(power) > PS_SCENE_MAX_LIGHT_POWER)
         return refuse(err, s, "light", light, l->line, ": power (%g %g %g) is above the %g W a light may have",
                       power.r, power.g, power.b, PS_SCENE_MAX_LIGHT_POWER);
+    if (l->type == PS_LIGHT_MESH && !reserve_edit(s))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
     if (l->type == PS_LIGHT_MESH) {
+        record_edit(s, l->object, (uint32_t)light, ps_v3(power.r, power.g, power.b));
         /* The faces are drawn and seen with their material's emission; that
          * MTL material was made for this mesh statement and emits only here. */
         uint32_t m = s->triangles.items[s->emitters.items[l->first_emitter]].material;
@@ -358,9 +384,14 @@ ps_status ps_scene_translate_object(ps_scene *s, size_t object, ps_vec3 delta, p
                           delta.x, delta.y, delta.z, i);
     }
 
+    /* A sphere is written at its centre; meshes and quads replay their moves. */
+    if (o->type != PS_OBJ_SPHERE && !reserve_edit(s))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory", s->path);
     /* Move it: the same sums as the checks, so the same results. */
     if (o->type == PS_OBJ_SPHERE)
         o->center = center;
+    else
+        record_edit(s, (uint32_t)object, PS_SOURCE_NONE, delta);
     for (size_t v = vlo; v <= vhi && vlo != SIZE_MAX; v++)
         s->positions.items[v] = ps_v3_add(s->positions.items[v], delta);
     ps_scene_update_object(s, (uint32_t)object);
@@ -410,6 +441,11 @@ ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err)
     DUP_VEC(lights);
     DUP_VEC(emitters);
     DUP_VEC(profiles);
+    DUP_VEC(stmts);
+    DUP_VEC(obj_src);
+    DUP_VEC(light_src);
+    DUP_VEC(edits);
+    DUP_VEC(strings);
 #undef DUP_VEC
     /* The tables themselves, so that a clone shares nothing with s; until
      * each is copied its slot is NULL (destroy frees only copies). */

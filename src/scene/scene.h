@@ -239,6 +239,15 @@ ps_status ps_scene_translate_object(ps_scene *s, size_t object, ps_vec3 delta, p
  * reads the old one. On failure (PS_ERR_NOMEM) *out is NULL. */
 ps_status ps_scene_clone(const ps_scene *s, ps_scene **out, ps_error *err);
 
+/* Writes the scene, as edited, to path as a .scn file that ps_scene_load
+ * reads back to the same scene: every number (17 significant digits), every
+ * material, object and light in the same order, the files it names relative
+ * to path's directory (absolute when they share nothing below the root), the
+ * edits to meshes and quads as `move` / `light-power` keys replayed on
+ * loading. Lights are written with their flux (`power`), whatever the file
+ * gave. Atomic (core/fileio.h): on error nothing appears under path. */
+ps_status ps_scene_write(const ps_scene *scene, const char *path, ps_error *err);
+
 const char *ps_material_type_name(ps_material_type t);
 const char *ps_light_type_name(ps_light_type t);
 

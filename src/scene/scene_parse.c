@@ -1,5 +1,7 @@
 /* scene_parse.c: the .scn reader. One statement per line; every problem is
  * reported as "file:line: problem" and nothing half-built escapes. */
+#include <inttypes.h>
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,7 +38,6 @@
 #define DEFAULT_GLOBAL_RADIUS_FRACTION 0.025
 #define DEFAULT_FOV_DEG 40.0
 #define DEFAULT_ALBEDO 0.5
-#define DEFAULT_MATERIAL_NAME "(default)"
 
 typedef struct parser {
     ps_scene *s;
@@ -49,6 +50,10 @@ typedef struct parser {
     int ntok, pos;
     bool has_camera, has_image, has_photons, has_radius;
     int64_t default_material; /* index, or -1 until first needed */
+    /* What the statement being read records for ps_scene_write (scene_internal.h). */
+    ps_object_source pending_obj;
+    ps_light_source pending_light;
+    PS_VEC(ps_scene_edit) pending_edits; /* a mesh's or quad's `move` and `light-power` keys */
     ps_namemap *material_names; /* name -> index in s->materials; the first of a name wins */
 } parser;
 
@@ -263,7 +268,7 @@ static ps_material *add_material(parser *p, const char *name)
 static int64_t default_material(parser *p)
 {
     if (p->default_material < 0) {
-        ps_material *m = add_material(p, DEFAULT_MATERIAL_NAME);
+        ps_material *m = add_material(p, PS_DEFAULT_MATERIAL_NAME);
         if (!m)
             return -1;
         m->type = PS_MAT_DIFFUSE;
@@ -373,6 +378,42 @@ static ps_status resolve_material(parser *p, const key_vals *kv, uint32_t *out)
 
 /* ---- geometry ------------------------------------------------------------------ */
 
+/* `move DX DY DZ` (meshes, quads) and `light-power K R G B` (meshes: the
+ * statement's K-th emissive light), repeatable, in order from p->pos to the
+ * end of the line: the edits ps_scene_write saves, replayed through the edit
+ * functions once the statement is read (apply_edits), so that they give the
+ * same numbers as when they were made. */
+static ps_status parse_edits(parser *p, bool mesh)
+{
+    while (more(p)) {
+        const char *key = p->tok[p->pos++];
+        ps_scene_edit e = {0, PS_SOURCE_NONE, {0, 0, 0}};
+        double v[4];
+        ps_status st;
+        if (!strcmp(key, "move")) {
+            if ((st = read_numbers(p, "move", 3, v)) != PS_OK)
+                return st;
+            e.v = ps_v3(v[0], v[1], v[2]);
+        } else if (mesh && !strcmp(key, "light-power")) {
+            if ((st = read_numbers(p, "light-power", 4, v)) != PS_OK)
+                return st;
+            if (!(v[0] >= 0.0 && v[0] < PS_SCENE_MAX_LIGHTS && v[0] == floor(v[0])))
+                return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: mesh: light-power: %g is not a light of the mesh",
+                                    p->name, p->line, v[0]);
+            e.light = (uint32_t)v[0];
+            e.v = ps_v3(v[1], v[2], v[3]);
+        } else {
+            return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: %s: unknown key '%s' after 'move' (expected %s)",
+                                p->name, p->line, p->tok[0], key, mesh ? "move or light-power" : "move");
+        }
+        ps_scene_edit *slot = PS_VEC_PUSH(p->pending_edits);
+        if (!slot)
+            return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        *slot = e;
+    }
+    return PS_OK;
+}
+
 static ps_object *add_object(parser *p, ps_object_type type)
 {
     if (p->s->objects.count >= PS_SCENE_MAX_OBJECTS) {
@@ -413,10 +454,19 @@ static ps_status parse_quad(parser *p)
 {
     static const key_spec spec[] = {{"corner", 3, true}, {"edge1", 3, true}, {"edge2", 3, true}, {"material", ARITY_WORD, false}};
     key_vals kv[4];
+    /* Saved edits (`move`, repeatable) follow the keys. */
+    int ntok = p->ntok, first_move = p->pos;
+    while (first_move < ntok && strcmp(p->tok[first_move], "move") != 0)
+        first_move++;
+    p->ntok = first_move;
     ps_status st = parse_keys(p, "quad", spec, 4, kv);
-    if (st != PS_OK)
+    p->ntok = ntok;
+    if (st != PS_OK || (st = parse_edits(p, false)) != PS_OK)
         return st;
     ps_vec3 c = kv_vec3(&kv[0]), e1 = kv_vec3(&kv[1]), e2 = kv_vec3(&kv[2]);
+    p->pending_obj.corner = c;
+    p->pending_obj.edge1 = e1;
+    p->pending_obj.edge2 = e2;
     uint32_t mat;
     if ((st = check_parallelogram(p, e1, e2)) != PS_OK || (st = resolve_material(p, &kv[3], &mat)) != PS_OK ||
         (st = reserve_geometry(p, 4, 0, 2)) != PS_OK)
@@ -673,6 +723,12 @@ static ps_status parse_mesh(parser *p)
         const char *key = p->tok[p->pos++];
         double v[4];
         ps_xform step;
+        if (!strcmp(key, "move") || !strcmp(key, "light-power")) {
+            p->pos--;
+            if ((st = parse_edits(p, true)) != PS_OK)
+                return st;
+            break;
+        }
         if (!strcmp(key, "material")) {
             if (override)
                 return ps_error_set(p->err, PS_ERR_PARSE, "%s:%d: mesh: 'material' given twice", p->name, p->line);
@@ -725,6 +781,24 @@ static ps_status parse_mesh(parser *p)
     ps_obj_mesh om;
     ps_error oerr;
     st = ps_obj_load(path, &om, p->warn, &oerr);
+    if (st == PS_OK) {
+        /* The keys as written, without the edits, and the file by absolute
+         * path: what ps_scene_write writes relative to a new place. */
+        char keys[SCN_LINE_MAX] = "";
+        size_t used = 0;
+        for (int k = 2; k < p->ntok && strcmp(p->tok[k], "move") != 0 && strcmp(p->tok[k], "light-power") != 0; k++)
+            used += (size_t)snprintf(keys + used, used < sizeof keys ? sizeof keys - used : 0, "%s%s", used ? " " : "",
+                                     p->tok[k]);
+        char *abs = ps_scene_abs_path(path);
+        p->pending_obj.file = abs ? ps_scene_add_string(p->s, abs) : PS_SOURCE_NONE;
+        p->pending_obj.keys = ps_scene_add_string(p->s, keys);
+        p->pending_obj.first_light = (uint32_t)p->s->lights.count;
+        free(abs);
+        if (p->pending_obj.file == PS_SOURCE_NONE || p->pending_obj.keys == PS_SOURCE_NONE) {
+            ps_obj_free(&om);
+            return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        }
+    }
     if (st != PS_OK) {
         /* An OBJ/MTL problem with a line of its own names that line first (and
          * the error keeps it); one without (a missing file) is the scene
@@ -865,6 +939,7 @@ static ps_status parse_ies_light(parser *p, ps_light *l)
     ps_vec3 aim = kv[1].present ? kv_vec3(&kv[1]) : ps_v3(0, -1, 0);
     if ((st = check_direction(p, "aim", aim)) != PS_OK)
         return st;
+    p->pending_light.dir = aim;
     l->direction = ps_v3_norm(aim);
     l->spin_deg = kv[2].present ? kv[2].v[0] : 0.0;
     if (!(fabs(l->spin_deg) <= 360.0 * 1000.0))
@@ -889,6 +964,15 @@ static ps_status parse_ies_light(parser *p, ps_light *l)
     ps_ies *ies = NULL;
     ps_error ierr;
     st = ps_ies_load(path, &ies, &ierr);
+    if (st == PS_OK) {
+        char *abs = ps_scene_abs_path(path);
+        p->pending_light.file = abs ? ps_scene_add_string(p->s, abs) : PS_SOURCE_NONE;
+        free(abs);
+        if (p->pending_light.file == PS_SOURCE_NONE) {
+            ps_ies_destroy(ies);
+            return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+        }
+    }
     if (st != PS_OK) {
         /* As for meshes: a problem on a line of the IES file names that line. */
         const char *colon = strchr(ierr.msg, ':');
@@ -959,6 +1043,7 @@ static ps_status parse_light(parser *p)
         l.position = kv_vec3(&kv[0]);
         if ((st = check_direction(p, "direction", kv_vec3(&kv[1]))) != PS_OK)
             return st;
+        p->pending_light.dir = kv_vec3(&kv[1]);
         l.direction = ps_v3_norm(kv_vec3(&kv[1]));
         l.angle_deg = kv[2].v[0];
         if (!(l.angle_deg > 0.0 && l.angle_deg <= 90.0))
@@ -1003,6 +1088,7 @@ static ps_status parse_light(parser *p)
             return st;
         l.type = PS_LIGHT_DISC;
         l.position = kv_vec3(&kv[0]);
+        p->pending_light.dir = kv_vec3(&kv[1]);
         l.direction = ps_v3_norm(kv_vec3(&kv[1]));
         l.radius = kv[2].v[0];
         l.area = PS_PI * l.radius * l.radius;
@@ -1182,11 +1268,73 @@ static void apply_defaults(parser *p)
         d->global_radius = DEFAULT_GLOBAL_RADIUS_FRACTION * diag;
 }
 
+/* After a statement: what it made, in the source arrays ps_scene_write reads
+ * (scene_internal.h), then its saved edits applied. */
+static ps_status record_statement(parser *p, const char *kw, size_t materials, size_t objects, size_t lights)
+{
+    ps_scene *s = p->s;
+    bool ok = true;
+    if (!strcmp(kw, "material") && s->materials.count > materials) {
+        ps_scene_stmt *st = PS_VEC_PUSH(s->stmts);
+        if ((ok = st != NULL))
+            *st = (ps_scene_stmt){PS_STMT_MATERIAL, (uint32_t)materials};
+    }
+    for (size_t o = objects; ok && o < s->objects.count; o++) {
+        ps_scene_stmt *st = PS_VEC_PUSH(s->stmts);
+        ps_object_source *src = st ? PS_VEC_PUSH(s->obj_src) : NULL;
+        if ((ok = src != NULL)) {
+            *st = (ps_scene_stmt){PS_STMT_OBJECT, (uint32_t)o};
+            *src = p->pending_obj;
+        }
+    }
+    for (size_t l = lights; ok && l < s->lights.count; l++) {
+        bool own = !strcmp(kw, "light"); /* else a mesh's emissive faces */
+        ps_scene_stmt *st = own ? PS_VEC_PUSH(s->stmts) : NULL;
+        ps_light_source *src = !own || st ? PS_VEC_PUSH(s->light_src) : NULL;
+        if ((ok = src != NULL)) {
+            if (own)
+                *st = (ps_scene_stmt){PS_STMT_LIGHT, (uint32_t)l};
+            *src = own ? p->pending_light : (ps_light_source){PS_SOURCE_NONE, {0, 0, 0}};
+        }
+    }
+    if (!ok)
+        return ps_error_set(p->err, PS_ERR_NOMEM, "%s:%d: out of memory", p->name, p->line);
+    for (size_t k = 0; k < p->pending_edits.count; k++) {
+        const ps_scene_edit *e = &p->pending_edits.items[k];
+        uint32_t object = (uint32_t)(s->objects.count - 1);
+        ps_status st;
+        if (e->light == PS_SOURCE_NONE) {
+            st = ps_scene_translate_object(s, object, e->v, p->err);
+        } else {
+            size_t first = p->pending_obj.first_light, count = s->lights.count - lights;
+            if (e->light >= count)
+                return ps_error_set(p->err, PS_ERR_RANGE, "%s:%d: mesh: light-power %" PRIu32
+                                    ": the mesh has %zu emissive light%s", p->name, p->line, e->light, count,
+                                    count == 1 ? "" : "s");
+            st = ps_scene_set_light_power(s, first + e->light, ps_rgb_make(e->v.x, e->v.y, e->v.z), p->err);
+        }
+        if (st != PS_OK)
+            return st;
+    }
+    return PS_OK;
+}
+
 static ps_status parse_one_line(void *user, char *text)
 {
     parser *p = user;
     ps_status st = tokenize(p, text);
-    return st == PS_OK && p->ntok > 0 ? parse_statement(p) : st;
+    if (st != PS_OK || p->ntok == 0)
+        return st;
+    ps_scene *s = p->s;
+    size_t materials = s->materials.count, objects = s->objects.count, lights = s->lights.count;
+    memset(&p->pending_obj, 0, sizeof p->pending_obj);
+    p->pending_obj.file = p->pending_obj.keys = p->pending_obj.first_light = PS_SOURCE_NONE;
+    memset(&p->pending_light, 0, sizeof p->pending_light);
+    p->pending_light.file = PS_SOURCE_NONE;
+    p->pending_edits.count = 0;
+    const char *kw = p->tok[0];
+    st = parse_statement(p);
+    return st == PS_OK ? record_statement(p, kw, materials, objects, lights) : st;
 }
 
 static ps_status parse_text(parser *p, const char *text, size_t len)
@@ -1241,6 +1389,7 @@ static ps_status load_text(const char *text, size_t len, const char *name, const
     ps_status st = bin ? ps_error_set(err, PS_ERR_PARSE, "%s:%d: binary data (a NUL byte), not a scene file", name, bin)
                        : parse_text(&p, text, len);
     ps_namemap_destroy(p.material_names);
+    free(p.pending_edits.items);
     if (st != PS_OK) {
         ps_scene_destroy(p.s);
         return st;
