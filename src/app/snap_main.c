@@ -550,9 +550,7 @@ static ps_status script_action(snap_run *s, const ps_script_action *act, bool *w
     case PS_SCRIPT_WAIT: *wait = true; return PS_OK;
     case PS_SCRIPT_QUIT: *quit = true; return PS_OK;
     case PS_SCRIPT_DUMP_PHOTONS: return dump_photons(s, act->path, err);
-    case PS_SCRIPT_SAVE_SCENE:
-        return ps_error_set(err, PS_ERR_PARSE, "%s:%d: save scene: not available in this build", s->o->script_path,
-                            act->line);
+    case PS_SCRIPT_SAVE_SCENE: return ps_scene_write(ps_session_scene(ss), act->path, err);
     case PS_SCRIPT_SET:
         switch (act->setting) {
         case PS_SET_SPLAT: ps_session_set_splat(ss, (ps_splat_mode)act->choice); return PS_OK;

@@ -837,8 +837,7 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
         return st;
     }
     case PS_SCRIPT_SAVE_SCENE:
-        return ps_error_set(err, PS_ERR_PARSE, "%s:%d: save scene: not available in this build", a->o.script,
-                            act->line);
+        return ps_scene_write(ps_session_scene(s), act->path, err);
     case PS_SCRIPT_SET:
         a->redraw = true;
         switch (act->setting) {
