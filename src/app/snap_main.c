@@ -71,6 +71,8 @@ static const char usage[] =
     "  --script FILE            a headless session: the window's script actions (see the\n"
     "                           README) on snap's own clock, progressive; the snapshot\n"
     "                           is written when the script ends (quit, or its last action)\n"
+    "  --repair on|off          a script's edits keep the photons they cannot change\n"
+    "                           (default on; off: every edit restarts both maps)\n"
     "  --help                   this text\n";
 
 /* Progressive float refreshes may give this share of tau to new splats:
@@ -91,6 +93,7 @@ typedef struct snap_options {
     int checkpoint_count;
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM */
     const char *script_path;      /* --script */
+    int no_repair;                /* --repair off: a script's edits restart the maps */
     ps_script *script;
 } snap_options;
 
@@ -125,6 +128,9 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
             st = ps_cli_string(&cli, &o->checkpoint_prefix, err);
         } else if (ps_cli_is(&cli, "--script")) {
             st = ps_cli_string(&cli, &o->script_path, err);
+        } else if (ps_cli_is(&cli, "--repair")) {
+            static const char *const on_off[] = {"on", "off", NULL};
+            st = ps_cli_choice(&cli, on_off, &o->no_repair, err);
         } else if (ps_cli_is(&cli, "--checkpoints")) {
             st = ps_cli_ascending(&cli, 1e-3, 1e6, o->checkpoints, SNAP_MAX_CHECKPOINTS, &o->checkpoint_count, err);
         } else {
@@ -762,7 +768,7 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
     bool progressive = o->time > 0.0 || o->script;
     set.incremental = progressive && set.float_buffer;
     /* Only a script edits: path records for the selective repair then. */
-    set.repair = o->script != NULL;
+    set.repair = o->script != NULL && !o->no_repair;
     set.splat_share = SNAP_SPLAT_SHARE;
     /* Progressive: the first picture without waiting for every area light's
      * 16 shadow cubes; a fixed photon count draws once, with all of them. */

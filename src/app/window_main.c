@@ -72,7 +72,7 @@ static const char usage[] =
     "  --size WxH               window size (default from the scene)\n"
     "  --exposure E             radiance multiplier before display (default 1)\n"
     "  --caustic-photons N      caustic photon cap: traced, then refining stops (default from the scene)\n"
-    "  --global-photons N       global photon cap likewise; each edit restarts both maps\n"
+    "  --global-photons N       global photon cap likewise; edits repair both maps (--repair)\n"
     "  --max-photons N          memory cap: stop once the maps store N photons (default 2^25, 0: none)\n"
     "  --caustic-radius R       caustic splat radius, scene units\n"
     "  --global-radius R        global splat radius, scene units\n"
@@ -95,6 +95,8 @@ static const char usage[] =
     "                           radius holding at the scene's photon count)\n"
     "  --radius-alpha A         the progressive schedule's alpha (default 2/3)\n"
     "  --overlay on|off         the text overlay (default on)\n"
+    "  --repair on|off          edits keep the photons they cannot change (default on;\n"
+    "                           off: every edit restarts both maps, as before)\n"
     "  --composite gl|cpu       where the picture is encoded for display: by GL (default),\n"
     "                           or read back and encoded on the CPU (the old way, for\n"
     "                           scripts/bench-window.sh to compare)\n"
@@ -126,6 +128,7 @@ typedef struct win_options {
     ps_preview_options p;
     const char *script;
     int overlay;
+    int no_repair; /* --repair off: every edit restarts the maps (the bench's baseline) */
     int64_t max_photons; /* stored photons of both maps; 0: no bound */
     int composite;       /* 1: on the GL side (the default); 0: read back and encoded on the CPU */
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM: the session ends */
@@ -215,6 +218,9 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
             st = ps_cli_string(&cli, &o->script, err);
         } else if (ps_cli_is(&cli, "--overlay")) {
             st = ps_cli_choice(&cli, on_off, &o->overlay, err);
+        } else if (ps_cli_is(&cli, "--repair")) {
+            st = ps_cli_choice(&cli, on_off, &o->no_repair, err);
+            o->no_repair = !o->no_repair;
         } else if (ps_cli_is(&cli, "--composite")) {
             static const char *const where[] = {"cpu", "gl", NULL};
             st = ps_cli_choice(&cli, where, &o->composite, err);
@@ -245,6 +251,7 @@ static ps_status open_session(app *a, ps_error *err)
     set.incremental = true;
     set.shadow_size = a->o.p.shadows ? WIN_SHADOW_SIZE : 0;
     set.progressive_lights = true; /* the first picture (and the first after an edit) sooner */
+    set.repair = !a->o.no_repair;
     ps_status st = ps_session_create(a->scene, &set, &a->session, err);
     ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE};
     if (st == PS_OK) {
@@ -937,10 +944,12 @@ static ps_status session(app *a, ps_error *err)
         if (st != PS_OK || a->quit)
             break;
         if (ps_session_edited(a->session)) {
-            /* Every edit restarts the maps (thesis 4.1.4); the first refresh
-             * follows at once, with whatever the first batch brings. */
-            st = apply_edits(a, err);
+            /* The maps keep what the edits cannot change and retrace the rest
+             * (preview/repair.h); the first refresh follows at once. Edits
+             * that came since the last refresh (a drag's mouse events) are
+             * applied together. The latency counts the repair. */
             a->edit_time = ps_now_seconds();
+            st = apply_edits(a, err);
             a->awaiting_edit_frame = true;
             next = 0.0;
             if (st != PS_OK)

@@ -761,6 +761,44 @@ bool ps_tracer_same_source(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_
     return memcmp(&xa, &xb, sizeof xa) == 0 && memcmp(pa->rotation, pb->rotation, sizeof pa->rotation) == 0;
 }
 
+static bool same_stratum(const map_plan *pa, size_t ka, const map_plan *pb, size_t kb)
+{
+    const stratum *sa = &pa->strata[ka], *sb = &pb->strata[kb];
+    if (sa->light != sb->light || sa->target != sb->target || sa->has_caustic_cone != sb->has_caustic_cone)
+        return false;
+    if (sa->has_caustic_cone && memcmp(&sa->caustic_cone, &sb->caustic_cone, sizeof sa->caustic_cone) != 0)
+        return false;
+    return memcmp(&pa->scale[ka], &pb->scale[kb], sizeof pa->scale[ka]) == 0;
+}
+
+ps_source_match ps_tracer_match_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total)
+{
+    map_plan *pa = &a->plans[kind], *pb = &b->plans[kind];
+    if (!pa->enabled || !pb->enabled || memcmp(pa->rotation, pb->rotation, sizeof pa->rotation) != 0)
+        return PS_SOURCES_NONE;
+    count_strata(pa, total);
+    count_strata(pb, total);
+    bool same = pa->count == pb->count;
+    for (size_t k = 0; same && k < pa->count; k++)
+        same = pa->strata[k].cdf == pb->strata[k].cdf && same_stratum(pa, k, pb, k);
+    if (same)
+        return PS_SOURCES_SAME;
+    for (size_t ka = 0; ka < pa->count; ka++)
+        for (size_t kb = 0; kb < pb->count; kb++)
+            if (same_stratum(pa, ka, pb, kb))
+                return PS_SOURCES_SOME;
+    return PS_SOURCES_NONE;
+}
+
+uint32_t ps_tracer_photon_light(ps_tracer *t, ps_map_kind kind, uint64_t i, uint64_t total)
+{
+    map_plan *p = &t->plans[kind];
+    if (!p->enabled)
+        return UINT32_MAX;
+    count_strata(p, total);
+    return p->strata[stratum_of(p, i)].light;
+}
+
 ps_status ps_traced_join(ps_traced *r, ps_photon_map *m, ps_error *err)
 {
     if (!r)

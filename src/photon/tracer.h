@@ -142,6 +142,13 @@ ps_path_quant ps_tracer_path_quant(const ps_tracer *t);
  * the caller's to know. */
 bool ps_tracer_same_source(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t i, uint64_t total,
                            uint32_t *light);
+/* The same question for all photons of a map at once: every photon leaves
+ * the same way (the plans are equal: then only its light is to be checked),
+ * none does (no stratum of a is one of b's), or some (ask each photon). */
+typedef enum ps_source_match { PS_SOURCES_NONE, PS_SOURCES_SOME, PS_SOURCES_SAME } ps_source_match;
+ps_source_match ps_tracer_match_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total);
+/* The light photon i of map kind leaves (UINT32_MAX when the map is off). */
+uint32_t ps_tracer_photon_light(ps_tracer *t, ps_map_kind kind, uint64_t i, uint64_t total);
 
 /* How many of photons [0, total) light l emits for map kind (all its caustic cones
  * together): the tracer shares photons between lights in proportion to flux. */

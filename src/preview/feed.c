@@ -130,12 +130,24 @@ static ps_status hand_over(ps_feed *f, int k, ps_traced *traced, const uint64_t 
     return st;
 }
 
-/* The next PS_FEED_BATCH of map k's pending indices, retraced. */
+/* Map k's share of a round's PS_FEED_BATCH photons (of the largest cap):
+ * maps keep pace with each other, as in round_once. */
+static uint64_t batch_of(const ps_feed *f, int k)
+{
+    uint64_t biggest = 0;
+    for (int j = 0; j < PS_MAP_COUNT; j++)
+        if (f->active[j] && f->cap[j] > biggest)
+            biggest = f->cap[j];
+    double n = biggest ? (double)PS_FEED_BATCH * (double)f->cap[k] / (double)biggest : PS_FEED_BATCH;
+    return n < 1.0 ? 1 : (uint64_t)n;
+}
+
+/* The next batch of map k's pending indices, retraced. */
 static ps_status retrace_batch(ps_feed *f, int k, ps_error *err)
 {
     size_t from = f->pending_done[k], n = f->pending_count[k] - from;
-    if (n > PS_FEED_BATCH)
-        n = PS_FEED_BATCH;
+    if (n > batch_of(f, k))
+        n = (size_t)batch_of(f, k);
     const uint64_t *idx = f->pending[k] + from;
     ps_traced *traced;
     ps_status st = ps_tracer_trace_list(f->tracer, (ps_map_kind)k, idx, n, f->cap[k], f->maps[k].count, &traced,
@@ -421,6 +433,7 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep
         /* Keep in place: the kept photons move down over the others (both
          * in index order), the others' indices go to the pending list. */
         size_t at = 0, cap = 0, from = 0, to = 0;
+        uint64_t every = batch_of(f, k);
         for (uint64_t i = 0; i < end && st == PS_OK; i++) {
             bool pending = (rec[i].flags & REC_PENDING) != 0;
             size_t n = pending ? 0 : rec[i].stored;
@@ -438,6 +451,17 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep
                 f->pending[k][at++] = i;
             }
             from += n;
+            /* A mark every batch of indices: the kept photons of indices
+             * below i + 1 stand for all of them, so a refresh that draws only
+             * its budget draws a prefix of the kept ones, scaled right. */
+            if ((i + 1) % every == 0 && i + 1 < end) {
+                if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1)) {
+                    st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
+                    break;
+                }
+                ps_feed_mark mk = {to, i + 1};
+                f->marks[k][f->mark_count[k]++] = mk;
+            }
         }
         if (st != PS_OK)
             break;
@@ -453,7 +477,7 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep
         f->repair.kept[k] = end - at;
         f->repair.retraced[k] = at;
         f->repair.kept_photons[k] = to;
-        if (!PS_RESERVE(f->marks[k], f->mark_cap[k], 1)) {
+        if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1)) {
             st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
             break;
         }

@@ -55,13 +55,18 @@ typedef struct keep_ctx {
     ps_aabb *moved; /* old and new box of each moved object */
     size_t moved_count;
     ps_path_quant quant;
+    ps_source_match match[PS_MAP_COUNT];
 } keep_ctx;
 
 static bool keep(void *arg, ps_map_kind k, uint64_t i, const ps_path_store *paths, const ps_path_rec *rec)
 {
     keep_ctx *c = arg;
     uint32_t light;
-    if (!ps_tracer_same_source(c->old_tracer, c->new_tracer, k, i, c->cap[k], &light))
+    if (c->match[k] == PS_SOURCES_NONE)
+        return false;
+    if (c->match[k] == PS_SOURCES_SAME)
+        light = ps_tracer_photon_light(c->old_tracer, k, i, c->cap[k]);
+    else if (!ps_tracer_same_source(c->old_tracer, c->new_tracer, k, i, c->cap[k], &light))
         return false;
     if (light < c->light_count && c->light_changed[light])
         return false;
@@ -97,6 +102,7 @@ ps_status ps_repair_feed(ps_feed *old, ps_tracer *old_tracer, ps_tracer *new_tra
         if (ps_tracer_map_enabled(old_tracer, (ps_map_kind)k) != ps_tracer_map_enabled(new_tracer, (ps_map_kind)k))
             return PS_OK;
         c.cap[k] = ps_feed_cap(old, (ps_map_kind)k);
+        c.match[k] = ps_tracer_match_sources(old_tracer, new_tracer, (ps_map_kind)k, c.cap[k]);
     }
     c.light_changed = calloc(nl ? nl : 1, sizeof *c.light_changed);
     c.moved = malloc(2 * (no ? no : 1) * sizeof *c.moved);

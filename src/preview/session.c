@@ -47,7 +47,8 @@ struct ps_session {
      * box path records are quantised in, what the last edit kept. */
     ps_repair_state traced;
     ps_aabb record_box;
-    bool repaired;         /* the feed goes on from a repair: no first round to prime */
+    bool repaired;         /* the last update repaired the maps (else restarted them) */
+    bool skip_prime;       /* ... and every map kept photons: no first round to prime */
     uint64_t feed_gen;     /* the feed's generation the drawn prefixes belong to */
     ps_feed_repair_count repair;
 };
@@ -242,7 +243,7 @@ ps_status ps_session_start(ps_session *s, bool held, ps_error *err)
     s->started = true;
     /* After a repair the kept photons are the first picture: the thread
      * retraces the rest. */
-    ps_status st = s->repaired ? PS_OK : ps_feed_prime(s->feed, err);
+    ps_status st = s->skip_prime ? PS_OK : ps_feed_prime(s->feed, err);
     if (st != PS_OK)
         return st;
     s->first_pending = held;
@@ -641,7 +642,7 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
         st = build_lights(s, err);
     if (st == PS_OK)
         st = new_tracer(s, err);
-    s->repaired = false;
+    s->repaired = s->skip_prime = false;
     memset(&s->repair, 0, sizeof s->repair);
     if (st == PS_OK) {
         ps_feed *f = NULL;
@@ -650,6 +651,13 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
         if (st == PS_OK && s->repaired) {
             s->feed = f;
             s->repair = ps_feed_repair_counts(f);
+            /* A map that kept nothing gets its first retraced batch before the
+             * first picture, as after a restart; one that kept photons shows
+             * them at once. */
+            bool kept_all_maps = true;
+            for (int k = 0; k < PS_MAP_COUNT; k++)
+                kept_all_maps = kept_all_maps && (s->repair.kept_photons[k] > 0 || s->repair.retraced[k] == 0);
+            s->skip_prime = kept_all_maps;
             for (int k = 0; k < PS_MAP_COUNT; k++)
                 s->drawn[k] = 0, s->drawn_emitted[k] = 0;
             s->counter_stopped = false;
