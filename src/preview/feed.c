@@ -337,6 +337,14 @@ void ps_feed_destroy(ps_feed *f)
 
 /* ---- selective repair ----------------------------------------------------------- */
 
+static bool compact_paths(ps_path_store *p)
+{
+    size_t used = 0;
+    for (size_t i = 0; i < p->count; i++)
+        used += p->rec[i].vertices;
+    return 2 * used >= p->vcount || ps_path_store_compact(p);
+}
+
 /* Puts map k back in index order: the kept run and the retraced run
  * interleaved by index (pending indices have no photons), then the rest.
  * Under the feed's thread or with it stopped; takes the lock to swap. */
@@ -379,6 +387,8 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
     pthread_mutex_unlock(&f->lock);
     for (uint64_t i = 0; i < f->repair_end[k]; i++)
         f->paths[k].rec[i].flags &= (uint8_t)~REC_RETRACED;
+    if (!compact_paths(&f->paths[k]))
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for path records");
     f->kept_end[k] = m->count;
     f->repairing[k] = false;
     return PS_OK;
@@ -448,6 +458,8 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep
                 st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %zu photons", at);
             } else {
                 rec[i].flags = REC_PENDING;
+                rec[i].vertices = 0; /* its path is to be retraced: the old one is garbage */
+                rec[i].stored = 0;
                 f->pending[k][at++] = i;
             }
             from += n;
@@ -465,6 +477,13 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep
         }
         if (st != PS_OK)
             break;
+        /* Retraced paths append their vertices; the pool is rewritten once
+         * half of it is garbage, so it stays within twice what the records
+         * use (the soak's memory stays flat over hundreds of edits). */
+        if (!compact_paths(&f->paths[k])) {
+            st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for path records");
+            break;
+        }
         f->pending_count[k] = at;
         m->count = to;
         f->kept_end[k] = to;
