@@ -275,7 +275,7 @@ ps_status ps_feed_start(ps_feed *f, ps_error *err)
     return PS_OK;
 }
 
-void ps_feed_stop(ps_feed *f)
+static void stop_thread(ps_feed *f)
 {
     pthread_mutex_lock(&f->lock);
     f->stop = true;
@@ -284,6 +284,23 @@ void ps_feed_stop(ps_feed *f)
     if (f->started) {
         pthread_join(f->thread, NULL);
         f->started = false;
+    }
+}
+
+void ps_feed_stop(ps_feed *f)
+{
+    stop_thread(f);
+    /* Stopped during a repair: the maps in index order all the same (the
+     * photons not yet retraced are missing), as a dump must have them. */
+    if (f->status == PS_OK) {
+        ps_error err;
+        ps_status st = merge(f, &err);
+        if (st != PS_OK) {
+            pthread_mutex_lock(&f->lock);
+            f->status = st;
+            f->err = err;
+            pthread_mutex_unlock(&f->lock);
+        }
     }
 }
 
@@ -323,7 +340,7 @@ void ps_feed_destroy(ps_feed *f)
 {
     if (!f)
         return;
-    ps_feed_stop(f);
+    stop_thread(f);
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_photon_map_free(&f->maps[k]);
         free(f->marks[k]);
