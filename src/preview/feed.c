@@ -103,7 +103,17 @@ static ps_status hand_over(ps_feed *f, int k, ps_traced *traced, const uint64_t 
     ps_status st = PS_OK;
     if (f->records) {
         ps_error perr;
+        bool repairing = false;
+        for (int j = 0; j < PS_MAP_COUNT; j++)
+            repairing = repairing || f->repairing[j];
         if (ps_traced_join_paths(traced, &f->paths[k], idx, &perr) != PS_OK) {
+            if (repairing) {
+                /* A map in repair order needs its records to be put back in
+                 * order: this is out of memory like the photons. */
+                ps_traced_destroy(traced);
+                *err = perr;
+                return perr.status;
+            }
             /* No room for the records: go on without them (edits restart). */
             pthread_mutex_lock(&f->lock);
             f->records = false;
