@@ -646,9 +646,12 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
     memset(&s->repair, 0, sizeof s->repair);
     if (st == PS_OK) {
         ps_feed *f = NULL;
-        st = ps_repair_feed(old, old_tracer, s->tracer, &s->traced, s->scene, ps_world_epsilon(s->world), &f,
-                            &s->repaired, err);
-        if (st == PS_OK && s->repaired) {
+        ps_error rerr;
+        /* A repair that fails (out of memory) is a restart. */
+        if (ps_repair_feed(old, old_tracer, s->tracer, &s->traced, s->scene, ps_world_epsilon(s->world), &f,
+                           &s->repaired, &rerr) != PS_OK)
+            s->repaired = false;
+        if (s->repaired) {
             s->feed = f;
             s->repair = ps_feed_repair_counts(f);
             /* A map that kept nothing gets its first retraced batch before the
