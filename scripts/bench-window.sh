@@ -86,3 +86,55 @@ for layer in splats maps; do
             "$(($(stat_of emitted_caustic "$f") + $(stat_of emitted_global "$f")))"
     done
 done
+echo
+echo "| edits (2 light moves, 2 mirror moves of 10 cm) | first frame after an edit, mean s | max s | restart per edit (--repair off): mean s | max s |"
+echo "| ---: | ---: | ---: | ---: | ---: |"
+edit_lines=("1 move light 0 0.5 1.9 0" "2 move light 0 -0.5 1.9 0" "3 move object 6 0.1 0 0" "4 move object 6 -0.1 0 0" "5 quit")
+printf '%s\n' "${edit_lines[@]}" >"$tmp/edits.txt"
+for r in on off; do
+    xvfb-run -a -s "-screen 0 1024x768x24" bin/photosplat "$scene" --size 512x512 --exposure 0.3 --overlay off \
+        --caustic-photons 1000000 --global-photons 250000 --script "$tmp/edits.txt" --repair $r \
+        --stats "$tmp/edits-$r.json" >/dev/null
+done
+printf '| %s | %.3f | %.3f | %.3f | %.3f |\n' "$(stat_of edits "$tmp/edits-on.json")" \
+    "$(stat_of edit_to_frame_seconds_mean "$tmp/edits-on.json")" "$(stat_of edit_to_frame_seconds_max "$tmp/edits-on.json")" \
+    "$(stat_of edit_to_frame_seconds_mean "$tmp/edits-off.json")" "$(stat_of edit_to_frame_seconds_max "$tmp/edits-off.json")"
+
+# Photons kept per kind of edit once the maps are full (the default scene's
+# counts; the two-light test scene for what only a second light shows).
+echo
+echo "| scene | edit | caustic kept / retraced | global kept / retraced |"
+echo "| --- | --- | ---: | ---: |"
+kinds=("cornell-caustic|data/scenes/cornell-caustic.scn|move light 0  0.3 1.8 0"
+    "cornell-caustic|data/scenes/cornell-caustic.scn|move object 6  0.1 0 0"
+    "cornell-caustic|data/scenes/cornell-caustic.scn|move object 5  0 0 -0.1"
+    "cornell-caustic|data/scenes/cornell-caustic.scn|move object 2  0 0 0.125"
+    "cornell-caustic|data/scenes/cornell-caustic.scn|power light 0  50 50 50"
+    "two lights|tests/data/good/repair.scn|move light 1  -0.3 1.8 0.2"
+    "two lights|tests/data/good/repair.scn|angle light 1  25"
+    "two lights|tests/data/good/repair.scn|move object 6  0.1 0 0")
+for k in "${kinds[@]}"; do
+    IFS='|' read -r label sc act <<<"$k"
+    printf '0 wait done\n0 %s\n0 quit\n' "$act" >"$tmp/kind.txt"
+    bin/photosplat-snap "$sc" --script "$tmp/kind.txt" --size 64x64 --shadows off --tau 0.02 \
+        --stats "$tmp/kind.json" >/dev/null
+    printf '| %s | %s | %s / %s | %s / %s |\n' "$label" "$act" "$(stat_of repair_kept_caustic "$tmp/kind.json")" \
+        "$(stat_of repair_retraced_caustic "$tmp/kind.json")" "$(stat_of repair_kept_global "$tmp/kind.json")" \
+        "$(stat_of repair_retraced_global "$tmp/kind.json")"
+done
+
+# The mirror moved 10 cm once the maps are full: the first refreshed picture
+# against the converged picture of the edited scene, and the picture just
+# before the edit against the same, with the repair and with a restart.
+echo
+echo "| mirror moved 10 cm, maps full (snap, 256x256, float) | relMSE of the picture before the edit | relMSE of the first picture after | restart (--repair off): first picture after |"
+echo "| --- | ---: | ---: | ---: |"
+for r in on off; do
+    printf '%s\n' "0 wait done" "0 screenshot $tmp/before-$r.png" "0 move object 6  0.1 0 0" \
+        "0 screenshot $tmp/first-$r.png" "0 wait done" "0 screenshot $tmp/after-$r.png" >"$tmp/rel-$r.txt"
+    bin/photosplat-snap "$scene" --script "$tmp/rel-$r.txt" --repair $r --color-depth float --size 256x256 \
+        --exposure 0.3 >/dev/null
+done
+rel() { bin/photosplat-compare "$1" "$2" | sed -n 's/.*relmse=\([^ ]*\).*/\1/p'; }
+printf '| default caps (200000 + 50000) | %s | %s | %s |\n' "$(rel "$tmp/before-on.png" "$tmp/after-on.png")" \
+    "$(rel "$tmp/first-on.png" "$tmp/after-on.png")" "$(rel "$tmp/first-off.png" "$tmp/after-off.png")"

@@ -1,11 +1,17 @@
 #!/usr/bin/env bash
 # soak.sh: a long session of the preview window (make soak; minutes, not part
 # of make test). Runs bin/photosplat under Xvfb with a generated, seeded script
-# of random light and object moves inside the default scene's box, samples the
-# window's resident memory (VmRSS) while it runs, and checks that
-#   - memory stays flat: after the warm-up, the median RSS of the last third
-#     is within SOAK_RSS_SLACK_MIB (8) or SOAK_RSS_SLACK_PERCENT (5) of it,
-#     the larger, of the median of the first third;
+# of random light and object moves, light power changes and camera orbits
+# inside the default scene's box (each edit a selective repair of the maps,
+# preview/repair.h), samples the window's resident memory (VmRSS) while it
+# runs, and checks that
+#   - memory stays flat: after the warm-up, the growth the Theil-Sen slope of
+#     the whole RSS series gives over the session is within
+#     SOAK_RSS_SLACK_MIB (8) or SOAK_RSS_SLACK_PERCENT (5) of the start, the
+#     larger, or else not significant: under 3 standard errors of the slope
+#     (from the residuals' MAD), so that noise alone never fails a run and two
+#     runs in a row agree; the medians of the first and last thirds are
+#     printed too;
 #   - the picture stays right: every light and object is moved back at the end
 #     and, with every photon of both caps drawn ("wait done"), the window
 #     matches the screenshot taken the same way before the first move
@@ -71,6 +77,9 @@ script=$DIR/script.txt
 # object 6 the mirror sphere (-0.45 0.35 -0.4, radius 0.35). The light stays
 # above the spheres and inside the box; each sphere's offset from its start
 # stays in a box that keeps it inside the room and apart from the other one.
+# Every tenth action or so is a camera orbit (small yaw and pitch steps, the
+# pitch kept within +-30 degrees of the start, undone at the end) and some
+# change the light's power (back to 100 W at the end).
 awk -v seed="$SEED" -v moves="$MOVES" -v span="$SECONDS_" -v wait_every="$WAIT_EVERY" \
     -v shot_every="$SHOT_EVERY" -v dir="$DIR" '
 function uniform(lo, hi) { return lo + (hi - lo) * rand() }
@@ -86,7 +95,19 @@ BEGIN {
     printf "%.3f wait done\n%.3f screenshot %s/start.png\n", t, t, dir
     t = 1.0
     gap = span / moves
+    yaw = 0; pitch = 0
     for (i = 1; i <= moves; i++) {
+        if (rand() < 0.1) {
+            dy = r4(uniform(-15, 15)); dp = r4(uniform(-5, 5))
+            if (pitch + dp > 30 || pitch + dp < -30) dp = -dp
+            printf "%.3f orbit %.4f %.4f\n", t, dy, dp
+            yaw += dy; pitch += dp
+        }
+        if (rand() < 0.1) {
+            printf "%.3f power light 0 %.2f %.2f %.2f\n", t, uniform(50, 150), uniform(50, 150), uniform(50, 150)
+            powered = 1
+            edits++
+        }
         if (rand() < 0.6) {
             printf "%.3f move light 0 %.4f %.4f %.4f\n", t, uniform(-0.85, 0.85), uniform(1.2, 1.9), uniform(-0.85, 0.85)
         } else {
@@ -101,11 +122,16 @@ BEGIN {
     }
     # Everything back where it started, then the same picture as at the start.
     printf "%.3f move light 0 0 1.9 0\n", t
+    if (powered) { printf "%.3f power light 0 100 100 100\n", t; edits++ }
+    # The camera back: pitch first, then yaw, the reverse of how it went
+    # (the turntable orbit yaws about up, pitches about right).
+    printf "%.3f orbit 0 %.4f\n%.3f orbit %.4f 0\n", t, -pitch, t, -yaw
     for (k = 0; k < 2; k++)
         printf "%.3f move object %d %.4f %.4f %.4f\n", t, obj[k], -ox[k], -oy[k], -oz[k]
     printf "%.3f wait done\n%.3f screenshot %s/end.png\n%.3f quit\n", t + 0.1, t + 0.2, dir, t + 0.3
+    printf "%d\n", edits > (dir "/extra-edits.txt")
 }' >"$script"
-edits_expected=$((MOVES + 3))
+edits_expected=$((MOVES + 3 + $(cat "$DIR/extra-edits.txt")))
 
 # ---- the session, sampled ------------------------------------------------------
 pidfile=$DIR/window.pid
@@ -155,20 +181,26 @@ else
 fi
 
 # RSS: start, warm (first sample after the warm-up), end, max; the max of each
-# tenth. Flat means: after the warm-up, the median of the last third is within
-# the limit of the median of the first third. Medians, not maxima: llvmpipe's
-# and the allocator's transient peaks come and go by a few tens of MiB between
-# refreshes (docs/soak.md), while a leak raises every sample. The maxima and a
-# least-squares line through the samples are printed too, not judged (the line
-# tilts with a late peak in a short run). The last line the awk prints is the
-# verdict: OK, or FAIL and why.
+# tenth. Flat means: the Theil-Sen slope (the median of the slopes between
+# samples half the series apart, which a few transient peaks cannot move) of
+# the RSS after the warm-up, times the session's length, stays under the
+# limit, or is not significant (under 3 standard errors: the residuals'
+# MAD-scaled spread over sqrt(n) times the times' spread). llvmpipe's and the
+# allocator's peaks come and go by tens of MiB between refreshes
+# (docs/soak.md), while a leak raises the whole series. The medians of the
+# first and last thirds and a least-squares line are printed, not judged.
+# The last line the awk prints is the verdict: OK, or FAIL and why.
 awk -F'\t' -v wf="$WARMUP_FRACTION" -v wmin="$WARMUP_MIN_SECONDS" -v slack="$SLACK_MIB" -v pct="$SLACK_PERCENT" '
-    function median(lo, hi,    i, j, k, v, tmp) {
+    function sortv(v, k,    i, j, tmp) {
+        for (i = 2; i <= k; i++) { tmp = v[i]; for (j = i - 1; j >= 1 && v[j] > tmp; j--) v[j + 1] = v[j]; v[j + 1] = tmp }
+    }
+    function median(lo, hi,    i, k, v) {
         k = 0
         for (i = lo; i <= hi; i++) v[++k] = r[i]
-        for (i = 2; i <= k; i++) { tmp = v[i]; for (j = i - 1; j >= 1 && v[j] > tmp; j--) v[j + 1] = v[j]; v[j + 1] = tmp }
+        sortv(v, k)
         return k % 2 ? v[(k + 1) / 2] : (v[k / 2] + v[k / 2 + 1]) / 2
     }
+    function medianv(v, k) { sortv(v, k); return k % 2 ? v[(k + 1) / 2] : (v[k / 2] + v[k / 2 + 1]) / 2 }
     function maximum(lo, hi,    i, x) { x = 0; for (i = lo; i <= hi; i++) if (r[i] > x) x = r[i]; return x }
     { t[NR] = $1; r[NR] = $2 / 1024; hwm[NR] = $3 / 1024 }
     END {
@@ -183,15 +215,28 @@ awk -F'\t' -v wf="$WARMUP_FRACTION" -v wmin="$WARMUP_MIN_SECONDS" -v slack="$SLA
         printf "RSS MiB, max of each tenth of the session:"
         for (d = 0; d < 10; d++) printf " %.1f", maximum(1 + int(d * n / 10), int((d + 1) * n / 10))
         printf "\n"
+        # Theil-Sen over pairs half the series apart: m/2 slopes, O(m).
+        h = int(m / 2); k = 0
+        for (i = w; i + h <= n; i++) if (t[i + h] > t[i]) s_[++k] = (r[i + h] - r[i]) / (t[i + h] - t[i])
+        slope = medianv(s_, k)
+        for (i = w; i <= n; i++) tt[i - w + 1] = t[i]
+        tmed = medianv(tt, m)
+        for (i = w; i <= n; i++) rr[i - w + 1] = r[i] - slope * (t[i] - tmed)
+        icpt = medianv(rr, m)
+        for (i = w; i <= n; i++) { e = r[i] - (icpt + slope * (t[i] - tmed)); ad[i - w + 1] = e < 0 ? -e : e }
+        sigma = 1.4826 * medianv(ad, m)
+        st = 0; for (i = w; i <= n; i++) st += (t[i] - tmed) ^ 2
+        se = sigma / sqrt(st > 0 ? st : 1)
+        span = t[n] - t[w]
+        growth = slope * span; noise = 3 * se * span
         a = median(w, w + third - 1); b = median(n - third + 1, n)
+        limit = slack; if (a * pct / 100 > limit) limit = a * pct / 100
+        printf "RSS after the warm-up (%.0f s on): Theil-Sen slope %+.4f MiB/s, %+.1f MiB over %.0f s (limit %.1f; 3 standard errors %.1f MiB; residual spread %.1f MiB)\n", t[w], slope, growth, span, limit, noise, sigma
         sx = sy = sxx = sxy = 0
         for (i = w; i <= n; i++) { sx += t[i]; sy += r[i]; sxx += t[i] * t[i]; sxy += t[i] * r[i] }
-        slope = (m * sxy - sx * sy) / (m * sxx - sx * sx)
-        fit = slope * (t[n] - t[w])
-        limit = slack; if (a * pct / 100 > limit) limit = a * pct / 100
-        printf "RSS after the warm-up (%.0f s on): median of the first third %.1f MiB, of the last third %.1f MiB: %+.1f MiB (limit %.1f)\n", t[w], a, b, b - a, limit
-        printf "  not judged: max of the first third %.1f MiB, of the last third %.1f MiB (%+.1f); fitted line %+.1f MiB over %.0f s\n", maximum(w, w + third - 1), maximum(n - third + 1, n), maximum(n - third + 1, n) - maximum(w, w + third - 1), fit, t[n] - t[w]
-        if (b - a > limit) printf "FAIL memory grew: the median RSS rose %.1f MiB (limit %.1f MiB)\n", b - a, limit
+        ls = (m * sxy - sx * sy) / (m * sxx - sx * sx)
+        printf "  not judged: median of the first third %.1f MiB, of the last third %.1f MiB (%+.1f); least-squares line %+.1f MiB\n", a, b, b - a, ls * span
+        if (growth > limit && growth > noise) printf "FAIL memory grew: %+.1f MiB over the session by the Theil-Sen slope (limit %.1f MiB, noise %.1f MiB)\n", growth, limit, noise
         else print "OK"
     }' "$rss" >"$DIR/rss-summary.txt"
 sed '$d' "$DIR/rss-summary.txt"

@@ -339,6 +339,27 @@ static void wait_done(void **state)
     ps_script_destroy(s);
 }
 
+/* dump photons and save scene: their paths, in time order with the rest. */
+static void dump_and_save(void **state)
+{
+    (void)state;
+    ps_script *s = parse_ok("2 save scene out/e.scn\n"
+                            "1 dump photons out/p.txt # the maps\n"
+                            "1 wait done\n");
+    assert_int_equal(ps_script_count(s), 3);
+    const ps_script_action *a = ps_script_at(s, 0);
+    assert_int_equal(a->kind, PS_SCRIPT_DUMP_PHOTONS);
+    assert_string_equal(a->path, "out/p.txt");
+    assert_int_equal(a->line, 2);
+    assert_rest_zero(a, true, false, false, false, false, false, false);
+    assert_int_equal(ps_script_at(s, 1)->kind, PS_SCRIPT_WAIT);
+    a = ps_script_at(s, 2);
+    assert_int_equal(a->kind, PS_SCRIPT_SAVE_SCENE);
+    assert_string_equal(a->path, "out/e.scn");
+    assert_near(a->time, 2.0, 0.0);
+    ps_script_destroy(s);
+}
+
 static void empty_scripts(void **state)
 {
     (void)state;
@@ -378,6 +399,11 @@ static const bad_case BAD[] = {
     {"0 screenshot\n", PS_ERR_PARSE, "s.txt:1: screenshot: expected 1 path (without spaces)"},
     {"0 screenshot my shot.png\n", PS_ERR_PARSE, "s.txt:1: screenshot: expected 1 path (without spaces)"},
     {"0 screenshot # no path\n", PS_ERR_PARSE, "s.txt:1: screenshot: expected 1 path (without spaces)"},
+    {"0 dump photons\n", PS_ERR_PARSE, "s.txt:1: dump photons: expected 1 path (without spaces)"},
+    {"0 dump photons a b\n", PS_ERR_PARSE, "s.txt:1: dump photons: expected 1 path (without spaces)"},
+    {"0 dump scene a.txt\n", PS_ERR_PARSE, "s.txt:1: dump: expected 'dump photons PATH'"},
+    {"0 save photons a.scn\n", PS_ERR_PARSE, "s.txt:1: save: expected 'save scene PATH'"},
+    {"0 save\n", PS_ERR_PARSE, "s.txt:1: save: expected 'save scene PATH'"},
     /* times */
     {"0 quit\n1 quit\n\n# c\n-1 quit\n", PS_ERR_PARSE, "s.txt:5: time '-1' must be a number >= 0"},
     {"1.5x quit\n", PS_ERR_PARSE, "s.txt:1: time '1.5x' must be a number >= 0"},
@@ -623,6 +649,7 @@ int main(void)
         cmocka_unit_test(sorted_by_time_stable),
         cmocka_unit_test(comments_and_blank_lines),
         cmocka_unit_test(wait_done),
+        cmocka_unit_test(dump_and_save),
         cmocka_unit_test(empty_scripts),
         cmocka_unit_test(malformed_inputs),
         cmocka_unit_test(limits),

@@ -261,6 +261,7 @@ static void edits_restart_the_maps(void **state)
     (void)state;
     ps_scene *scene = load();
     ps_session_settings set = settings(scene, false);
+    set.repair = false; /* the restart; test_repair checks the selective repair */
     ps_session *s = open_session(scene, &set);
     ps_error err;
     assert_int_equal(ps_session_trace_all(s, &err), PS_OK);

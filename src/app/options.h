@@ -10,6 +10,7 @@
 #include "core/clock.h"
 #include "core/status.h"
 #include "image/image.h"
+#include "photon/path_record.h"
 #include "photon/tracer.h"
 #include "preview/session.h"
 
@@ -92,10 +93,11 @@ ps_status ps_check_outputs(const ps_shared_options *o, ps_error *err);
  * may store more, which the tracer's cap (ps_photon_cap) catches as it grows. */
 #define PS_PHOTON_PLAN_BYTES (2 * PS_PHOTON_MAP_BYTES + sizeof(ps_photon) + sizeof(uint32_t))
 
-/* A photon of the preview (snap, window): its map entry and its splat
+/* A photon of the preview (snap, window): its map entry, its splat
  * geometry (triangles: 3 vertices of position, colour and texture coordinate
- * floats, the largest splat mode). */
-#define PS_PREVIEW_PHOTON_BYTES (PS_PHOTON_PLAN_BYTES + 3 * (3 + 4 + 2) * sizeof(float))
+ * floats, the largest splat mode) and its path record for the selective
+ * repair after edits (photon/path_record.h). */
+#define PS_PREVIEW_PHOTON_BYTES (PS_PHOTON_PLAN_BYTES + 3 * (3 + 4 + 2) * sizeof(float) + PS_PATH_PLAN_BYTES)
 /* The preview holds both maps at once. */
 #define PS_PREVIEW_MAPS 2
 

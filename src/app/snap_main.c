@@ -3,6 +3,7 @@
  * libGL, src/gl/platform_osmesa.c), one snapshot written as PNG and/or PFM.
  * The same frame the window shows, for tests and benchmarks. */
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +17,7 @@
 #include "gl/gl_render.h"
 #include "image/exr_io.h"
 #include "gl/platform.h"
+#include "preview/script.h"
 #include "preview/session.h"
 #include "scene/scene.h"
 
@@ -68,6 +70,11 @@ static const char usage[] =
     "                           P-I.pfm, P-I-direct.pfm ... and a row of P.csv\n"
     "                           (the writing is not counted in the seconds)\n"
     "  --checkpoint-prefix P    where checkpoints go (needed with --checkpoints)\n"
+    "  --script FILE            a headless session: the window's script actions (see the\n"
+    "                           README) on snap's own clock, progressive; the snapshot\n"
+    "                           is written when the script ends (quit, or its last action)\n"
+    "  --repair on|off          a script's edits keep the photons they cannot change\n"
+    "                           (default on; off: every edit restarts both maps)\n"
     "  --help                   this text\n";
 
 /* Progressive float refreshes may give this share of tau to new splats:
@@ -87,6 +94,9 @@ typedef struct snap_options {
     double checkpoints[SNAP_MAX_CHECKPOINTS]; /* ascending */
     int checkpoint_count;
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM */
+    const char *script_path;      /* --script */
+    int no_repair;                /* --repair off: a script's edits restart the maps */
+    ps_script *script;
 } snap_options;
 
 /* The memory plan (ps_check_run_memory): a pixel, besides the colour buffer,
@@ -118,6 +128,11 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
             st = ps_cli_string(&cli, &o->hdr_layers, err);
         } else if (ps_cli_is(&cli, "--checkpoint-prefix")) {
             st = ps_cli_string(&cli, &o->checkpoint_prefix, err);
+        } else if (ps_cli_is(&cli, "--script")) {
+            st = ps_cli_string(&cli, &o->script_path, err);
+        } else if (ps_cli_is(&cli, "--repair")) {
+            static const char *const on_off[] = {"on", "off", NULL};
+            st = ps_cli_choice(&cli, on_off, &o->no_repair, err);
         } else if (ps_cli_is(&cli, "--checkpoints")) {
             st = ps_cli_ascending(&cli, 1e-3, 1e6, o->checkpoints, SNAP_MAX_CHECKPOINTS, &o->checkpoint_count, err);
         } else {
@@ -128,7 +143,8 @@ static ps_status parse_args(int argc, char **argv, snap_options *o, bool *help, 
         return st;
     if (!o->c.scene)
         return ps_error_set(err, PS_ERR_PARSE, "photosplat-snap: no scene given (see --help)");
-    if (!o->c.out_png && !o->c.out_hdr && !o->hdr_layers && !o->checkpoint_prefix && !o->out_lux && !o->out_false)
+    if (!o->c.out_png && !o->c.out_hdr && !o->hdr_layers && !o->checkpoint_prefix && !o->out_lux && !o->out_false &&
+        !o->script_path && !o->c.dump)
         return ps_error_set(err, PS_ERR_PARSE,
                             "photosplat-snap: nothing to write: give -o FILE.png, --hdr FILE.pfm, --illuminance "
                             "FILE.pfm or --false-color FILE.png");
@@ -153,8 +169,12 @@ typedef struct snap_run {
      * colour buffer (8 bits, or a fixed photon count). */
     ps_gl_layers *layers;
     ps_camera_frame cam;
+    ps_camera camera;       /* what cam is made of (a script orbits it) */
     ps_session_frame frame; /* the last refresh's */
     uint64_t frames, splats; /* refreshes; splats drawn in all (layers) */
+    /* --script: edits applied, and over them the photon indices the repairs
+     * kept and retraced, per map (repair.h). */
+    uint64_t updates, repairs, kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
     double draw_seconds;
 } snap_run;
 
@@ -461,6 +481,208 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
     return st;
 }
 
+/* ---- --script: a headless session --------------------------------------------- */
+
+/* Rotates v about unit axis k by angle (Rodrigues). */
+static ps_vec3 rotate(ps_vec3 v, ps_vec3 k, double angle)
+{
+    double c = cos(angle), sn = sin(angle);
+    return ps_v3_add(ps_v3_add(ps_v3_scale(v, c), ps_v3_scale(ps_v3_cross(k, v), sn)),
+                     ps_v3_scale(k, ps_v3_dot(k, v) * (1.0 - c)));
+}
+
+/* The window's turntable orbit (window_main.c): yaw about up, pitch about
+ * right, never over the pole. */
+static void orbit(snap_run *s, double yaw_deg, double pitch_deg)
+{
+    ps_camera *cam = &s->camera;
+    ps_vec3 up = ps_v3_norm(cam->up);
+    ps_vec3 v = rotate(ps_v3_sub(cam->eye, cam->target), up, -yaw_deg * PS_PI / 180.0);
+    double r = ps_v3_len(v);
+    double elevation = asin(fmax(-1.0, fmin(1.0, ps_v3_dot(v, up) / r))) * 180.0 / PS_PI;
+    double want = fmax(-89.0, fmin(89.0, elevation + pitch_deg));
+    ps_vec3 right = ps_v3_norm(ps_v3_cross(v, up));
+    v = rotate(v, right, -(want - elevation) * PS_PI / 180.0);
+    cam->eye = ps_v3_add(cam->target, v);
+    s->cam = ps_camera_frame_make(cam, s->cam.width, s->cam.height);
+}
+
+/* The maps as they stand, as --dump-photons writes them. */
+static ps_status dump_photons(snap_run *s, const char *path, ps_error *err)
+{
+    const ps_photon_map *maps = ps_session_lock_maps(s->session);
+    ps_status st = ps_write_photon_dump(path, maps, err);
+    ps_session_unlock_maps(s->session);
+    return st;
+}
+
+static ps_status script_index(const snap_run *s, const ps_script_action *act, size_t n, const char *things,
+                              ps_error *err)
+{
+    if (act->index < n)
+        return PS_OK;
+    return ps_error_set(err, PS_ERR_RANGE, "%s:%d: %s %u: the scene has %zu %s", s->o->script_path, act->line,
+                        things, act->index, n, things);
+}
+
+/* One action, as the window runs it (window_main.c, run_action). */
+static ps_status script_action(snap_run *s, const ps_script_action *act, bool *wait, bool *quit, ps_error *err)
+{
+    ps_session *ss = s->session;
+    size_t nl, no;
+    (void)ps_scene_lights(ps_session_scene(ss), &nl);
+    (void)ps_scene_objects(ps_session_scene(ss), &no);
+    ps_status st = PS_OK;
+    switch (act->kind) {
+    case PS_SCRIPT_SCREENSHOT: {
+        ps_image img;
+        st = read_picture(s, true, every_map, &img, err);
+        if (st == PS_OK)
+            st = ps_png_write(&img, act->path, 1.0f, err);
+        ps_image_destroy(&img);
+        return st;
+    }
+    case PS_SCRIPT_MOVE_LIGHT:
+        return script_index(s, act, nl, "lights", err) != PS_OK ? err->status
+                                                                : ps_session_move_light(ss, act->index, act->v, err);
+    case PS_SCRIPT_MOVE_OBJECT:
+        return script_index(s, act, no, "objects", err) != PS_OK ? err->status
+                                                                 : ps_session_move_object(ss, act->index, act->v, err);
+    case PS_SCRIPT_POWER:
+        return script_index(s, act, nl, "lights", err) != PS_OK
+                   ? err->status
+                   : ps_session_set_light_power(ss, act->index, act->power, err);
+    case PS_SCRIPT_ANGLE:
+        return script_index(s, act, nl, "lights", err) != PS_OK
+                   ? err->status
+                   : ps_session_set_spot_angle(ss, act->index, act->number, err);
+    case PS_SCRIPT_ORBIT: orbit(s, act->yaw, act->pitch); return PS_OK;
+    case PS_SCRIPT_WAIT: *wait = true; return PS_OK;
+    case PS_SCRIPT_QUIT: *quit = true; return PS_OK;
+    case PS_SCRIPT_DUMP_PHOTONS: return dump_photons(s, act->path, err);
+    case PS_SCRIPT_SAVE_SCENE: return ps_scene_write(ps_session_scene(ss), act->path, err);
+    case PS_SCRIPT_SET:
+        switch (act->setting) {
+        case PS_SET_SPLAT: ps_session_set_splat(ss, (ps_splat_mode)act->choice); return PS_OK;
+        case PS_SET_LAYERS: ps_session_set_layers(ss, act->layers); return PS_OK;
+        case PS_SET_KERNEL:
+            st = ps_session_set_kernel(ss, (ps_kernel)act->choice, err);
+            if (st == PS_OK)
+                ps_gl_renderer_set_kernel(s->gl, ps_session_kernel(ss));
+            return st;
+        case PS_SET_RADIUS:
+            ps_session_set_radius(ss, PS_MAP_CAUSTIC, act->number);
+            ps_session_set_radius(ss, PS_MAP_GLOBAL, act->number2);
+            return PS_OK;
+        case PS_SET_TAU: ps_session_set_tau(ss, act->number); return PS_OK;
+        case PS_SET_PRECISION: ps_session_set_precision(ss, (ps_precision)act->choice); return PS_OK;
+        case PS_SET_EXPOSURE: ps_session_set_exposure(ss, act->number); return PS_OK;
+        case PS_SET_PAUSE: ps_session_set_paused(ss, act->choice != 0); return PS_OK;
+        case PS_SET_FALSE_COLOR:
+            return ps_error_set(err, PS_ERR_PARSE, "%s:%d: set false-color: the window's view (snap: --false-color)",
+                                s->o->script_path, act->line);
+        case PS_SET_GLOBAL_LAYER: return ps_session_set_global_layer(ss, (ps_global_layer)act->choice, err);
+        }
+        return PS_OK;
+    }
+    return PS_OK;
+}
+
+/* Edits made since the last refresh: the session repairs the maps, the
+ * renderer follows its meshes and lights. */
+static ps_status apply_edits(snap_run *s, ps_error *err)
+{
+    ps_session_changes ch;
+    ps_status st = ps_session_update(s->session, &ch, err);
+    if (st == PS_OK) {
+        ps_gl_scene gs = ps_gl_scene_of(s->session);
+        st = ps_gl_renderer_set_scene(s->gl, &gs, err);
+    }
+    bool repaired;
+    uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
+    ps_session_repair_counts(s->session, &repaired, kept, retraced);
+    s->updates++;
+    s->repairs += repaired ? 1 : 0;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        s->kept[k] += kept[k], s->retraced[k] += retraced[k];
+    return st;
+}
+
+/* The script on snap's clock: a refresh every tau, each action when its time
+ * (counted from the first frame, and after a wait done from when it ended)
+ * has come; ends at quit or after the last action (or at --time). */
+static ps_status run_script(snap_run *s, double t_start, double *first_frame, ps_error *err)
+{
+    const snap_options *o = s->o;
+    ps_status st = ps_session_start(s->session, true, err);
+    size_t next = 0, count = ps_script_count(o->script);
+    bool waiting = false, quit = false;
+    double t0 = -1.0, delay = 0.0, wait_time = 0.0;
+    while (st == PS_OK && !quit) {
+        if (ps_cancelled(o->cancel)) {
+            st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.1f s", ps_now_seconds() - t_start);
+            break;
+        }
+        if (ps_session_edited(s->session))
+            st = apply_edits(s, err);
+        if (st == PS_OK)
+            st = refresh(s, err);
+        if (st != PS_OK)
+            break;
+        double now = ps_now_seconds();
+        if (t0 < 0.0) {
+            t0 = now;
+            *first_frame = now - t_start;
+        }
+        while (st == PS_OK && !quit && next < count) {
+            const ps_script_action *act = ps_script_at(o->script, next);
+            if (waiting) {
+                if (ps_session_edited(s->session) || !ps_session_settled(s->session))
+                    break;
+                waiting = false;
+                delay = now - t0 - wait_time;
+            }
+            if (act->time + delay > now - t0)
+                break;
+            next++;
+            bool w = false;
+            /* Files written are off the clock: tracing is held meanwhile. */
+            ps_session_hold(s->session, true);
+            st = script_action(s, act, &w, &quit, err);
+            ps_session_hold(s->session, false);
+            if (w) {
+                waiting = true;
+                wait_time = act->time;
+            }
+            /* An edit, a setting or an orbit shows at the next refresh. */
+            if (act->kind != PS_SCRIPT_SCREENSHOT && act->kind != PS_SCRIPT_DUMP_PHOTONS &&
+                act->kind != PS_SCRIPT_SAVE_SCENE && act->kind != PS_SCRIPT_QUIT)
+                break;
+        }
+        if (st != PS_OK || quit || (next >= count && !waiting))
+            break;
+        if (o->time > 0.0 && now - t_start >= o->time)
+            break;
+        double due = now + o->p.tau;
+        if (!waiting && next < count) {
+            double at = t0 + delay + ps_script_at(o->script, next)->time;
+            due = fmin(due, fmax(at, now));
+        }
+        if (ps_session_settled(s->session) && waiting)
+            due = now;
+        sleep_until(due);
+    }
+    ps_status stop = ps_session_stop(s->session, st == PS_OK ? err : NULL);
+    if (st == PS_OK)
+        st = stop;
+    ps_session_full_lights(s->session);
+    if (st == PS_OK)
+        st = refresh(s, err);
+    while (st == PS_OK && s->layers && !ps_session_settled(s->session))
+        st = refresh(s, err);
+    return st;
+}
+
 static ps_status write_stats_and_report(snap_run *s, int width, int height, double t_start, double first_frame,
                                         ps_error *err)
 {
@@ -503,6 +725,18 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
     ps_stats_add(&rs, "radius_progressive", o->p.radius_schedule == PS_RADIUS_PROGRESSIVE ? 1.0 : 0.0);
     ps_stats_add(&rs, "global_maps", o->p.global_layer == PS_GLOBAL_MAPS ? 1.0 : 0.0);
     ps_stats_add(&rs, "luminous_flux_lm", ps_scene_total_lumens(ps_session_scene(s->session)));
+    if (o->script) {
+        ps_stats_add(&rs, "edits_applied", (double)s->updates);
+        ps_stats_add(&rs, "repairs", (double)s->repairs);
+        ps_stats_add(&rs, "repair_kept_caustic", (double)s->kept[PS_MAP_CAUSTIC]);
+        ps_stats_add(&rs, "repair_kept_global", (double)s->kept[PS_MAP_GLOBAL]);
+        ps_stats_add(&rs, "repair_retraced_caustic", (double)s->retraced[PS_MAP_CAUSTIC]);
+        ps_stats_add(&rs, "repair_retraced_global", (double)s->retraced[PS_MAP_GLOBAL]);
+        printf("script: %llu updates, %llu repaired; photons kept/retraced: caustic %llu/%llu, global %llu/%llu\n",
+               (unsigned long long)s->updates, (unsigned long long)s->repairs,
+               (unsigned long long)s->kept[PS_MAP_CAUSTIC], (unsigned long long)s->retraced[PS_MAP_CAUSTIC],
+               (unsigned long long)s->kept[PS_MAP_GLOBAL], (unsigned long long)s->retraced[PS_MAP_GLOBAL]);
+    }
     if (o->c.stats) {
         ps_status st = ps_stats_write(o->c.stats, &rs, err);
         if (st != PS_OK)
@@ -530,17 +764,21 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
     memset(&s, 0, sizeof s);
     s.o = o;
     s.platform = platform;
-    s.cam = ps_camera_frame_make(ps_scene_camera(scene), width, height);
+    s.camera = *ps_scene_camera(scene);
+    s.cam = ps_camera_frame_make(&s.camera, width, height);
     ps_session_settings set = ps_preview_settings(&o->c, &o->p, scene);
     set.skip_hidden = true; /* a layer left out is not traced */
     set.cancel = o->cancel;
     /* Progressive in float: only new photons each refresh, so that a refresh
      * (and a checkpoint) comes when it is due however many have arrived. */
-    set.incremental = o->time > 0.0 && set.float_buffer;
+    bool progressive = o->time > 0.0 || o->script;
+    set.incremental = progressive && set.float_buffer;
+    /* Only a script edits: path records for the selective repair then. */
+    set.repair = o->script != NULL && !o->no_repair;
     set.splat_share = SNAP_SPLAT_SHARE;
     /* Progressive: the first picture without waiting for every area light's
      * 16 shadow cubes; a fixed photon count draws once, with all of them. */
-    set.progressive_lights = o->time > 0.0;
+    set.progressive_lights = progressive;
     ps_status st = ps_session_create(scene, &set, &s.session, err);
     ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0};
     if (st == PS_OK) {
@@ -550,7 +788,9 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
     if (st == PS_OK && set.incremental)
         st = ps_gl_layers_create(width, height, true, &s.layers, err);
     double t_start = ps_now_seconds(), first_frame = -1.0;
-    if (st == PS_OK && o->time <= 0.0) {
+    if (st == PS_OK && o->script) {
+        st = run_script(&s, t_start, &first_frame, err);
+    } else if (st == PS_OK && o->time <= 0.0) {
         /* A fixed photon count: trace everything, then draw once. */
         st = ps_session_trace_all(s.session, err);
         if (st == PS_OK)
@@ -559,7 +799,7 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
     } else if (st == PS_OK) {
         st = refine(&s, t_start, &first_frame, err);
     }
-    if (st == PS_OK && ps_cancelled(o->cancel) && o->time > 0.0)
+    if (st == PS_OK && ps_cancelled(o->cancel) && (o->time > 0.0 || o->script))
         st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.1f s of %.1f s", ps_now_seconds() - t_start,
                           o->time);
     else if (st == PS_OK && ps_cancelled(o->cancel))
@@ -610,14 +850,27 @@ int main(int argc, char **argv)
         fputs(usage, stdout);
         return PS_EXIT_OK;
     }
+    if (o.script_path && ps_script_load(o.script_path, &o.script, &err) != PS_OK)
+        return ps_cli_fail(&err);
+    for (size_t i = 0; o.script && i < ps_script_count(o.script); i++) {
+        const ps_script_action *act = ps_script_at(o.script, i);
+        if (act->path && ps_check_output_path(act->path, &err) != PS_OK) {
+            ps_script_destroy(o.script);
+            return ps_cli_fail(&err);
+        }
+    }
     if (ps_check_outputs(&o.c, &err) != PS_OK || check_prefixed_outputs(&o, &err) != PS_OK ||
         (o.out_lux && ps_check_output_path(o.out_lux, &err) != PS_OK) ||
-        (o.out_false && ps_check_output_path(o.out_false, &err) != PS_OK))
+        (o.out_false && ps_check_output_path(o.out_false, &err) != PS_OK)) {
+        ps_script_destroy(o.script);
         return ps_cli_fail(&err);
+    }
     o.cancel = ps_interrupt_install();
     ps_scene *scene;
-    if (ps_scene_load(o.c.scene, NULL, &scene, &err) != PS_OK)
+    if (ps_scene_load(o.c.scene, NULL, &scene, &err) != PS_OK) {
+        ps_script_destroy(o.script);
         return ps_cli_fail(&err);
+    }
     const ps_scene_defaults *def = ps_scene_get_defaults(scene);
     int width = o.c.width ? o.c.width : def->width, height = o.c.height ? o.c.height : def->height;
     /* Refuse what would not fit before the buffer or a photon. */
@@ -626,6 +879,7 @@ int main(int argc, char **argv)
     if (ps_check_run_memory("photosplat-snap", photons, PS_PREVIEW_PHOTON_BYTES, width, height, pixel_bytes, &err) !=
         PS_OK) {
         ps_scene_destroy(scene);
+        ps_script_destroy(o.script);
         return ps_cli_fail(&err);
     }
     ps_platform_config pc = {width, height, o.p.color_depth != 0, NULL};
@@ -640,6 +894,7 @@ int main(int argc, char **argv)
     }
     ps_platform_close(platform);
     ps_scene_destroy(scene);
+    ps_script_destroy(o.script);
     if (st == PS_ERR_INTERRUPTED)
         return ps_interrupt_fail("photosplat-snap", &err);
     return st == PS_OK ? PS_EXIT_OK : ps_cli_fail(&err);

@@ -73,7 +73,7 @@ static const char usage[] =
     "  --size WxH               window size (default from the scene)\n"
     "  --exposure E             radiance multiplier before display (default 1)\n"
     "  --caustic-photons N      caustic photon cap: traced, then refining stops (default from the scene)\n"
-    "  --global-photons N       global photon cap likewise; each edit restarts both maps\n"
+    "  --global-photons N       global photon cap likewise; edits repair both maps (--repair)\n"
     "  --max-photons N          memory cap: stop once the maps store N photons (default 2^25, 0: none)\n"
     "  --caustic-radius R       caustic splat radius, scene units\n"
     "  --global-radius R        global splat radius, scene units\n"
@@ -101,6 +101,8 @@ static const char usage[] =
     "  --autosave on|off        write every edit within a second to\n"
     "                           NAME.autosave.scn (default on; off with --script,\n"
     "                           whose sessions are tests and demos)\n"
+    "  --repair on|off          edits keep the photons they cannot change (default on;\n"
+    "                           off: every edit restarts both maps, as before)\n"
     "  --composite gl|cpu       where the picture is encoded for display: by GL (default),\n"
     "                           or read back and encoded on the CPU (the old way, for\n"
     "                           scripts/bench-window.sh to compare)\n"
@@ -136,6 +138,7 @@ typedef struct win_options {
     const char *script;
     int overlay;
     int autosave; /* 1 on, 0 off, -1 unset: on unless scripted */
+    int no_repair; /* --repair off: every edit restarts the maps (the bench's baseline) */
     int64_t max_photons; /* stored photons of both maps; 0: no bound */
     int composite;       /* 1: on the GL side (the default); 0: read back and encoded on the CPU */
     const ps_cancel_flag *cancel; /* raised by SIGINT or SIGTERM: the session ends */
@@ -232,6 +235,9 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
             st = ps_cli_choice(&cli, on_off, &o->overlay, err);
         } else if (ps_cli_is(&cli, "--autosave")) {
             st = ps_cli_choice(&cli, on_off, &o->autosave, err);
+        } else if (ps_cli_is(&cli, "--repair")) {
+            st = ps_cli_choice(&cli, on_off, &o->no_repair, err);
+            o->no_repair = !o->no_repair;
         } else if (ps_cli_is(&cli, "--composite")) {
             static const char *const where[] = {"cpu", "gl", NULL};
             st = ps_cli_choice(&cli, where, &o->composite, err);
@@ -264,6 +270,7 @@ static ps_status open_session(app *a, ps_error *err)
     set.incremental = true;
     set.shadow_size = a->o.p.shadows ? WIN_SHADOW_SIZE : 0;
     set.progressive_lights = true; /* the first picture (and the first after an edit) sooner */
+    set.repair = !a->o.no_repair;
     ps_status st = ps_session_create(a->scene, &set, &a->session, err);
     ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE};
     if (st == PS_OK) {
@@ -882,6 +889,14 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
     case PS_SCRIPT_QUIT:
         a->quit = true;
         return PS_OK;
+    case PS_SCRIPT_DUMP_PHOTONS: {
+        const ps_photon_map *maps = ps_session_lock_maps(s);
+        ps_status st = ps_write_photon_dump(act->path, maps, err);
+        ps_session_unlock_maps(s);
+        return st;
+    }
+    case PS_SCRIPT_SAVE_SCENE:
+        return ps_scene_write(ps_session_scene(s), act->path, err);
     case PS_SCRIPT_SET:
         a->redraw = true;
         switch (act->setting) {
@@ -992,13 +1007,15 @@ static ps_status session(app *a, ps_error *err)
         if (st != PS_OK || a->quit)
             break;
         if (ps_session_edited(a->session)) {
-            /* Every edit restarts the maps (thesis 4.1.4); the first refresh
-             * follows at once, with whatever the first batch brings. */
+            /* The maps keep what the edits cannot change and retrace the rest
+             * (preview/repair.h); the first refresh follows at once. Edits
+             * that came since the last refresh (a drag's mouse events) are
+             * applied together. The latency counts the repair. */
+            a->edit_time = ps_now_seconds();
             ps_work_before_update(&a->work, ps_session_scene(a->session));
             st = apply_edits(a, err);
             if (st == PS_OK)
                 st = ps_work_after_update(&a->work, ps_session_scene(a->session), ps_now_seconds(), err);
-            a->edit_time = ps_now_seconds();
             a->awaiting_edit_frame = true;
             next = 0.0;
             if (st != PS_OK)
@@ -1094,7 +1111,7 @@ int main(int argc, char **argv)
     ps_status st = ps_check_outputs(&a.o.c, &err);
     for (size_t i = 0; st == PS_OK && a.script && i < ps_script_count(a.script); i++) {
         const ps_script_action *act = ps_script_at(a.script, i);
-        if (act->kind == PS_SCRIPT_SCREENSHOT)
+        if (act->path)
             st = ps_check_output_path(act->path, &err);
     }
     if (st == PS_OK)

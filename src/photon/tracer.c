@@ -54,6 +54,7 @@ struct ps_tracer {
     map_plan plans[PS_MAP_COUNT];
     ps_skip *skips;
     size_t skip_count, skip_cap;
+    ps_path_quant quant; /* records: the vertices' quantisation */
 };
 
 ps_tracer_options ps_tracer_default_options(void)
@@ -257,6 +258,7 @@ ps_status ps_tracer_create(const ps_world *w, const ps_tracer_options *opt, ps_t
     size_t nm;
     t->materials = ps_scene_materials(s, &nm);
     t->opt = opt ? *opt : ps_tracer_default_options();
+    t->quant = ps_path_quant_make(t->opt.record_box, ps_world_epsilon(w));
     t->threads = t->opt.threads > 0 ? (t->opt.threads < PS_TRACER_MAX_THREADS ? t->opt.threads : PS_TRACER_MAX_THREADS)
                                     : ps_online_cores();
     ps_status st = ps_light_sampler_create(s, &t->lights, err);
@@ -383,8 +385,15 @@ uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light,
  * joined to the map: a photon map of its own. */
 typedef struct chunk_out {
     ps_photon_map map;
+    ps_path_store paths; /* records: one per emitted photon of the chunk */
     bool failed;
 } chunk_out;
+
+static void vertex(const ps_tracer *t, chunk_out *out, ps_vec3 p)
+{
+    if (t->opt.records)
+        ps_path_add_vertex(&out->paths, ps_path_quantize(&t->quant, p));
+}
 
 static void store(chunk_out *out, const ps_surface *sp, ps_rgb power, ps_vec3 d, ps_vec3 n, double dither)
 {
@@ -396,7 +405,7 @@ static void store(chunk_out *out, const ps_surface *sp, ps_rgb power, ps_vec3 d,
     out->map.counters.stored++;
 }
 
-static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk_out *out)
+static void trace_path(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk_out *out)
 {
     const map_plan *plan = &t->plans[kind];
     const ps_world *w = t->world;
@@ -420,6 +429,7 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
     ps_ray ray = e.ray;
     if (ps_v3_len2(e.normal) > 0.0) /* leave an emitting surface (mesh lights are geometry too) */
         ray.o = ps_v3_madd(ray.o, e.normal, ps_world_epsilon(w));
+    vertex(t, out, ray.o);
     ps_rng rng = ps_rng_make(t->opt.seed, plan->stream, i);
     bool diffuse_seen = false;
 
@@ -431,9 +441,12 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
         ps_surface sp;
         c->rays++;
         if (!ps_world_intersect(w, ray, INFINITY, &sp)) {
+            if (t->opt.records)
+                vertex(t, out, ps_path_exit(&t->quant, ray.o, ray.d));
             c->escaped++;
             return;
         }
+        vertex(t, out, sp.p);
         ps_material textured;
         const ps_material *m = ps_surface_material(ps_world_scene(w), t->materials, &sp, &textured);
         ps_vec3 d = ray.d;
@@ -525,12 +538,30 @@ static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk
     }
 }
 
+/* One photon, and with records its path's record. */
+static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk_out *out)
+{
+    if (!t->opt.records) {
+        trace_path(t, kind, i, out);
+        return;
+    }
+    size_t before = out->map.count;
+    ps_path_begin(&out->paths);
+    trace_path(t, kind, i, out);
+    if (out->paths.failed || out->map.count - before > UINT8_MAX) {
+        out->failed = true;
+        return;
+    }
+    out->paths.rec[out->paths.count - 1].stored = (uint8_t)(out->map.count - before);
+}
+
 /* ---- threads ------------------------------------------------------------- */
 
 typedef struct trace_job {
     const ps_tracer *t;
     ps_map_kind kind;
     uint64_t first, count;
+    const uint64_t *list; /* NULL: the range [first, first + count); else these count indices */
     size_t chunks;
     chunk_out *outs;
     atomic_size_t next;
@@ -555,7 +586,7 @@ static void *worker(void *arg)
         if (hi > job->first + job->count)
             hi = job->first + job->count;
         for (uint64_t i = lo; i < hi && !job->outs[k].failed; i++)
-            trace_photon(job->t, job->kind, i, &job->outs[k]);
+            trace_photon(job->t, job->kind, job->list ? job->list[i - job->first] : i, &job->outs[k]);
         size_t n = job->outs[k].map.count;
         uint64_t stored = atomic_fetch_add(&job->stored, n) + n;
         if (job->room && stored > job->room)
@@ -576,22 +607,21 @@ void ps_traced_destroy(ps_traced *r)
 {
     if (!r)
         return;
-    for (size_t k = 0; k < r->chunks; k++)
+    for (size_t k = 0; k < r->chunks; k++) {
         ps_photon_map_free(&r->outs[k].map);
+        ps_path_store_free(&r->outs[k].paths);
+    }
     free(r->outs);
     free(r);
 }
 
 size_t ps_traced_count(const ps_traced *r) { return r ? r->count : 0; }
 
-ps_status ps_tracer_trace_range(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
-                                size_t stored, ps_traced **out, ps_error *err)
+static ps_status trace_some(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, const uint64_t *list,
+                            uint64_t total, size_t stored, ps_traced **out, ps_error *err)
 {
     *out = NULL;
     const char *path = ps_scene_path(t->scene);
-    if (first > total || count > total - first)
-        return ps_error_set(err, PS_ERR_RANGE, "%s: photons %llu..%llu lie beyond the map's total %llu", path,
-                            (unsigned long long)first, (unsigned long long)(first + count), (unsigned long long)total);
     map_plan *plan = &t->plans[kind];
     if (!plan->enabled || count == 0)
         return PS_OK;
@@ -601,8 +631,9 @@ ps_status ps_tracer_trace_range(ps_tracer *t, ps_map_kind kind, uint64_t first, 
     memset(&job, 0, sizeof job);
     job.t = t;
     job.kind = kind;
-    job.first = first;
+    job.first = list ? 0 : first;
     job.count = count;
+    job.list = list;
     job.chunks = (size_t)((count + PS_PHOTON_CHUNK - 1) / PS_PHOTON_CHUNK);
     atomic_init(&job.next, 0);
     atomic_init(&job.done, 0);
@@ -646,7 +677,8 @@ ps_status ps_tracer_trace_range(ps_tracer *t, ps_map_kind kind, uint64_t first, 
                           path, ps_map_name(kind), (unsigned long long)max_stored);
     else if (done < job.chunks)
         st = ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted after %.0f %% of the %s photons",
-                          100.0 * ((double)first + (double)done * PS_PHOTON_CHUNK) / (double)total, ps_map_name(kind));
+                          100.0 * ((double)job.first + (double)done * PS_PHOTON_CHUNK) / (double)total,
+                          ps_map_name(kind));
     for (size_t k = 0; k < job.chunks && st == PS_OK; k++) {
         if (job.outs[k].failed || job.outs[k].map.count > SIZE_MAX - r->count)
             st = ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory storing photons", path);
@@ -659,6 +691,113 @@ ps_status ps_tracer_trace_range(ps_tracer *t, ps_map_kind kind, uint64_t first, 
     }
     *out = r;
     return PS_OK;
+}
+
+ps_status ps_tracer_trace_range(ps_tracer *t, ps_map_kind kind, uint64_t first, uint64_t count, uint64_t total,
+                                size_t stored, ps_traced **out, ps_error *err)
+{
+    *out = NULL;
+    if (first > total || count > total - first)
+        return ps_error_set(err, PS_ERR_RANGE, "%s: photons %llu..%llu lie beyond the map's total %llu",
+                            ps_scene_path(t->scene), (unsigned long long)first, (unsigned long long)(first + count),
+                            (unsigned long long)total);
+    return trace_some(t, kind, first, count, NULL, total, stored, out, err);
+}
+
+ps_status ps_tracer_trace_list(ps_tracer *t, ps_map_kind kind, const uint64_t *idx, size_t n, uint64_t total,
+                               size_t stored, ps_traced **out, ps_error *err)
+{
+    *out = NULL;
+    for (size_t k = 0; k < n; k++)
+        if (idx[k] >= total || (k > 0 && idx[k] <= idx[k - 1]))
+            return ps_error_set(err, PS_ERR_RANGE, "%s: photon %llu out of order or beyond the map's total %llu",
+                                ps_scene_path(t->scene), (unsigned long long)idx[k], (unsigned long long)total);
+    return trace_some(t, kind, 0, n, idx, total, stored, out, err);
+}
+
+ps_status ps_traced_join_paths(ps_traced *r, ps_path_store *dst, const uint64_t *idx, ps_error *err)
+{
+    if (!r || !r->outs)
+        return PS_OK;
+    /* All or nothing: room first, then copies that cannot fail. */
+    size_t nv = 0, nr = 0;
+    for (size_t k = 0; k < r->chunks; k++)
+        nv += r->outs[k].paths.vcount, nr += r->outs[k].paths.count;
+    if (nv > UINT32_MAX - dst->vcount || !PS_RESERVE(dst->vert, dst->vcap, dst->vcount + nv) ||
+        (!idx && !PS_RESERVE(dst->rec, dst->cap, dst->count + nr)))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for path records", r->path);
+    for (size_t k = 0; k < r->chunks; k++) {
+        const ps_path_store *src = &r->outs[k].paths;
+        if (idx) {
+            (void)ps_path_store_put(dst, src, idx);
+            idx += src->count;
+        } else {
+            (void)ps_path_store_append(dst, src);
+        }
+    }
+    return PS_OK;
+}
+
+ps_path_quant ps_tracer_path_quant(const ps_tracer *t) { return t->quant; }
+bool ps_tracer_records(const ps_tracer *t) { return t->opt.records; }
+
+bool ps_tracer_same_source(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t i, uint64_t total,
+                           uint32_t *light)
+{
+    map_plan *pa = &a->plans[kind], *pb = &b->plans[kind];
+    *light = UINT32_MAX;
+    if (!pa->enabled)
+        return !pb->enabled;
+    if (!pb->enabled)
+        return false;
+    count_strata(pa, total);
+    count_strata(pb, total);
+    const stratum *sa = &pa->strata[stratum_of(pa, i)], *sb = &pb->strata[stratum_of(pb, i)];
+    *light = sa->light;
+    if (sa->light != sb->light || sa->target != sb->target || sa->has_caustic_cone != sb->has_caustic_cone)
+        return false;
+    if (sa->has_caustic_cone && memcmp(&sa->caustic_cone, &sb->caustic_cone, sizeof sa->caustic_cone) != 0)
+        return false;
+    double xa = pa->scale[sa - pa->strata], xb = pb->scale[sb - pb->strata];
+    return memcmp(&xa, &xb, sizeof xa) == 0 && memcmp(pa->rotation, pb->rotation, sizeof pa->rotation) == 0;
+}
+
+static bool same_stratum(const map_plan *pa, size_t ka, const map_plan *pb, size_t kb)
+{
+    const stratum *sa = &pa->strata[ka], *sb = &pb->strata[kb];
+    if (sa->light != sb->light || sa->target != sb->target || sa->has_caustic_cone != sb->has_caustic_cone)
+        return false;
+    if (sa->has_caustic_cone && memcmp(&sa->caustic_cone, &sb->caustic_cone, sizeof sa->caustic_cone) != 0)
+        return false;
+    return memcmp(&pa->scale[ka], &pb->scale[kb], sizeof pa->scale[ka]) == 0;
+}
+
+ps_source_match ps_tracer_match_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total)
+{
+    map_plan *pa = &a->plans[kind], *pb = &b->plans[kind];
+    if (!pa->enabled || !pb->enabled || memcmp(pa->rotation, pb->rotation, sizeof pa->rotation) != 0)
+        return PS_SOURCES_NONE;
+    count_strata(pa, total);
+    count_strata(pb, total);
+    bool same = pa->count == pb->count;
+    for (size_t k = 0; same && k < pa->count; k++)
+        same = pa->strata[k].cdf == pb->strata[k].cdf && same_stratum(pa, k, pb, k);
+    if (same)
+        return PS_SOURCES_SAME;
+    for (size_t ka = 0; ka < pa->count; ka++)
+        for (size_t kb = 0; kb < pb->count; kb++)
+            if (same_stratum(pa, ka, pb, kb))
+                return PS_SOURCES_SOME;
+    return PS_SOURCES_NONE;
+}
+
+uint32_t ps_tracer_photon_light(ps_tracer *t, ps_map_kind kind, uint64_t i, uint64_t total)
+{
+    map_plan *p = &t->plans[kind];
+    if (!p->enabled)
+        return UINT32_MAX;
+    count_strata(p, total);
+    return p->strata[stratum_of(p, i)].light;
 }
 
 ps_status ps_traced_join(ps_traced *r, ps_photon_map *m, ps_error *err)

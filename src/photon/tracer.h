@@ -23,6 +23,7 @@
 #include "core/cancel.h"
 #include "core/status.h"
 #include "photon/photon.h"
+#include "photon/path_record.h"
 #include "photon/photon_map.h"
 #include "photon/world.h"
 
@@ -50,6 +51,11 @@ typedef struct ps_tracer_options {
     uint64_t max_stored;          /* 0, or the most photons a map may hold: a trace that
                                    * would store more stops (PS_ERR_LIMIT, the map left as
                                    * it was) before the map grows past it */
+    /* Path records (photon/path_record.h) for the preview's selective repair:
+     * when records is set, each traced range also gives every emitted photon's
+     * path, its vertices quantised in record_box (which must hold the scene). */
+    bool records;
+    ps_aabb record_box;
 } ps_tracer_options;
 
 /* Online cores, at least 1 and at most PS_TRACER_MAX_THREADS: the default
@@ -113,6 +119,36 @@ size_t ps_traced_count(const ps_traced *r);
 ps_status ps_traced_join(ps_traced *r, ps_photon_map *m, ps_error *err);
 /* Frees the chunks; accepts NULL. */
 void ps_traced_destroy(ps_traced *r);
+
+/* ps_tracer_trace_range for the n photon indices idx (ascending, each below
+ * total) instead of a range: the photons a selective repair retraces. */
+ps_status ps_tracer_trace_list(ps_tracer *t, ps_map_kind kind, const uint64_t *idx, size_t n, uint64_t total,
+                               size_t stored, ps_traced **out, ps_error *err);
+
+/* With ps_tracer_options.records: the traced photons' path records, in index
+ * order, appended to dst (idx NULL: a range, dst holding the records of every
+ * index before it) or put at dst's records idx[0..] (a list). PS_ERR_NOMEM,
+ * dst unchanged, when out of memory. Without records: nothing. */
+ps_status ps_traced_join_paths(ps_traced *r, ps_path_store *dst, const uint64_t *idx, ps_error *err);
+/* Whether the tracer records paths (ps_tracer_options.records). */
+bool ps_tracer_records(const ps_tracer *t);
+/* The quantisation the tracer records paths with. */
+ps_path_quant ps_tracer_path_quant(const ps_tracer *t);
+
+/* Whether photon i of map `kind` leaves tracer a's lights exactly as tracer
+ * b's (both planned for `total` photons): the same light, caustic cone,
+ * first-hit target and normalisation, bit for bit. *light: its light under
+ * a (UINT32_MAX when a's map is off). Whether that light itself changed is
+ * the caller's to know. */
+bool ps_tracer_same_source(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t i, uint64_t total,
+                           uint32_t *light);
+/* The same question for all photons of a map at once: every photon leaves
+ * the same way (the plans are equal: then only its light is to be checked),
+ * none does (no stratum of a is one of b's), or some (ask each photon). */
+typedef enum ps_source_match { PS_SOURCES_NONE, PS_SOURCES_SOME, PS_SOURCES_SAME } ps_source_match;
+ps_source_match ps_tracer_match_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total);
+/* The light photon i of map kind leaves (UINT32_MAX when the map is off). */
+uint32_t ps_tracer_photon_light(ps_tracer *t, ps_map_kind kind, uint64_t i, uint64_t total);
 
 /* How many of photons [0, total) light l emits for map kind (all its caustic cones
  * together): the tracer shares photons between lights in proportion to flux. */

@@ -15,6 +15,8 @@ struct ps_feed {
     bool active[PS_MAP_COUNT];
     pthread_mutex_t lock;
     pthread_cond_t wake;              /* signalled when pause or stop change */
+    pthread_cond_t idle;              /* signalled when the thread waits paused, or ends */
+    bool waiting;                     /* under lock: the thread waits paused between batches */
     ps_photon_map maps[PS_MAP_COUNT]; /* under lock: what has arrived */
     ps_feed_mark *marks[PS_MAP_COUNT];  /* under lock: batch ends */
     size_t mark_count[PS_MAP_COUNT], mark_cap[PS_MAP_COUNT];
@@ -28,7 +30,27 @@ struct ps_feed {
     ps_status status;
     ps_error err;
     double seconds;
+    /* Selective repair (ps_feed_create_repair). With the tracer's records,
+     * paths[k] holds a record for every photon index below next[k] (records
+     * false once they could not be kept: then edits restart). While
+     * repairing, map k is in repair order: photons [0, kept_end[k]) of the
+     * indices kept (index order), then those retraced (index order), then
+     * those of indices from repair_end[k] on; a merge puts it back in index
+     * order (generation counts merges). */
+    bool records;
+    ps_path_store paths[PS_MAP_COUNT];
+    uint64_t *pending[PS_MAP_COUNT];  /* indices to retrace first, ascending */
+    size_t pending_count[PS_MAP_COUNT], pending_done[PS_MAP_COUNT];
+    size_t kept_end[PS_MAP_COUNT];
+    uint64_t repair_end[PS_MAP_COUNT];
+    bool repairing[PS_MAP_COUNT];
+    uint64_t generation;            /* under lock */
+    ps_feed_repair_count repair;    /* what the repair that made this feed kept */
 };
+
+/* Path record flags (ps_path_rec.flags). */
+#define REC_PENDING 1u  /* to retrace: its photons are not in the map */
+#define REC_RETRACED 2u /* retraced: its photons are in the retraced run */
 
 ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const bool active[PS_MAP_COUNT],
                          ps_feed **out, ps_error *err)
@@ -38,6 +60,7 @@ ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const 
     if (!f)
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
     f->tracer = t;
+    f->records = ps_tracer_records(t);
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         f->cap[k] = caps[k];
         f->active[k] = active[k] && caps[k] > 0;
@@ -45,9 +68,13 @@ ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const 
     }
     pthread_mutex_init(&f->lock, NULL);
     pthread_cond_init(&f->wake, NULL);
+    pthread_cond_init(&f->idle, NULL);
     *out = f;
     return PS_OK;
 }
+
+static ps_status hand_over(ps_feed *f, int k, ps_traced *traced, const uint64_t *idx, ps_error *err);
+static ps_status merge(ps_feed *f, ps_error *err);
 
 /* Traces photons [first, first + count) of map k outside the lock, then
  * joins them to the map under it: each photon is copied once, from the
@@ -69,17 +96,88 @@ static ps_status batch(ps_feed *f, int k, uint64_t first, uint64_t count, ps_err
     }
     if (st != PS_OK)
         return st;
+    return hand_over(f, k, traced, NULL, err);
+}
+
+/* Joins a traced range (idx NULL) or list of indices to map k, with their
+ * path records, under the lock. */
+static ps_status hand_over(ps_feed *f, int k, ps_traced *traced, const uint64_t *idx, ps_error *err)
+{
+    ps_status st = PS_OK;
+    if (f->records) {
+        ps_error perr;
+        bool repairing = false;
+        for (int j = 0; j < PS_MAP_COUNT; j++)
+            repairing = repairing || f->repairing[j];
+        if (ps_traced_join_paths(traced, &f->paths[k], idx, &perr) != PS_OK) {
+            if (repairing) {
+                /* A map in repair order needs its records to be put back in
+                 * order: this is out of memory like the photons. */
+                ps_traced_destroy(traced);
+                *err = perr;
+                return perr.status;
+            }
+            /* No room for the records: go on without them (edits restart). */
+            pthread_mutex_lock(&f->lock);
+            f->records = false;
+            for (int j = 0; j < PS_MAP_COUNT; j++)
+                ps_path_store_free(&f->paths[j]);
+            pthread_mutex_unlock(&f->lock);
+        }
+    }
     pthread_mutex_lock(&f->lock);
+    uint64_t emitted = f->maps[k].counters.emitted;
     if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1) ||
         ps_traced_join(traced, &f->maps[k], err) != PS_OK)
         st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for %llu more photons",
                           (unsigned long long)ps_traced_count(traced));
     if (st == PS_OK) {
+        /* Retraced photons stand for indices already counted as emitted. */
+        if (idx)
+            f->maps[k].counters.emitted = emitted;
         ps_feed_mark m = {f->maps[k].count, f->maps[k].counters.emitted};
         f->marks[k][f->mark_count[k]++] = m;
     }
     pthread_mutex_unlock(&f->lock);
     ps_traced_destroy(traced);
+    return st;
+}
+
+/* Map k's share of a round's PS_FEED_BATCH photons (of the largest cap):
+ * maps keep pace with each other, as in round_once. */
+static uint64_t batch_of(const ps_feed *f, int k)
+{
+    uint64_t biggest = 0;
+    for (int j = 0; j < PS_MAP_COUNT; j++)
+        if (f->active[j] && f->cap[j] > biggest)
+            biggest = f->cap[j];
+    double n = biggest ? (double)PS_FEED_BATCH * (double)f->cap[k] / (double)biggest : PS_FEED_BATCH;
+    return n < 1.0 ? 1 : (uint64_t)n;
+}
+
+/* The next batch of map k's pending indices, retraced. */
+static ps_status retrace_batch(ps_feed *f, int k, ps_error *err)
+{
+    size_t from = f->pending_done[k], n = f->pending_count[k] - from;
+    if (n > batch_of(f, k))
+        n = (size_t)batch_of(f, k);
+    const uint64_t *idx = f->pending[k] + from;
+    ps_traced *traced;
+    ps_status st = ps_tracer_trace_list(f->tracer, (ps_map_kind)k, idx, n, f->cap[k], f->maps[k].count, &traced,
+                                        err);
+    if (st == PS_ERR_LIMIT) {
+        pthread_mutex_lock(&f->lock);
+        f->store_limited = true;
+        pthread_mutex_unlock(&f->lock);
+        return PS_OK;
+    }
+    if (st == PS_OK)
+        st = hand_over(f, k, traced, idx, err);
+    if (st == PS_OK) {
+        for (size_t j = 0; f->records && j < n; j++)
+            f->paths[k].rec[idx[j]].flags = REC_RETRACED;
+        f->pending_done[k] = from + n;
+    }
     return st;
 }
 
@@ -95,6 +193,15 @@ static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
         pthread_mutex_unlock(&f->lock);
         return false;
     }
+    /* A repair first retraces what the edit changed, then goes on. */
+    bool repairing = false;
+    for (int k = 0; k < PS_MAP_COUNT && *st == PS_OK; k++)
+        if (f->pending_done[k] < f->pending_count[k]) {
+            *st = retrace_batch(f, k, err);
+            repairing = true;
+        }
+    if (repairing)
+        return *st == PS_OK && !f->store_limited;
     uint64_t biggest = 0;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (f->active[k] && f->cap[k] > biggest)
@@ -125,19 +232,31 @@ static void *feed_main(void *arg)
     bool more = st == PS_OK && !f->ended;
     while (more) {
         pthread_mutex_lock(&f->lock);
-        while (f->paused && !f->stop)
+        while (f->paused && !f->stop) {
+            f->waiting = true;
+            pthread_cond_broadcast(&f->idle);
             pthread_cond_wait(&f->wake, &f->lock);
+        }
+        f->waiting = false;
         bool stop = f->stop;
         pthread_mutex_unlock(&f->lock);
         if (stop)
             break;
         more = round_once(f, &st, &err);
     }
+    /* Every photon traced: the maps back in index order, as a fresh trace
+     * of the edited scene has them. */
+    pthread_mutex_lock(&f->lock);
+    bool stopped = f->stop;
+    pthread_mutex_unlock(&f->lock);
+    if (st == PS_OK && !stopped)
+        st = merge(f, &err);
     pthread_mutex_lock(&f->lock);
     f->status = st;
     f->err = err;
     f->ended = true;
     f->seconds += ps_now_seconds() - t0;
+    pthread_cond_broadcast(&f->idle);
     pthread_mutex_unlock(&f->lock);
     return NULL;
 }
@@ -174,7 +293,7 @@ ps_status ps_feed_start(ps_feed *f, ps_error *err)
     return PS_OK;
 }
 
-void ps_feed_stop(ps_feed *f)
+static void stop_thread(ps_feed *f)
 {
     pthread_mutex_lock(&f->lock);
     f->stop = true;
@@ -186,11 +305,38 @@ void ps_feed_stop(ps_feed *f)
     }
 }
 
+void ps_feed_stop(ps_feed *f)
+{
+    stop_thread(f);
+    /* Stopped during a repair: the maps in index order all the same (the
+     * photons not yet retraced are missing), as a dump must have them. */
+    if (f->status == PS_OK) {
+        ps_error err;
+        ps_status st = merge(f, &err);
+        if (st != PS_OK) {
+            pthread_mutex_lock(&f->lock);
+            f->status = st;
+            f->err = err;
+            pthread_mutex_unlock(&f->lock);
+        }
+    }
+}
+
 void ps_feed_pause(ps_feed *f, bool paused)
 {
     pthread_mutex_lock(&f->lock);
     f->paused = paused;
     pthread_cond_broadcast(&f->wake);
+    pthread_mutex_unlock(&f->lock);
+}
+
+void ps_feed_hold_idle(ps_feed *f)
+{
+    pthread_mutex_lock(&f->lock);
+    f->paused = true;
+    pthread_cond_broadcast(&f->wake);
+    while (f->started && !f->ended && !f->waiting)
+        pthread_cond_wait(&f->idle, &f->lock);
     pthread_mutex_unlock(&f->lock);
 }
 
@@ -222,12 +368,195 @@ void ps_feed_destroy(ps_feed *f)
 {
     if (!f)
         return;
-    ps_feed_stop(f);
+    stop_thread(f);
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_photon_map_free(&f->maps[k]);
         free(f->marks[k]);
+        ps_path_store_free(&f->paths[k]);
+        free(f->pending[k]);
     }
     pthread_cond_destroy(&f->wake);
+    pthread_cond_destroy(&f->idle);
     pthread_mutex_destroy(&f->lock);
     free(f);
 }
+
+/* ---- selective repair ----------------------------------------------------------- */
+
+static bool compact_paths(ps_path_store *p)
+{
+    size_t used = 0;
+    for (size_t i = 0; i < p->count; i++)
+        used += p->rec[i].vertices;
+    return 2 * used >= p->vcount || ps_path_store_compact(p);
+}
+
+/* Puts map k back in index order: the kept run and the retraced run
+ * interleaved by index (pending indices have no photons), then the rest.
+ * Under the feed's thread or with it stopped; takes the lock to swap. */
+static ps_status merge_map(ps_feed *f, int k, ps_error *err)
+{
+    if (!f->repairing[k])
+        return PS_OK;
+    ps_photon_map *m = &f->maps[k];
+    ps_photon_map out;
+    ps_photon_map_init(&out, (ps_map_kind)k);
+    if (!ps_photon_map_reserve_exact(&out, m->count ? m->count : 1))
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory reordering %zu photons", m->count);
+    size_t kept = 0, re = f->kept_end[k];
+    const ps_path_rec *rec = f->paths[k].rec;
+    for (uint64_t i = 0; i < f->repair_end[k]; i++) {
+        if (rec[i].flags & REC_PENDING)
+            continue;
+        size_t *from = (rec[i].flags & REC_RETRACED) ? &re : &kept;
+        size_t n = rec[i].stored;
+        memcpy(out.photons + out.count, m->photons + *from, n * sizeof *m->photons);
+        memcpy(out.materials + out.count, m->materials + *from, n * sizeof *m->materials);
+        memcpy(out.objects + out.count, m->objects + *from, n * sizeof *m->objects);
+        out.count += n;
+        *from += n;
+    }
+    /* Those traced past the repair follow in order. */
+    size_t rest = m->count - re;
+    memcpy(out.photons + out.count, m->photons + re, rest * sizeof *m->photons);
+    memcpy(out.materials + out.count, m->materials + re, rest * sizeof *m->materials);
+    memcpy(out.objects + out.count, m->objects + re, rest * sizeof *m->objects);
+    out.count += rest;
+    out.counters = m->counters;
+    pthread_mutex_lock(&f->lock);
+    ps_photon_map_free(m);
+    *m = out;
+    f->mark_count[k] = 0;
+    ps_feed_mark mk = {m->count, m->counters.emitted};
+    f->marks[k][f->mark_count[k]++] = mk; /* room: the marks only shrank */
+    f->generation++;
+    pthread_mutex_unlock(&f->lock);
+    for (uint64_t i = 0; i < f->repair_end[k]; i++)
+        f->paths[k].rec[i].flags &= (uint8_t)~REC_RETRACED;
+    if (!compact_paths(&f->paths[k]))
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for path records");
+    f->kept_end[k] = m->count;
+    f->repairing[k] = false;
+    return PS_OK;
+}
+
+static ps_status merge(ps_feed *f, ps_error *err)
+{
+    ps_status st = PS_OK;
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
+        st = merge_map(f, k, err);
+    return st;
+}
+
+bool ps_feed_repairable(const ps_feed *f)
+{
+    if (!f->records || f->status != PS_OK || f->store_limited || f->started)
+        return false;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        if (f->active[k] && f->paths[k].count != f->next[k])
+            return false;
+    return true;
+}
+
+ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep, void *ctx, ps_feed **out,
+                                ps_error *err)
+{
+    *out = NULL;
+    ps_status st = merge(old, err);
+    if (st != PS_OK)
+        return st;
+    ps_feed *f;
+    st = ps_feed_create(t, old->cap, old->active, &f, err);
+    if (st != PS_OK)
+        return st;
+    f->max_stored = old->max_stored;
+    f->round = old->round;
+    f->seconds = old->seconds;
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
+        ps_photon_map *om = &old->maps[k], *m = &f->maps[k];
+        ps_path_store *op = &old->paths[k];
+        uint64_t end = old->next[k];
+        f->next[k] = end;
+        f->repair_end[k] = end;
+        if (!f->active[k] || end == 0)
+            continue;
+        /* Take the old map and records whole, then keep in place. */
+        *m = *om;
+        ps_photon_map_init(om, (ps_map_kind)k);
+        f->paths[k] = *op;
+        ps_path_store_init(op);
+        ps_path_rec *rec = f->paths[k].rec;
+        /* Keep in place: the kept photons move down over the others (both
+         * in index order), the others' indices go to the pending list. */
+        size_t at = 0, cap = 0, from = 0, to = 0;
+        uint64_t every = batch_of(f, k);
+        for (uint64_t i = 0; i < end && st == PS_OK; i++) {
+            bool pending = (rec[i].flags & REC_PENDING) != 0;
+            size_t n = pending ? 0 : rec[i].stored;
+            if (!pending && keep(ctx, (ps_map_kind)k, i, &f->paths[k], &rec[i])) {
+                if (to != from) {
+                    memmove(m->photons + to, m->photons + from, n * sizeof *m->photons);
+                    memmove(m->materials + to, m->materials + from, n * sizeof *m->materials);
+                    memmove(m->objects + to, m->objects + from, n * sizeof *m->objects);
+                }
+                to += n;
+            } else if (!PS_RESERVE(f->pending[k], cap, at + 1)) {
+                st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %zu photons", at);
+            } else {
+                rec[i].flags = REC_PENDING;
+                rec[i].vertices = 0; /* its path is to be retraced: the old one is garbage */
+                rec[i].stored = 0;
+                f->pending[k][at++] = i;
+            }
+            from += n;
+            /* A mark every batch of indices: the kept photons of indices
+             * below i + 1 stand for all of them, so a refresh that draws only
+             * its budget draws a prefix of the kept ones, scaled right. */
+            if ((i + 1) % every == 0 && i + 1 < end) {
+                if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1)) {
+                    st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
+                    break;
+                }
+                ps_feed_mark mk = {to, i + 1};
+                f->marks[k][f->mark_count[k]++] = mk;
+            }
+        }
+        if (st != PS_OK)
+            break;
+        /* Retraced paths append their vertices; the pool is rewritten once
+         * half of it is garbage, so it stays within twice what the records
+         * use (the soak's memory stays flat over hundreds of edits). */
+        if (!compact_paths(&f->paths[k])) {
+            st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for path records");
+            break;
+        }
+        f->pending_count[k] = at;
+        m->count = to;
+        f->kept_end[k] = to;
+        f->repairing[k] = at > 0;
+        /* Counters: every index below `end` counts as emitted (the pending
+         * ones are on their way); what the paths did is counted anew. */
+        memset(&m->counters, 0, sizeof m->counters);
+        m->counters.emitted = end;
+        m->counters.stored = to;
+        f->repair.kept[k] = end - at;
+        f->repair.retraced[k] = at;
+        f->repair.kept_photons[k] = to;
+        if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1)) {
+            st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
+            break;
+        }
+        ps_feed_mark mk = {to, end};
+        f->marks[k][f->mark_count[k]++] = mk;
+    }
+    if (st != PS_OK) {
+        ps_feed_destroy(f);
+        return st;
+    }
+    *out = f;
+    return PS_OK;
+}
+
+ps_feed_repair_count ps_feed_repair_counts(const ps_feed *f) { return f->repair; }
+
+uint64_t ps_feed_generation(const ps_feed *f) { return f->generation; }

@@ -53,6 +53,9 @@ ps_status ps_feed_start(ps_feed *f, ps_error *err);
 void ps_feed_stop(ps_feed *f);
 /* Holds the thread between batches (true) or lets it go on. */
 void ps_feed_pause(ps_feed *f, bool paused);
+/* Holds the thread and waits until it is between batches (or done), so that
+ * the scene it traces may change (an edit, before ps_feed_stop). */
+void ps_feed_hold_idle(ps_feed *f);
 
 /* Between lock and unlock the maps do not change or move. */
 void ps_feed_lock(ps_feed *f);
@@ -80,5 +83,39 @@ ps_status ps_feed_status(const ps_feed *f, ps_error *err);
 double ps_feed_seconds(const ps_feed *f);
 uint64_t ps_feed_cap(const ps_feed *f, ps_map_kind k);
 bool ps_feed_active(const ps_feed *f, ps_map_kind k);
+
+/* ---- selective repair (issue 18) ------------------------------------------------
+ * With the tracer's path records (ps_tracer_options.records) a feed can go on
+ * after an edit from what it has: ps_feed_create_repair takes a stopped
+ * feed's maps and records, keeps every photon index that keep() says the
+ * edit cannot have changed, and retraces the others first (PS_FEED_BATCH at
+ * a time, in index order), before tracing on from where the old feed was.
+ * Until then a map is in repair order (kept, then retraced, then new
+ * photons), each batch still a mark whose emitted count is the whole range
+ * (the kept photons stand for all of it, the retraced fill in); when tracing
+ * ends the map is put back in index order, equal photon for photon to a
+ * fresh trace of the edited scene, and the generation counts up. */
+
+/* Whether photon index i of map k, with record rec (in paths), is kept. */
+typedef bool (*ps_feed_keep_fn)(void *ctx, ps_map_kind k, uint64_t i, const ps_path_store *paths,
+                                const ps_path_rec *rec);
+/* Whether a stopped feed can be repaired: its records are complete, it did
+ * not fail or end at the store limit. */
+bool ps_feed_repairable(const ps_feed *f);
+/* The new feed, on tracer t (the edited scene's), from old (stopped and
+ * repairable; left empty, to be destroyed). On an error old's maps may be
+ * lost: start a new feed from photon 0. */
+ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep, void *ctx, ps_feed **out,
+                                ps_error *err);
+/* What the repair that made f did, per map: photon indices kept and to
+ * retrace, and the stored photons kept. */
+typedef struct ps_feed_repair_count {
+    uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
+    uint64_t kept_photons[PS_MAP_COUNT];
+} ps_feed_repair_count;
+ps_feed_repair_count ps_feed_repair_counts(const ps_feed *f);
+/* Under the lock: how many times a map was reordered (a drawn prefix of it
+ * is then not the same photons). */
+uint64_t ps_feed_generation(const ps_feed *f);
 
 #endif

@@ -260,6 +260,26 @@ static ps_status parse_action(parser *p, ps_script_action *a)
         a->path = dst;
         return PS_OK;
     }
+    if (strcmp(action, "dump") == 0 || strcmp(action, "save") == 0) {
+        /* "dump photons PATH", "save scene PATH": the session's maps or scene. */
+        bool dump = action[0] == 'd';
+        const char *what = dump ? "photons" : "scene";
+        a->kind = dump ? PS_SCRIPT_DUMP_PHOTONS : PS_SCRIPT_SAVE_SCENE;
+        if (nargs < 1 || strcmp(arg[0], what) != 0)
+            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: expected '%s %s PATH'", action, action,
+                               what);
+        if (nargs != 2)
+            return wrong_count(p, dump ? "dump photons" : "save scene", "1 path (without spaces)");
+        size_t n = strlen(arg[1]);
+        if (n > PS_SCRIPT_PATH_MAX)
+            return ps_error_at(p->err, PS_ERR_PARSE, p->name, p->line, "%s: path longer than %d characters", action,
+                               PS_SCRIPT_PATH_MAX);
+        char *dst = p->pool + p->pool_used;
+        memcpy(dst, arg[1], n + 1);
+        p->pool_used += n + 1;
+        a->path = dst;
+        return PS_OK;
+    }
     if (strcmp(action, "move") == 0) {
         a->kind = PS_SCRIPT_MOVE_LIGHT; /* or MOVE_OBJECT, which subject() decides */
         return parse_indexed(p, a, action);

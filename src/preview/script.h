@@ -29,6 +29,11 @@
  *                                      is paused); their times
  *                                      then count on from when the wait ended
  *     quit
+ *     dump photons PATH                the maps as they stand, as --dump-photons
+ *                                      writes them (in index order once traced:
+ *                                      after wait done, equal to photosplat-ref
+ *                                      --photons-only on the edited scene)
+ *     save scene PATH                  the edited scene as a .scn
  * (power, angle and wait are extras beyond the contract: editing lights, and
  * pictures at a known photon count whatever the machine's speed.)
  * Numbers are strict (core/number.h); indices are integers in [0, 2^32 - 1],
@@ -64,7 +69,9 @@ typedef enum ps_script_kind {
     PS_SCRIPT_POWER,
     PS_SCRIPT_ANGLE,
     PS_SCRIPT_WAIT,
-    PS_SCRIPT_QUIT
+    PS_SCRIPT_QUIT,
+    PS_SCRIPT_DUMP_PHOTONS, /* dump photons PATH */
+    PS_SCRIPT_SAVE_SCENE    /* save scene PATH */
 } ps_script_kind;
 
 typedef enum ps_script_setting {
@@ -87,7 +94,7 @@ typedef struct ps_script_action {
     double time;         /* seconds from the first frame, >= 0 */
     int line;            /* where it stands in the file (1-based) */
     ps_script_kind kind;
-    const char *path;    /* screenshot (owned by the script) */
+    const char *path;    /* screenshot, dump photons, save scene (owned by the script) */
     uint32_t index;      /* move/power/angle */
     ps_vec3 v;           /* move light: position; move object: delta */
     ps_rgb power;        /* power, watts per channel */

@@ -8,6 +8,7 @@
 
 #include "core/clock.h"
 #include "preview/feed.h"
+#include "preview/repair.h"
 
 struct ps_session {
     ps_scene *scene;
@@ -54,6 +55,14 @@ struct ps_session {
     const ps_material *imap_mats;/* ... (colours are remade only when these or the maps change) */
     size_t lobe_drawn;
     ps_material *lobe_mats;
+    /* Selective repair (repair.h): the scene the maps were traced for, the
+     * box path records are quantised in, what the last edit kept. */
+    ps_repair_state traced;
+    ps_aabb record_box;
+    bool repaired;         /* the last update repaired the maps (else restarted them) */
+    bool skip_prime;       /* ... and every map kept photons: no first round to prime */
+    uint64_t feed_gen;     /* the feed's generation the drawn prefixes belong to */
+    ps_feed_repair_count repair;
 };
 
 ps_session_settings ps_session_default_settings(const ps_scene *scene)
@@ -78,6 +87,7 @@ ps_session_settings ps_session_default_settings(const ps_scene *scene)
     set.tau = 0.1;
     set.splat_share = PS_SESSION_SPLAT_TIME_SHARE;
     set.shadow_size = PS_SHADOW_SIZE_DEFAULT;
+    set.repair = true;
     return set;
 }
 
@@ -91,7 +101,7 @@ static double exposure(const ps_session *s) { return s->illuminance ? 1.0 : s->s
 static void apply_pause(ps_session *s)
 {
     if (s->feed)
-        ps_feed_pause(s->feed, s->user_paused || s->hold || s->first_pending || s->counter_stopped);
+        ps_feed_pause(s->feed, s->user_paused || s->hold || s->first_pending || s->counter_stopped || s->edited);
 }
 
 /* ---- building ----------------------------------------------------------------- */
@@ -145,12 +155,37 @@ static ps_status new_tracer(ps_session *s, ps_error *err)
     to.threads = s->set.threads;
     to.cancel = s->set.cancel;
     to.max_stored = s->set.max_map_photons;
+    to.records = s->set.repair;
+    to.record_box = s->record_box;
     return ps_tracer_create(s->world, &to, &s->tracer, err);
 }
 
 /* A new feed from photon 0. Which maps it traces: a disabled one (the scene
  * needs none) never; one of 0 photons, or not shown when the session skips
  * hidden layers, is recorded as skipped with its reason. */
+/* The illumination maps start over (they sum photons in the map's order). */
+static void forget_imap(ps_session *s)
+{
+    if (s->imap)
+        ps_illummap_reset(s->imap, s->set.kernel);
+    s->imap_emitted = 0;
+    s->lobe_drawn = 0;
+}
+
+/* The feed's maps are other photons now (a new feed, a repaired one): nothing
+ * drawn from them stands, the illumination maps included. */
+static void forget_drawn(ps_session *s)
+{
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        s->drawn[k] = 0;
+        s->drawn_emitted[k] = 0;
+    }
+    forget_imap(s);
+    s->counter_stopped = false;
+    s->view_dirty = true;
+    s->feed_gen = 0;
+}
+
 static ps_status new_feed(ps_session *s, ps_error *err)
 {
     bool active[PS_MAP_COUNT] = {false, false};
@@ -173,16 +208,7 @@ static ps_status new_feed(ps_session *s, ps_error *err)
     st = ps_feed_create(s->tracer, s->set.caps, active, &s->feed, err);
     if (st == PS_OK)
         ps_feed_set_store_limit(s->feed, s->set.max_stored);
-    for (int k = 0; k < PS_MAP_COUNT; k++) {
-        s->drawn[k] = 0;
-        s->drawn_emitted[k] = 0;
-    }
-    if (s->imap)
-        ps_illummap_reset(s->imap, s->set.kernel);
-    s->imap_emitted = 0;
-    s->lobe_drawn = 0;
-    s->counter_stopped = false;
-    s->view_dirty = true;
+    forget_drawn(s);
     return st;
 }
 
@@ -222,7 +248,10 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
         ps_splat_batch_init(&s->batch[k]);
         s->splat_radius[k] = set->radius[k];
     }
+    s->record_box = ps_repair_record_box(scene);
     ps_status st = build_geometry(s, err);
+    if (st == PS_OK)
+        st = ps_repair_state_take(scene, ps_world_epsilon(s->world), &s->traced, err);
     if (st == PS_OK)
         st = new_tracer(s, err);
     if (st == PS_OK)
@@ -256,6 +285,7 @@ void ps_session_destroy(ps_session *s)
     free(s->white);
     ps_illummap_destroy(s->imap);
     free(s->lobe_mats);
+    ps_repair_state_free(&s->traced);
     free(s);
 }
 
@@ -266,7 +296,9 @@ ps_status ps_session_trace_all(ps_session *s, ps_error *err) { return ps_feed_ru
 ps_status ps_session_start(ps_session *s, bool held, ps_error *err)
 {
     s->started = true;
-    ps_status st = ps_feed_prime(s->feed, err);
+    /* After a repair the kept photons are the first picture: the thread
+     * retraces the rest. */
+    ps_status st = s->skip_prime ? PS_OK : ps_feed_prime(s->feed, err);
     if (st != PS_OK)
         return st;
     s->first_pending = held;
@@ -450,6 +482,24 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         s->view_dirty = true;
     }
     out->moving = s->moving;
+    ps_feed_lock(s->feed);
+    uint64_t gen = ps_feed_generation(s->feed);
+    if (gen != s->feed_gen) {
+        /* The feed put a map back in index order: a drawn prefix that was
+         * not all of it is other photons now. */
+        s->feed_gen = gen;
+        for (int k = 0; k < PS_MAP_COUNT; k++)
+            if (s->drawn[k] != ps_feed_maps(s->feed)[k].count)
+                s->view_dirty = true;
+        /* The illumination maps sum photons in the map's order, so even all
+         * of them, summed in the repair's order, are not the bytes a fresh
+         * trace's maps would give. */
+        if (s->imap_emitted > 0) {
+            forget_imap(s);
+            s->view_dirty = true; /* the lobe splats with them */
+        }
+    }
+    ps_feed_unlock(s->feed);
     if (s->lights_pending) {
         s->lights_pending = false;
         ps_status lst = build_lights(s, err);
@@ -599,7 +649,7 @@ bool ps_session_settled(ps_session *s)
     if (s->user_paused || s->counter_stopped)
         return true;
     ps_feed_lock(s->feed);
-    bool over = ps_feed_ended(s->feed);
+    bool over = ps_feed_ended(s->feed) && ps_feed_generation(s->feed) == s->feed_gen;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         over = over && s->drawn[k] >= ps_feed_maps(s->feed)[k].count;
     ps_feed_unlock(s->feed);
@@ -721,6 +771,15 @@ const ps_material *ps_session_materials(const ps_session *s)
 
 /* ---- edits --------------------------------------------------------------------------- */
 
+/* Before an edit changes the scene: the tracing thread reads it (the world's
+ * triangles, the lights), so it is held between batches first, and stays
+ * held until ps_session_update replaces it. */
+static void hold_for_edit(ps_session *s)
+{
+    if (s->feed && !s->edited)
+        ps_feed_hold_idle(s->feed);
+}
+
 static ps_status edited(ps_session *s, ps_status st, bool geometry)
 {
     if (st == PS_OK) {
@@ -728,32 +787,38 @@ static ps_status edited(ps_session *s, ps_status st, bool geometry)
         s->geometry_edited = s->geometry_edited || geometry;
         s->edits++;
     }
+    apply_pause(s); /* a refused edit lets tracing go on */
     return st;
 }
 
 ps_status ps_session_move_light(ps_session *s, size_t light, ps_vec3 position, ps_error *err)
 {
+    hold_for_edit(s);
     return edited(s, ps_scene_set_light_position(s->scene, light, position, err), false);
 }
 
 ps_status ps_session_move_object(ps_session *s, size_t object, ps_vec3 delta, ps_error *err)
 {
+    hold_for_edit(s);
     return edited(s, ps_scene_translate_object(s->scene, object, delta, err), true);
 }
 
 ps_status ps_session_set_light_power(ps_session *s, size_t light, ps_rgb power, ps_error *err)
 {
+    hold_for_edit(s);
     return edited(s, ps_scene_set_light_power(s->scene, light, power, err), false);
 }
 
 ps_status ps_session_set_spot_angle(ps_session *s, size_t light, double degrees, ps_error *err)
 {
+    hold_for_edit(s);
     return edited(s, ps_scene_set_spot_angle(s->scene, light, degrees, err), false);
 }
 
 ps_status ps_session_restore_scene(ps_session *s, const ps_scene *snapshot, ps_error *err)
 {
     bool geometry = false;
+    hold_for_edit(s);
     ps_status st = ps_scene_restore(s->scene, snapshot, &geometry, err);
     return edited(s, st, geometry);
 }
@@ -764,9 +829,13 @@ uint64_t ps_session_edits(const ps_session *s) { return s->edits; }
 ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error *err)
 {
     changes->geometry = s->geometry_edited;
-    /* Every edit restarts both maps from photon 0 (thesis 4.1.4): the tracer's
-     * caustic cones follow lights and objects. */
-    free_maps(s);
+    /* The old maps and tracer stay until the repair has taken what the edits
+     * left unchanged (repair.h); what it cannot, starts over from photon 0. */
+    ps_feed *old = s->feed;
+    ps_tracer *old_tracer = s->tracer;
+    s->feed = NULL;
+    s->tracer = NULL;
+    ps_feed_stop(old);
     ps_status st = PS_OK;
     if (s->geometry_edited) {
         /* The maps' samples are the fine mesh's vertices: made again with it. */
@@ -783,8 +852,36 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
         st = build_lights(s, err);
     if (st == PS_OK)
         st = new_tracer(s, err);
-    if (st == PS_OK)
+    s->repaired = s->skip_prime = false;
+    memset(&s->repair, 0, sizeof s->repair);
+    if (st == PS_OK) {
+        ps_feed *f = NULL;
+        ps_error rerr;
+        /* A repair that fails (out of memory) is a restart. */
+        if (ps_repair_feed(old, old_tracer, s->tracer, &s->traced, s->scene, ps_world_epsilon(s->world), &f,
+                           &s->repaired, &rerr) != PS_OK)
+            s->repaired = false;
+        if (s->repaired) {
+            s->feed = f;
+            s->repair = ps_feed_repair_counts(f);
+            /* A map that kept nothing gets its first retraced batch before the
+             * first picture, as after a restart; one that kept photons shows
+             * them at once. */
+            bool kept_all_maps = true;
+            for (int k = 0; k < PS_MAP_COUNT; k++)
+                kept_all_maps = kept_all_maps && (s->repair.kept_photons[k] > 0 || s->repair.retraced[k] == 0);
+            s->skip_prime = kept_all_maps;
+            forget_drawn(s);
+        }
+    }
+    ps_feed_destroy(old);
+    ps_tracer_destroy(old_tracer);
+    if (st == PS_OK && !s->feed)
         st = new_feed(s, err);
+    if (st == PS_OK) {
+        ps_repair_state_free(&s->traced);
+        st = ps_repair_state_take(s->scene, ps_world_epsilon(s->world), &s->traced, err);
+    }
     s->edited = s->geometry_edited = false;
     /* The first batch is traced here and the thread held until the first
      * refresh has drawn it: that refresh then has every core. */
@@ -823,3 +920,21 @@ void ps_session_get_counts(ps_session *s, ps_session_counts *out)
 }
 
 const ps_photon_map *ps_session_maps(const ps_session *s) { return ps_feed_maps(s->feed); }
+
+const ps_photon_map *ps_session_lock_maps(ps_session *s)
+{
+    ps_feed_lock(s->feed);
+    return ps_feed_maps(s->feed);
+}
+
+void ps_session_unlock_maps(ps_session *s) { ps_feed_unlock(s->feed); }
+
+void ps_session_repair_counts(const ps_session *s, bool *repaired, uint64_t kept[PS_MAP_COUNT],
+                              uint64_t retraced[PS_MAP_COUNT])
+{
+    *repaired = s->repaired;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        kept[k] = s->repair.kept[k];
+        retraced[k] = s->repair.retraced[k];
+    }
+}

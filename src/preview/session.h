@@ -99,6 +99,9 @@ typedef struct ps_session_settings {
                                     * shadow cubes; else all from the start */
     ps_global_layer global_layer;  /* the global layer as splats or as illumination maps
                                     * (illummap.h) with only the glossy lobes splatted */
+    bool repair;                   /* edits keep the photons they cannot change (repair.h):
+                                    * path records cost PS_PATH_PLAN_BYTES an emitted
+                                    * photon (default on) */
 } ps_session_settings;
 
 /* Defaults: the scene's photon counts and radii, every layer, triangles, the
@@ -222,8 +225,11 @@ const ps_material *ps_session_materials(const ps_session *s);
 /* ---- edits ------------------------------------------------------------------------
  * Each checks its arguments as the scene's edits do (scene.h: an error names
  * the scene line, and leaves everything as it was) and marks what it
- * invalidates; ps_session_update then rebuilds it. Today every edit restarts
- * both maps from photon 0. */
+ * invalidates; ps_session_update then rebuilds it. With settings.repair the
+ * maps keep every photon the edits cannot have changed and retrace the rest
+ * first (preview/repair.h), exactly: once traced to the caps, the maps equal
+ * a fresh trace of the edited scene photon for photon; else both maps
+ * restart from photon 0. */
 ps_status ps_session_move_light(ps_session *s, size_t light, ps_vec3 position, ps_error *err);
 ps_status ps_session_move_object(ps_session *s, size_t object, ps_vec3 delta, ps_error *err);
 ps_status ps_session_set_light_power(ps_session *s, size_t light, ps_rgb power, ps_error *err);
@@ -269,5 +275,13 @@ typedef struct ps_session_counts {
 void ps_session_get_counts(ps_session *s, ps_session_counts *out);
 /* The maps; only while tracing is stopped (after trace_all or stop). */
 const ps_photon_map *ps_session_maps(const ps_session *s);
+/* The maps under the feed's lock, while tracing may go on (a script's dump
+ * photons); unlock soon. */
+const ps_photon_map *ps_session_lock_maps(ps_session *s);
+void ps_session_unlock_maps(ps_session *s);
+/* What the last ps_session_update did: whether it repaired (else restarted),
+ * and per map the photon indices kept and those to retrace. */
+void ps_session_repair_counts(const ps_session *s, bool *repaired, uint64_t kept[PS_MAP_COUNT],
+                              uint64_t retraced[PS_MAP_COUNT]);
 
 #endif

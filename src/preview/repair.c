@@ -1,0 +1,139 @@
+/* repair.c: which photons an edit keeps (repair.h). */
+#include "preview/repair.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+ps_status ps_repair_state_take(const ps_scene *scene, double epsilon, ps_repair_state *out, ps_error *err)
+{
+    memset(out, 0, sizeof *out);
+    size_t nl, no;
+    const ps_light *L = ps_scene_lights(scene, &nl);
+    const ps_object *O = ps_scene_objects(scene, &no);
+    out->lights = malloc((nl ? nl : 1) * sizeof *out->lights);
+    out->bounds = malloc((no ? no : 1) * sizeof *out->bounds);
+    if (!out->lights || !out->bounds) {
+        ps_repair_state_free(out);
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for the repair's copy of the scene",
+                            ps_scene_path(scene));
+    }
+    if (nl)
+        memcpy(out->lights, L, nl * sizeof *L);
+    for (size_t o = 0; o < no; o++)
+        out->bounds[o] = O[o].bounds;
+    out->light_count = nl;
+    out->object_count = no;
+    out->epsilon = epsilon;
+    return PS_OK;
+}
+
+void ps_repair_state_free(ps_repair_state *st)
+{
+    free(st->lights);
+    free(st->bounds);
+    memset(st, 0, sizeof *st);
+}
+
+ps_aabb ps_repair_record_box(const ps_scene *scene)
+{
+    ps_aabb b = ps_scene_bounds(scene);
+    ps_vec3 e = ps_v3_sub(b.hi, b.lo);
+    double m = e.x > e.y ? e.x : e.y;
+    m = m > e.z ? m : e.z;
+    if (!(m > 0.0))
+        m = 1.0;
+    ps_vec3 w = ps_v3(m, m, m);
+    ps_aabb r = {ps_v3_sub(b.lo, w), ps_v3_add(b.hi, w)};
+    return r;
+}
+
+typedef struct keep_ctx {
+    ps_tracer *old_tracer, *new_tracer;
+    uint64_t cap[PS_MAP_COUNT];
+    bool *light_changed;
+    size_t light_count;
+    ps_aabb *moved; /* old and new box of each moved object */
+    size_t moved_count;
+    ps_path_quant quant;
+    ps_source_match match[PS_MAP_COUNT];
+} keep_ctx;
+
+static bool keep(void *arg, ps_map_kind k, uint64_t i, const ps_path_store *paths, const ps_path_rec *rec)
+{
+    keep_ctx *c = arg;
+    uint32_t light;
+    if (c->match[k] == PS_SOURCES_NONE)
+        return false;
+    if (c->match[k] == PS_SOURCES_SAME)
+        light = ps_tracer_photon_light(c->old_tracer, k, i, c->cap[k]);
+    else if (!ps_tracer_same_source(c->old_tracer, c->new_tracer, k, i, c->cap[k], &light))
+        return false;
+    if (light < c->light_count && c->light_changed[light])
+        return false;
+    for (size_t m = 0; m < c->moved_count; m++)
+        if (ps_path_meets(paths, rec, &c->quant, c->moved[m]))
+            return false;
+    return true;
+}
+
+static bool inside(ps_aabb b, ps_aabb box, double margin)
+{
+    return b.lo.x - margin >= box.lo.x && b.lo.y - margin >= box.lo.y && b.lo.z - margin >= box.lo.z &&
+           b.hi.x + margin <= box.hi.x && b.hi.y + margin <= box.hi.y && b.hi.z + margin <= box.hi.z;
+}
+
+ps_status ps_repair_feed(ps_feed *old, ps_tracer *old_tracer, ps_tracer *new_tracer, const ps_repair_state *was,
+                         const ps_scene *scene, double epsilon, ps_feed **out, bool *repaired, ps_error *err)
+{
+    *out = NULL;
+    *repaired = false;
+    size_t nl, no;
+    const ps_light *L = ps_scene_lights(scene, &nl);
+    const ps_object *O = ps_scene_objects(scene, &no);
+    if (!old || !old_tracer || !ps_feed_repairable(old) || !ps_tracer_records(new_tracer) ||
+        nl != was->light_count || no != was->object_count || epsilon != was->epsilon)
+        return PS_OK;
+    keep_ctx c;
+    memset(&c, 0, sizeof c);
+    c.old_tracer = old_tracer;
+    c.new_tracer = new_tracer;
+    c.quant = ps_tracer_path_quant(new_tracer);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        if (ps_tracer_map_enabled(old_tracer, (ps_map_kind)k) != ps_tracer_map_enabled(new_tracer, (ps_map_kind)k))
+            return PS_OK;
+        c.cap[k] = ps_feed_cap(old, (ps_map_kind)k);
+        c.match[k] = ps_tracer_match_sources(old_tracer, new_tracer, (ps_map_kind)k, c.cap[k]);
+    }
+    c.light_changed = calloc(nl ? nl : 1, sizeof *c.light_changed);
+    c.moved = malloc(2 * (no ? no : 1) * sizeof *c.moved);
+    if (!c.light_changed || !c.moved) {
+        free(c.light_changed);
+        free(c.moved);
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for a repair", ps_scene_path(scene));
+    }
+    c.light_count = nl;
+    bool fits = true;
+    for (size_t o = 0; o < no; o++) {
+        if (memcmp(&O[o].bounds, &was->bounds[o], sizeof O[o].bounds) == 0)
+            continue;
+        c.moved[c.moved_count++] = was->bounds[o];
+        c.moved[c.moved_count++] = O[o].bounds;
+        fits = fits && inside(was->bounds[o], c.quant.box, c.quant.margin) &&
+               inside(O[o].bounds, c.quant.box, c.quant.margin);
+        /* A mesh light's faces move with its object: its emission changes. */
+        for (size_t l = 0; l < nl; l++)
+            if (L[l].type == PS_LIGHT_MESH && L[l].object == o)
+                c.light_changed[l] = true;
+    }
+    for (size_t l = 0; l < nl; l++)
+        if (memcmp(&L[l], &was->lights[l], sizeof L[l]) != 0)
+            c.light_changed[l] = true;
+    ps_status st = PS_OK;
+    if (fits) {
+        st = ps_feed_create_repair(new_tracer, old, keep, &c, out, err);
+        *repaired = st == PS_OK;
+    }
+    free(c.light_changed);
+    free(c.moved);
+    return st;
+}
