@@ -252,8 +252,8 @@ static uint32_t z_side(const ps_camera_frame *cam, int *key_bits)
 #define PS_PREFETCH_WRITE(addr) ((void)(addr))
 #endif
 #define SORT_DIGIT_BITS 11
-/* The screen's 4 x 4 tiles are the Z-order's first 4 bits (splat.h). */
-#define REGION_BITS 4
+/* The screen's tiles are the Z-order's first bits (splat.h). */
+#define REGION_BITS PS_SPLAT_DIFFUSION_REGION_BITS
 
 /* Jobs 0..count-1 on up to `threads` threads (0: one a core), dealt
  * round-robin; what a job does never depends on which thread runs it. */
@@ -320,15 +320,16 @@ static unsigned region_of(const diffusion *d, uint64_t entry)
 }
 
 /* Bucket pass, one build range: its splats into their regions' slices of t,
- * in order (stable). */
+ * in order (stable), each key joined by the splat's final place. */
 static void bucket_range(void *ctx, size_t k)
 {
     diffusion *d = ctx;
     size_t base[PS_SPLAT_DIFFUSION_REGIONS];
     memcpy(base, d->range_base[k], sizeof base);
-    const uint64_t *a = d->a + d->range_at[k];
-    for (size_t i = 0; i < d->range_n[k]; i++)
-        d->t[base[region_of(d, a[i])]++] = a[i];
+    size_t at = d->range_at[k];
+    const uint64_t *a = d->a + at;
+    for (size_t i = 0; i < d->range_n[k]; i++) /* with its place, the sort's tie-break */
+        d->t[base[region_of(d, a[i])]++] = a[i] | (uint64_t)(at + i);
 }
 
 /* One region: the rest of the key sorted (LSD radix, stable), then each
@@ -618,8 +619,6 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
                 memmove(b->order + (at - first_splat), b->order + (from - first_splat), n * sizeof *b->order);
         }
         if (diffuse) {
-            for (size_t q = 0; q < n; q++)
-                b->order[at - first_splat + q] |= (uint64_t)(at - first_splat + q);
             range_at[k] = at - first_splat;
             range_n[k] = n;
             memcpy(range_regions[k], R[k].regions, sizeof R[k].regions);

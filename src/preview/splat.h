@@ -129,8 +129,11 @@ static inline unsigned ps_splat_stencil(uint32_t object) { return object % (PS_S
 #define PS_SPLAT_SPRITE_MAX_TAN 10.0
 
 /* Error diffusion carries round-off along a Z-order curve over the screen,
- * in this many tiles (4 x 4), each with a carry of its own (splat.c). */
-#define PS_SPLAT_DIFFUSION_REGIONS 16
+ * in 2^PS_SPLAT_DIFFUSION_REGION_BITS tiles (16 x 16), each with a carry of
+ * its own (splat.c): enough that the cores share even a caustic that covers
+ * a few tiles. */
+#define PS_SPLAT_DIFFUSION_REGION_BITS 8
+#define PS_SPLAT_DIFFUSION_REGIONS (1 << PS_SPLAT_DIFFUSION_REGION_BITS)
 
 /* Vertex arrays for glDrawArrays, and the precision bookkeeping of the photons
  * that went in. The carry persists across batches of the same map (clear it
