@@ -83,7 +83,7 @@ static const char usage[] =
     "  --tau SECONDS            time between refreshes (default 0.1)\n"
     "  --splat points|triangles|sprites  (default triangles)\n"
     "  --kernel box|cone|gauss|epanechnikov  (default cone)\n"
-    "  --layers LIST            comma list of direct,caustic,global (default all)\n"
+    "  --layers LIST            comma list of direct,caustic,global,specular (default all)\n"
     "  --color-depth 8|float    splat layers' precision (default float)\n"
     "  --precision none|diffusion|counter  8-bit handling (default diffusion)\n"
     "  --counter-threshold F    counter: stop shooting past this round-off (default 0.1)\n"

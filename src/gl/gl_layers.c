@@ -15,7 +15,17 @@ struct ps_gl_layers {
     int width, height;
     bool float_buffers;
     GLuint tex[LAYER_TEX_COUNT], fbo[LAYER_TEX_COUNT], depth_stencil;
+    GLuint extra_tex; /* the specular layer (gl_specular.c), times extra_gain */
+    double extra_gain;
 };
+
+GLuint ps_gl_layers_depth_stencil(const ps_gl_layers *l) { return l->depth_stencil; }
+
+void ps_gl_layers_set_extra(ps_gl_layers *l, GLuint texture, double gain)
+{
+    l->extra_tex = texture;
+    l->extra_gain = gain;
+}
 
 ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_layers **out, ps_error *err)
 {
@@ -181,6 +191,8 @@ static void composite(ps_gl_layers *l, int target, double direct_gain, const dou
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (map_gain[k] > 0.0)
             add_texture(l->tex[LAYER_CAUSTIC_TEX + k], map_gain[k]);
+    if (l->extra_tex && l->extra_gain > 0.0)
+        add_texture(l->extra_tex, l->extra_gain);
     glDisable(GL_FRAMEBUFFER_SRGB);
     glDisable(GL_BLEND);
     glBindTexture(GL_TEXTURE_2D, 0);
