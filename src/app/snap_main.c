@@ -510,6 +510,7 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
     ps_stats_add(&rs, "first_frame_seconds", first_frame);
     /* The splats the picture is made of: drawn over all refreshes into
      * layers, or the last whole frame's. */
+    ps_stats_add(&rs, "specular_cube_faces", (double)ps_gl_specular_faces_rendered(s->spec));
     ps_stats_add(&rs, "splats", (double)(s->layers ? s->splats : s->frame.splats));
     ps_stats_add(&rs, "kernel_mean", ps_session_kernel(s->session)->mean);
     ps_stats_add(&rs, "caustic_radius", ps_session_radius(s->session, PS_MAP_CAUSTIC));

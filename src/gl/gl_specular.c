@@ -1,8 +1,11 @@
 /* gl_specular.c: the specular layer's cube maps and lookups (gl_specular.h). */
 #include "gl/gl_specular.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "core/clock.h"
 
 #include "gl/gl_internal.h"
 
@@ -31,8 +34,11 @@ struct ps_gl_specular {
     unsigned layers;   /* what the cubes were rendered with: the frame's layers */
     uint64_t edits;
     bool frozen;       /* filled by a test: never rendered over */
-    bool cubes_changed;
+    bool cubes_changed;  /* a cube completed (or all faces drawn): the layer to redraw */
     unsigned faces_rendered;
+    /* The time budget: seconds a face took (the last one, finished), and
+     * the share of tau saved up for the next. */
+    double face_seconds, credit;
     /* The layered path's texture. */
     GLuint layer_tex, layer_fbo;
     int layer_w, layer_h;
@@ -145,6 +151,7 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
     /* The shadow maps hold every object: made before the objects are left out. */
     if (fr->direct && r->opt.shadows && !r->shadows_valid)
         ps_gl_make_shadow_maps(r);
+
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, g->cube[c], 0);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, g->depth_stencil);
@@ -184,6 +191,15 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     if (settled && g->since_settled >= total && g->since_change >= total)
         return PS_OK;
     int n = faces <= 0 || faces > total ? total : faces;
+    if (faces > 0) {
+        /* A face only when the refreshes' share of tau has saved up for one
+         * (it took face_seconds last time; the first comes at once). */
+        g->credit = fmin(g->credit + PS_GL_SPECULAR_TIME_SHARE * ps_session_get_settings(s)->tau,
+                         fmax(g->face_seconds, PS_GL_SPECULAR_TIME_SHARE * ps_session_get_settings(s)->tau));
+        if (g->credit < g->face_seconds)
+            return PS_OK;
+        g->credit -= g->face_seconds;
+    }
     GLint old_fbo = 0, vp[4];
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glGetIntegerv(GL_VIEWPORT, vp);
@@ -193,13 +209,20 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     int width = r->width, height = r->height;
     double eye_extent = r->eye_extent;
     ps_status st = PS_OK;
+    double t0 = ps_now_seconds();
     for (int i = 0; i < n && st == PS_OK; i++) {
         st = render_face(g, r, s, f, g->cursor / 6, g->cursor % 6, err);
         g->cursor = (g->cursor + 1) % total;
+        /* The layer is redrawn when a cube is whole again, not each face. */
+        if (g->cursor % 6 == 0)
+            g->cubes_changed = true;
+    }
+    if (faces > 0) {
+        glFinish(); /* llvmpipe draws when flushed: the face's own time */
+        g->face_seconds = (ps_now_seconds() - t0) / n;
     }
     g->since_change += n;
     g->since_settled = settled ? g->since_settled + n : 0;
-    g->cubes_changed = true;
     /* Back to the view. */
     memcpy(r->view, view, sizeof view);
     memcpy(r->proj, proj, sizeof proj);

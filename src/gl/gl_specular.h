@@ -9,8 +9,10 @@
  * photons so far, at most PS_GL_SPECULAR_ENV_PHOTONS a map, a prefix with
  * the level of detail's grown radius), every mirror and glass object left
  * out (the lookups trace through them on the CPU), at exposure 1: radiance.
- * Faces are refreshed round-robin, a few a refresh while photons arrive
- * (all at once for a single frame and a snapshot's last picture), and kept
+ * Faces are refreshed round-robin while photons arrive, as
+ * PS_GL_SPECULAR_TIME_SHARE of tau allows (a face every few refreshes, the
+ * first one at the first refresh), all at once for a single frame and a snapshot's last
+ * picture; the objects are redrawn when a cube is whole again. They are kept
  * while only the camera moves; a new layer set, an edit or new GL lights
  * start a new round. The objects are then drawn PS_SPECULAR_TERMS times,
  * each pass one lookup direction (texture coordinates into the object's
@@ -22,8 +24,10 @@
 #include "preview/specular.h"
 
 #define PS_GL_SPECULAR_CUBE_SIZE 128
-#define PS_GL_SPECULAR_FACES_PER_REFRESH 2
-#define PS_GL_SPECULAR_ENV_PHOTONS 65536
+#define PS_GL_SPECULAR_FACES_PER_REFRESH 1
+/* Past the first round, faces take at most this share of tau on average. */
+#define PS_GL_SPECULAR_TIME_SHARE 0.15
+#define PS_GL_SPECULAR_ENV_PHOTONS 16384
 
 typedef struct ps_gl_specular ps_gl_specular;
 

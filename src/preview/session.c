@@ -667,9 +667,10 @@ ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_fr
         ps_splat_params p;
         memset(&p, 0, sizeof p);
         p.mode = PS_SPLAT_TRIANGLES;
-        /* The level of detail's cover: as many photons' worth as have arrived. */
-        double arrived = (double)mk[nm - 1].emitted;
-        p.radius = radius_at(s, k, emitted) * fmin(PS_RADIUS_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
+        /* The radius of the photons used (under the schedule), not grown to
+         * cover for the ones left out: a grown global splat would fill much
+         * of a cube face, and the fill is what a face costs. */
+        p.radius = radius_at(s, k, emitted);
         p.kernel_mean = s->kernel.mean;
         p.kernel_extent = s->kernel.extent;
         p.scale = (double)s->set.caps[k] / (double)emitted; /* radiance: exposure 1 */
