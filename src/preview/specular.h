@@ -44,7 +44,7 @@
 #define PS_SPECULAR_TERMS 4
 /* Surfaces one eye path meets at most (the reference's own bound is 16;
  * past 8 mirror or glass bounces little weight is left). */
-#define PS_SPECULAR_MAX_DEPTH 8
+#define PS_SPECULAR_MAX_DEPTH 16
 /* Paths with less weight than this (of a unit eye ray) are not followed. */
 #define PS_SPECULAR_MIN_WEIGHT 1e-4
 /* Paths collected a vertex before the heaviest are kept. */
