@@ -85,13 +85,14 @@ static void glass_sphere_keeps_energy(void **state)
     const ps_material *glass = material(&r, "glass");
     ps_vec3 eye = ps_v3(0, 0, 3);
     for (int i = 0; i <= 20; i++) {
-        double a = 1.5 * i / 20.0; /* from the pole facing the eye to near grazing */
+        double a = 1.35 * i / 20.0; /* from the pole facing the eye to near its silhouette (1.40) */
         ps_vec3 n = ps_v3(sin(a), 0.0, cos(a));
         ps_vec3 p = ps_v3_scale(n, 0.5);
         ps_specular_term t[PS_SPECULAR_TERMS];
         double dropped;
         int k = ps_specular_trace_point(r.world, r.mats, glass, eye, p, n, ps_v3(0, 0, 0), t, &dropped);
-        assert_true(k >= 2);
+        if (k < 2)
+            fail_msg("angle %g: %d terms", a, k);
         double sum = dropped;
         for (int j = 0; j < k; j++)
             sum += t[j].weight.r;
