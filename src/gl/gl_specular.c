@@ -255,7 +255,8 @@ static const float *weights(ps_gl_specular *g, const ps_specular *sp, int k, siz
     return g->scaled;
 }
 
-void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure)
+/* The first `terms` lookups of every vertex (the heaviest first). */
+static void draw_terms(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure, int terms)
 {
     ps_specular *sp = ps_session_specular(s);
     const ps_preview_mesh *mesh = ps_session_mesh(s);
@@ -283,7 +284,7 @@ void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, do
     glEnableClientState(GL_VERTEX_ARRAY);
     glEnableClientState(GL_COLOR_ARRAY);
     glEnableClientState(GL_TEXTURE_COORD_ARRAY);
-    for (int k = 0; k < PS_SPECULAR_TERMS; k++) {
+    for (int k = 0; k < terms; k++) {
         const float *w = weights(g, sp, k, n, exposure);
         const float *d = ps_specular_dirs(sp, k);
         for (size_t i = 0; i < nr; i++) {
@@ -303,6 +304,11 @@ void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, do
     glDisable(GL_TEXTURE_CUBE_MAP);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
+}
+
+void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure)
+{
+    draw_terms(g, r, s, exposure, PS_SPECULAR_TERMS);
 }
 
 ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_renderer *r, ps_session *s,
@@ -341,7 +347,9 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         glClearColor(0, 0, 0, 0);
         glClear(GL_COLOR_BUFFER_BIT); /* colour only: the depth is the view's prepass */
-        ps_gl_specular_draw(g, r, s, f->direct_exposure);
+        /* A moving camera's level of detail: the heaviest lookup only (one
+         * pass instead of PS_SPECULAR_TERMS); all again once it stops. */
+        draw_terms(g, r, s, f->direct_exposure, f->moving ? 1 : PS_SPECULAR_TERMS);
         glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
         g->cubes_changed = false;
         g->layer_valid = true;

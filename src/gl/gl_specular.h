@@ -45,8 +45,9 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
 void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure);
 /* The layered path (the window, snap --time in float): the specular layer
  * as a texture of l's size sharing l's depth, redrawn when the cubes, the
- * lookups or the view changed, and added to l's composite times f's direct
- * gain (0 when f does not show it). */
+ * lookups or the view changed (while the camera moves, with the heaviest
+ * lookup only: one pass instead of PS_SPECULAR_TERMS), and added to l's
+ * composite times f's direct gain (0 when f does not show it). */
 ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_renderer *r, ps_session *s,
                                const ps_session_frame *f, ps_error *err);
 /* The layer's weight in l's composite: the gain, or 0 to leave it out (a

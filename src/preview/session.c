@@ -405,11 +405,12 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     if (st != PS_OK)
         return st;
     out->direct = (s->set.layers & PS_LAYER_DIRECT) != 0;
-    /* The specular layer: its lookups for this eye (all at once: about
-     * 0.1 s for the default scene's two spheres, docs/preview.md). */
+    /* The specular layer: its lookups for this eye, in incremental sessions
+     * (the window) at most PS_SESSION_SPECULAR_VERTICES a refresh, the rest
+     * in the next ones (the default scene's two spheres: 10^4, 12 ms). */
     out->specular = (s->set.layers & PS_LAYER_SPECULAR) && !s->illuminance && ps_specular_range_count(s->spec) > 0;
     if (out->specular)
-        ps_specular_update(s->spec, s->world, cam->eye, 0);
+        ps_specular_update(s->spec, s->world, cam->eye, inc ? PS_SESSION_SPECULAR_VERTICES : 0);
     out->direct_exposure = inc ? 1.0 : exposure(s);
     out->direct_gain = inc ? exposure(s) : 1.0;
     out->splat = s->set.splat;

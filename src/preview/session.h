@@ -59,6 +59,9 @@
  * most PS_RADIUS_GROWTH_MAX) so that the fewer photons still cover; the
  * first refresh with the camera still starts the view over in full. */
 #define PS_SESSION_MOVING_SHARE 0.25
+/* The specular layer's eye paths an incremental refresh traces at most
+ * (distinct vertices of mirrors and glass; preview/specular.h). */
+#define PS_SESSION_SPECULAR_VERTICES 32768
 
 typedef struct ps_session_settings {
     /* The photons. */
