@@ -190,8 +190,10 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     /* Settled (every photon drawn) and a whole round done since: nothing new. */
     if (settled && g->since_settled >= total && g->since_change >= total)
         return PS_OK;
-    int n = faces <= 0 || faces > total ? total : faces;
-    if (faces > 0) {
+    /* Settled (every photon drawn, nothing else to show): the round is
+     * finished at once, so that the picture is whole as a snapshot's. */
+    int n = faces <= 0 || faces > total || settled ? total : faces;
+    if (faces > 0 && !settled) {
         /* A face only when the refreshes' share of tau has saved up for one
          * (it took face_seconds last time; the first comes at once). */
         g->credit = fmin(g->credit + PS_GL_SPECULAR_TIME_SHARE * ps_session_get_settings(s)->tau,
