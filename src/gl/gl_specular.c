@@ -39,6 +39,7 @@ struct ps_gl_specular {
     /* The time budget: seconds a face took (the last one, finished), and
      * the share of tau saved up for the next. */
     double face_seconds, credit;
+    uint64_t arrived; /* photons emitted (both maps) when last looked */
     /* The layered path's texture. */
     GLuint layer_tex, layer_fbo;
     int layer_w, layer_h;
@@ -186,13 +187,25 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
         g->edits = ps_session_edits(s);
         g->since_change = g->since_settled = 0;
     }
-    bool settled = ps_session_settled(s);
-    /* Settled (every photon drawn) and a whole round done since: nothing new. */
+    /* Settled: every photon has arrived (the feed ended; a new view of the
+     * same photons changes no cube), and since the last arrived a whole
+     * round was drawn: nothing new to show. */
+    ps_session_counts counts;
+    ps_session_get_counts(s, &counts);
+    uint64_t arrived = counts.map[0].emitted + counts.map[1].emitted;
+    if (arrived != g->arrived || !counts.ended) {
+        g->arrived = arrived;
+        g->since_settled = 0;
+    }
+    bool settled = counts.ended;
     if (settled && g->since_settled >= total && g->since_change >= total)
         return PS_OK;
-    /* Settled (every photon drawn, nothing else to show): the round is
-     * finished at once, so that the picture is whole as a snapshot's. */
-    int n = faces <= 0 || faces > total || settled ? total : faces;
+    /* Settled but not yet drawn from the last photons: the round is finished
+     * over the next PS_GL_SPECULAR_SETTLE_REFRESHES refreshes whatever the
+     * budget, so that the picture is soon whole as a snapshot's. */
+    int n = faces <= 0 || faces > total ? total
+            : settled ? (total + PS_GL_SPECULAR_SETTLE_REFRESHES - 1) / PS_GL_SPECULAR_SETTLE_REFRESHES
+                      : faces;
     if (faces > 0 && !settled) {
         /* A face only when the refreshes' share of tau has saved up for one
          * (it took face_seconds last time; the first comes at once). */
@@ -224,7 +237,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
         g->face_seconds = (ps_now_seconds() - t0) / n;
     }
     g->since_change += n;
-    g->since_settled = settled ? g->since_settled + n : 0;
+    g->since_settled += n;
     /* Back to the view. */
     memcpy(r->view, view, sizeof view);
     memcpy(r->proj, proj, sizeof proj);

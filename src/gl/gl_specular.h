@@ -11,7 +11,8 @@
  * out (the lookups trace through them on the CPU), at exposure 1: radiance.
  * Faces are refreshed round-robin while photons arrive, as
  * PS_GL_SPECULAR_TIME_SHARE of tau allows (a face every few refreshes, the
- * first one at the first refresh), all at once for a single frame and a snapshot's last
+ * first one at the first refresh), the last round once they all arrived
+ * over a few refreshes whatever the budget, all at once for a single frame and a snapshot's last
  * picture; the objects are redrawn when a cube is whole again. They are kept
  * while only the camera moves; a new layer set, an edit or new GL lights
  * start a new round. The objects are then drawn PS_SPECULAR_TERMS times,
@@ -27,7 +28,10 @@
 #define PS_GL_SPECULAR_FACES_PER_REFRESH 1
 /* Past the first round, faces take at most this share of tau on average. */
 #define PS_GL_SPECULAR_TIME_SHARE 0.15
-#define PS_GL_SPECULAR_ENV_PHOTONS 16384
+#define PS_GL_SPECULAR_ENV_PHOTONS 8192
+/* Once every photon has arrived, the last round is drawn over this many
+ * refreshes, budget or not. */
+#define PS_GL_SPECULAR_SETTLE_REFRESHES 4
 
 typedef struct ps_gl_specular ps_gl_specular;
 
