@@ -668,10 +668,14 @@ ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_fr
         ps_splat_params p;
         memset(&p, 0, sizeof p);
         p.mode = PS_SPLAT_TRIANGLES;
-        /* The radius of the photons used (under the schedule), not grown to
-         * cover for the ones left out: a grown global splat would fill much
-         * of a cube face, and the fill is what a face costs. */
-        p.radius = radius_at(s, k, emitted);
+        /* The level of detail's cover for the photons left out, grown by
+         * sqrt(arrived / used) (at most PS_RADIUS_GROWTH_MAX), but never past
+         * the larger of the two maps' own radii: a grown global splat would
+         * fill much of a cube face, and the fill is what a face costs. */
+        double arrived = (double)mk[nm - 1].emitted;
+        double grown = radius_at(s, k, emitted) * fmin(PS_RADIUS_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
+        double largest = fmax(s->splat_radius[PS_MAP_CAUSTIC], s->splat_radius[PS_MAP_GLOBAL]);
+        p.radius = fmax(radius_at(s, k, emitted), fmin(grown, largest));
         p.kernel_mean = s->kernel.mean;
         p.kernel_extent = s->kernel.extent;
         p.scale = (double)s->set.caps[k] / (double)emitted; /* radiance: exposure 1 */

@@ -245,8 +245,9 @@ struct ps_specular *ps_session_specular(ps_session *s);
 /* For the specular layer's cube maps: map k's photons so far (at most
  * max_photons, a prefix ending at a feed mark, scaled by N / n to radiance
  * at exposure 1) as triangle splats seen from `view` (photons behind its eye
- * plane are left out), at the radius of that many photons (the schedule's);
- * *radius: that radius. Empty when map k's layer is off. Briefly holds the
+ * plane are left out), at the radius of that many photons (the schedule's)
+ * grown by sqrt(arrived / drawn) (at most PS_RADIUS_GROWTH_MAX, and never
+ * past the larger map radius); *radius: that radius. Empty when map k's layer is off. Briefly holds the
  * lock. */
 ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_frame *view, size_t max_photons,
                                 ps_splat_batch *b, double *radius, ps_error *err);
