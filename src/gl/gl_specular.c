@@ -206,6 +206,10 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     int n = faces <= 0 || faces > total ? total
             : settled ? (total + PS_GL_SPECULAR_SETTLE_REFRESHES - 1) / PS_GL_SPECULAR_SETTLE_REFRESHES
                       : faces;
+    /* A new view (the first picture, the first after an edit, a moving
+     * camera) comes as soon as without the layer: its faces wait. */
+    if (faces > 0 && f->new_view)
+        return PS_OK;
     if (faces > 0 && !settled) {
         /* A face only when the refreshes' share of tau has saved up for one
          * (it took face_seconds last time; the first comes at once). */

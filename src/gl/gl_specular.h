@@ -11,7 +11,9 @@
  * out (the lookups trace through them on the CPU), at exposure 1: radiance.
  * Faces are refreshed round-robin while photons arrive, as
  * PS_GL_SPECULAR_TIME_SHARE of tau allows (a face every few refreshes, the
- * first one at the first refresh), the last round once they all arrived
+ * first one at the first refresh after a new view, never in one: the first
+ * picture, the first after an edit and a moving camera's come as fast as
+ * without the layer), the last round once they all arrived
  * over a few refreshes whatever the budget, all at once for a single frame and a snapshot's last
  * picture; the objects are redrawn when a cube is whole again. They are kept
  * while only the camera moves; a new layer set, an edit or new GL lights
