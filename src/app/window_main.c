@@ -866,7 +866,10 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
 
 /* Whether a script's wait done is over: everything shown (session.h), and
  * nothing the window itself has still to redraw. */
-static bool script_wait_over(app *a) { return !a->redraw && ps_session_settled(a->session); }
+static bool script_wait_over(app *a)
+{
+    return !a->redraw && ps_session_settled(a->session) && ps_gl_specular_done(a->spec, a->session);
+}
 
 /* ---- the session ---------------------------------------------------------------------- */
 

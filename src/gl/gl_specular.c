@@ -193,11 +193,12 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     ps_session_counts counts;
     ps_session_get_counts(s, &counts);
     uint64_t arrived = counts.map[0].emitted + counts.map[1].emitted;
-    if (arrived != g->arrived || !counts.ended) {
+    /* Held for good (paused, or the error counter stopped it): as ended. */
+    bool settled = counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL);
+    if (arrived != g->arrived || !settled) {
         g->arrived = arrived;
         g->since_settled = 0;
     }
-    bool settled = counts.ended;
     if (settled && g->since_settled >= total && g->since_change >= total)
         return PS_OK;
     /* Settled but not yet drawn from the last photons: the round is finished
@@ -254,6 +255,22 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     glMatrixMode(GL_MODELVIEW);
     glLoadMatrixd(r->view);
     return st;
+}
+
+bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s)
+{
+    unsigned layers = ps_session_get_settings(s)->layers;
+    int cubes = ps_specular_cube_count(ps_session_specular(s));
+    if (g->frozen || !(layers & PS_LAYER_SPECULAR) || ps_session_illuminance(s) || cubes == 0)
+        return true;
+    if (g->cube_count != cubes || g->layers != layers || g->edits != ps_session_edits(s) || g->cubes_changed)
+        return false;
+    ps_session_counts counts;
+    ps_session_get_counts(s, &counts);
+    int total = 6 * cubes;
+    bool settled = counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL);
+    return settled && counts.map[0].emitted + counts.map[1].emitted == g->arrived && g->since_settled >= total &&
+           g->since_change >= total;
 }
 
 /* The weights of term k times exposure (the arrays as they are at 1). */
