@@ -385,7 +385,8 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
         glClear(GL_COLOR_BUFFER_BIT); /* colour only: the depth is the view's prepass */
         /* A moving camera's level of detail: the heaviest lookup only (one
          * pass instead of PS_SPECULAR_TERMS); all again once it stops. */
-        draw_terms(g, r, s, f->direct_exposure, f->moving ? 1 : PS_SPECULAR_TERMS);
+        if (g->faces_rendered > 0 || g->frozen) /* black cubes draw black: the first picture saves them */
+            draw_terms(g, r, s, f->direct_exposure, f->moving ? 1 : PS_SPECULAR_TERMS);
         glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
         g->cubes_changed = false;
         g->layer_valid = true;
