@@ -7,7 +7,8 @@
 # first refreshed frame. Each run is made twice, the picture composited and
 # encoded by GL (the window's default) and, as the baseline measured in the
 # same run, read back and encoded on the CPU (--composite cpu): the last
-# column says what the GL side saves a refresh. Prints Markdown tables; the
+# column says what the GL side saves a refresh; then the still view with the
+# specular layer on and off. Prints Markdown tables; the
 # figures come from the window's own --stats.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -57,6 +58,20 @@ for n in 100000 1000000; do
             "$(ms "$(stat_of composite_seconds_mean "$f")")" "$(ms "$(stat_of composite_seconds_mean "$c")")" \
             "$(stat_of fps "$c")"
     done
+done
+echo
+# The specular layer's cost (issue 15): the same still view with it on and
+# off, in the same run; its cube faces are drawn within a share of tau.
+echo "| layers | fps (still, 10^6 + 2.5 10^5) | frames | first frame s |"
+echo "| --- | ---: | ---: | ---: |"
+for layers in direct,caustic,global direct,caustic,global,specular; do
+    printf '4.5 quit\n' >"$tmp/spec.txt"
+    xvfb-run -a -s "-screen 0 1024x768x24" bin/photosplat "$scene" --size 512x512 --exposure 0.3 --overlay off \
+        --caustic-photons 1000000 --global-photons 250000 --script "$tmp/spec.txt" --layers "$layers" \
+        --stats "$tmp/spec-$layers.json" >/dev/null
+    f=$tmp/spec-$layers.json
+    printf '| %s | %.1f | %s | %.3f |\n' "$layers" "$(stat_of fps "$f")" "$(stat_of frames "$f")" \
+        "$(stat_of first_frame_seconds "$f")"
 done
 echo
 echo "| light moves | first frame after a move, mean s | max s | mean s (CPU read-back) | tau s |"

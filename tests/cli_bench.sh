@@ -27,24 +27,26 @@ expect_usage_error "bad alpha" "$snap" "$mirror" -o "$cli_tmp/x.png" --radius-al
 # ---- snap: layers alone add up to the picture (float buffer: no rounding) --------
 expect_success "layers" "$snap" "$mirror" --size 32x32 --color-depth float --caustic-photons 20000 \
     --hdr "$cli_tmp/w.pfm" --hdr-layers "$cli_tmp/l"
-for l in direct caustic global; do
+for l in direct caustic global specular; do
     [ "$(head -2 "$cli_tmp/l-$l.pfm" 2>/dev/null | tr '\n' ' ')" = "PF 32 32 " ] && ok || bad "no 32x32 l-$l.pfm"
 done
 whole=$(mean_of "$cli_tmp/w.pfm")
 sum=$(awk -v a="$(mean_of "$cli_tmp/l-direct.pfm")" -v b="$(mean_of "$cli_tmp/l-caustic.pfm")" \
-    -v c="$(mean_of "$cli_tmp/l-global.pfm")" 'BEGIN { print a + b + c }')
+    -v c="$(mean_of "$cli_tmp/l-global.pfm")" -v d="$(mean_of "$cli_tmp/l-specular.pfm")" 'BEGIN { print a + b + c + d }')
 awk_true "$whole > 0 && ($sum - $whole) / $whole < 1e-4 && ($whole - $sum) / $whole < 1e-4" &&
     ok || bad "layers' means add to $sum, the picture's is $whole"
 # The mirror scene has no global photons: that layer is black; the caustic is not.
 awk_true "$(mean_of "$cli_tmp/l-global.pfm") == 0" && ok || bad "global layer not black"
 awk_true "$(mean_of "$cli_tmp/l-caustic.pfm") > 0" && ok || bad "caustic layer black"
+# Nor does the camera see its mirror (above the picture): the specular layer is black.
+awk_true "$(mean_of "$cli_tmp/l-specular.pfm") == 0" && ok || bad "specular layer not black"
 
 # ---- snap: checkpoints and the progressive radius --------------------------------
 expect_success "checkpoints" "$snap" "$mirror" --size 32x32 --time 1.5 --tau 0.05 --checkpoints 0.1,0.5,1.5 \
     --checkpoint-prefix "$cli_tmp/cp" --caustic-photons 20000000 --radius-schedule progressive
 [ "$(wc -l <"$cli_tmp/cp.csv")" = 4 ] && ok || bad "cp.csv: $(wc -l <"$cli_tmp/cp.csv") lines, expected 4"
 for i in 0 1 2; do
-    for s in "" -direct -caustic -global; do
+    for s in "" -direct -caustic -global -specular; do
         [ -s "$cli_tmp/cp-$i$s.pfm" ] && ok || bad "no checkpoint image cp-$i$s.pfm"
     done
 done

@@ -70,7 +70,9 @@ grep -q '"emitted_caustic": 0,' "$cli_tmp/d.json" && ok || bad "a hidden layer's
 # Golden pictures (scripts/regen-golden.sh remakes them, on purpose only).
 # llvmpipe is deterministic, so the tolerance only absorbs rounding: an RMSE
 # of 2 codes in 255 on the stored values.
-for mode in triangles points; do
+# (specular: --layers direct,specular, the direct light seen in the mirror and
+# through the glass.)
+for mode in triangles points specular; do
     golden=tests/data/golden/cornell-caustic-snap-$mode
     # shellcheck disable=SC2046
     expect_success "golden $mode" "$snap" $(cut -d" " -f2- "$golden.args") -o "$cli_tmp/g-$mode.png"

@@ -43,7 +43,11 @@ expect_success "session with waits" xrun "$win" "$scene" "${common[@]}" --script
 s=$cli_tmp/wait.json
 diff=$("$bin/photosplat-compare" "$cli_tmp/b.png" "$cli_tmp/a.png")
 echo "after the caps, moved away and back: $diff"
-[[ $diff == rmse=0\ * ]] && ok || bad "the picture after moving back differs: $diff"
+# The same picture, but for the specular layer's eye paths, which follow the
+# glass sphere's centre to its last bit (0.35 + 0.1 - 0.1 is 0.34999999999999996)
+# and may branch otherwise at a vertex: a code or so in a few pixels.
+rmse=$(sed -n 's/^rmse=\([^ ]*\).*/\1/p' <<<"$diff")
+awk_true "$rmse < 1.0 / 255" && ok || bad "the picture after moving back differs: $diff"
 early=$("$bin/photosplat-compare" "$cli_tmp/first.png" "$cli_tmp/a.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
 echo "the first refresh against the capped picture: rmse $early"
 awk_true "$early > 0.001" && ok || bad "wait done did not wait: the first refresh already equals it (rmse $early)"

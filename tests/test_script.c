@@ -451,7 +451,7 @@ static const bad_case BAD[] = {
     {"0 set layers ,\n", PS_ERR_PARSE, "s.txt:1: set layers: empty name in the list"},
     {"0 set layers direct,\n", PS_ERR_PARSE, "s.txt:1: set layers: empty name in the list"},
     {"0 set layers direct,,global\n", PS_ERR_PARSE, "s.txt:1: set layers: empty name in the list"},
-    {"0 set layers direct,specular\n", PS_ERR_PARSE, "s.txt:1: set layers: 'specular' is not direct, caustic or global"},
+    {"0 set layers direct,glossy\n", PS_ERR_PARSE, "s.txt:1: set layers: 'glossy' is not direct, caustic, global or specular"},
     {"0 set layers caustic,caustic\n", PS_ERR_PARSE, "s.txt:1: set layers: 'caustic' given twice"},
     {"0 set radius 0\n", PS_ERR_PARSE, "s.txt:1: set radius: '0' must be a number > 0"},
     {"0 set radius 0.1 -0.2\n", PS_ERR_PARSE, "s.txt:1: set radius: '-0.2' must be a number > 0"},

@@ -63,7 +63,7 @@ bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_
  * cap of each map planned as the preview's, exposure as given. The program
  * sets what only it knows (threads, incremental, shadow size, cancel). */
 ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_preview_options *o, const ps_scene *s);
-/* "direct,caustic,global" (any non-empty subset) to PS_LAYER_* bits. */
+/* "direct,caustic,global,specular" (any non-empty subset) to PS_LAYER_* bits. */
 ps_status ps_parse_layers(const char *text, const char *prog, unsigned *out, ps_error *err);
 
 /* --illuminance (a one-channel PFM or EXR of lux) and --false-color (its

@@ -15,6 +15,7 @@
 #include "app/stats.h"
 #include "core/fileio.h"
 #include "gl/gl_render.h"
+#include "gl/gl_specular.h"
 #include "image/exr_io.h"
 #include "gl/platform.h"
 #include "preview/script.h"
@@ -50,7 +51,7 @@ static const char usage[] =
     "  --tau SECONDS            time between refreshes (default 0.1)\n"
     "  --splat points|triangles|sprites  splat primitive (default triangles)\n"
     "  --kernel box|cone|gauss|epanechnikov  splat kernel (default cone)\n"
-    "  --layers LIST            comma list of direct,caustic,global (default all)\n"
+    "  --layers LIST            comma list of direct,caustic,global,specular (default all)\n"
     "  --color-depth 8|float    colour buffer precision (default 8)\n"
     "  --precision none|diffusion|counter  8-bit handling (default diffusion)\n"
     "  --counter-threshold F    counter: stop when this fraction rounds away (default 0.1)\n"
@@ -64,7 +65,7 @@ static const char usage[] =
     "  --global-layer splats|maps  the global map as splats, or as illumination maps\n"
     "                           on the surfaces (glossy lobes still splatted) (default splats)\n"
     "  --hdr-layers PREFIX      also each layer alone, linear: PREFIX-direct.pfm,\n"
-    "                           PREFIX-caustic.pfm, PREFIX-global.pfm\n"
+    "                           PREFIX-caustic.pfm, PREFIX-global.pfm, PREFIX-specular.pfm\n"
     "  --checkpoints T1,T2,...  progressive mode: at each of these seconds, write the\n"
     "                           picture and its layers as --checkpoint-prefix P:\n"
     "                           P-I.pfm, P-I-direct.pfm ... and a row of P.csv\n"
@@ -171,6 +172,8 @@ typedef struct snap_run {
     ps_camera_frame cam;
     ps_camera camera;       /* what cam is made of (a script orbits it) */
     ps_session_frame frame; /* the last refresh's */
+    ps_gl_specular *spec;   /* the specular layer's cube maps */
+    bool all_faces;         /* the next refresh renders every cube face (the last picture) */
     uint64_t frames, splats; /* refreshes; splats drawn in all (layers) */
     /* --script: edits applied, and over them the photon indices the repairs
      * kept and retraced, per map (repair.h). */
@@ -190,12 +193,23 @@ static ps_status refresh(snap_run *s, ps_error *err)
     if (st != PS_OK)
         return st;
     double t0 = ps_now_seconds();
+    /* A few cube faces a refresh while photons arrive; all of them for a
+     * single frame and for the last picture. */
+    int faces = s->o->time > 0.0 && !s->all_faces ? PS_GL_SPECULAR_FACES_PER_REFRESH : 0;
+    st = ps_gl_specular_refresh(s->spec, s->gl, s->session, &s->frame, faces, err);
+    if (st != PS_OK)
+        return st;
     if (s->layers) {
         ps_gl_layers_draw(s->layers, s->gl, &s->cam, &s->frame);
+        st = ps_gl_specular_layer(s->spec, s->layers, s->gl, s->session, &s->frame, err);
+        if (st != PS_OK)
+            return st;
         if (s->frame.splats > 0)
             ps_gl_finish(); /* llvmpipe draws when flushed: time the drawing, not the queueing */
     } else {
         ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+        if (s->frame.specular)
+            ps_gl_specular_draw(s->spec, s->gl, s->session, s->frame.direct_exposure);
     }
     double spent = ps_now_seconds() - t0;
     s->splats += s->frame.splats;
@@ -232,8 +246,11 @@ static const bool every_map[PS_MAP_COUNT] = {true, true};
  * again (the layers' composite is read without drawing anything). */
 static void redraw_frame(snap_run *s)
 {
-    if (!s->layers)
+    if (!s->layers) {
         ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+        if (s->frame.specular)
+            ps_gl_specular_draw(s->spec, s->gl, s->session, s->frame.direct_exposure);
+    }
 }
 
 static ps_status write_radiance(snap_run *s, const char *path, ps_error *err)
@@ -253,24 +270,30 @@ static ps_status write_radiance(snap_run *s, const char *path, ps_error *err)
  * frame again after. */
 static ps_status write_layers(snap_run *s, const char *prefix, ps_error *err)
 {
-    static const char *const names[PS_MAP_COUNT] = {"caustic", "global"};
+    static const char *const names[PS_MAP_COUNT + 1] = {"caustic", "global", "specular"};
     const ps_session_frame *f = &s->frame;
     char path[PATH_MAX];
     ps_status st = PS_OK;
-    for (int layer = -1; layer < PS_MAP_COUNT && st == PS_OK; layer++) {
-        /* layer -1: the direct light alone, no splats. */
+    for (int layer = -1; layer <= PS_MAP_COUNT && st == PS_OK; layer++) {
+        /* layer -1: the direct light alone, no splats; PS_MAP_COUNT: the
+         * specular layer alone. */
+        bool specular = layer == PS_MAP_COUNT;
         if (snprintf(path, sizeof path, "%s-%s.pfm", prefix, layer < 0 ? "direct" : names[layer]) >= (int)sizeof path)
             return ps_error_set(err, PS_ERR_IO, "%s: path too long", prefix);
         ps_image img;
         if (s->layers) {
             bool map[PS_MAP_COUNT] = {layer == 0, layer == 1};
+            ps_gl_specular_set_gain(s->spec, s->layers, specular && f->specular ? f->direct_gain : 0.0);
             st = read_picture(s, layer < 0, map, &img, err);
+            ps_gl_specular_set_gain(s->spec, s->layers, f->specular ? f->direct_gain : 0.0);
         } else {
             ps_gl_begin_frame(s->gl, &s->cam, f->direct_exposure, layer < 0 && f->direct);
-            if (layer == PS_MAP_GLOBAL)
+            if (layer == PS_MAP_GLOBAL && !specular)
                 ps_gl_draw_illummap(s->gl, f->imap_colors);
-            if (layer >= 0)
+            if (layer >= 0 && !specular)
                 ps_gl_draw_splats(s->gl, f->map[layer].batch, f->splat, f->map[layer].radius, f->point_size);
+            if (specular && f->specular)
+                ps_gl_specular_draw(s->spec, s->gl, s->session, f->direct_exposure);
             st = ps_platform_read(s->platform, &img, err);
         }
         if (st == PS_OK) {
@@ -464,6 +487,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
      * batches not drawn yet, however many refreshes the budget takes), and
      * the area lights with all their virtual lights. */
     ps_session_full_lights(s->session);
+    s->all_faces = true;
     if (st == PS_OK)
         st = refresh(s, err);
     while (st == PS_OK && s->layers && !ps_session_settled(s->session))
@@ -712,6 +736,7 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
     ps_stats_add(&rs, "first_frame_seconds", first_frame);
     /* The splats the picture is made of: drawn over all refreshes into
      * layers, or the last whole frame's. */
+    ps_stats_add(&rs, "specular_cube_faces", (double)ps_gl_specular_faces_rendered(s->spec));
     ps_stats_add(&rs, "splats", (double)(s->layers ? s->splats : s->frame.splats));
     ps_stats_add(&rs, "kernel_mean", ps_session_kernel(s->session)->mean);
     ps_stats_add(&rs, "caustic_radius", ps_session_radius(s->session, PS_MAP_CAUSTIC));
@@ -787,6 +812,8 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
     }
     if (st == PS_OK && set.incremental)
         st = ps_gl_layers_create(width, height, true, &s.layers, err);
+    if (st == PS_OK)
+        st = ps_gl_specular_create(0, &s.spec, err);
     double t_start = ps_now_seconds(), first_frame = -1.0;
     if (st == PS_OK && o->script) {
         st = run_script(&s, t_start, &first_frame, err);
@@ -812,6 +839,7 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
         st = ps_write_photon_dump(o->c.dump, ps_session_maps(s.session), err);
     if (st == PS_OK)
         st = write_stats_and_report(&s, width, height, t_start, first_frame, err);
+    ps_gl_specular_destroy(s.spec);
     ps_gl_layers_destroy(s.layers);
     ps_gl_renderer_destroy(s.gl);
     ps_session_destroy(s.session);

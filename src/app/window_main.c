@@ -21,6 +21,7 @@
 #include "core/fileio.h"
 #include "gl/gl_font.h"
 #include "gl/gl_render.h"
+#include "gl/gl_specular.h"
 #include "gl/platform.h"
 #include "image/falsecolor.h"
 #include "image/image.h"
@@ -84,7 +85,7 @@ static const char usage[] =
     "  --tau SECONDS            time between refreshes (default 0.1)\n"
     "  --splat points|triangles|sprites  (default triangles)\n"
     "  --kernel box|cone|gauss|epanechnikov  (default cone)\n"
-    "  --layers LIST            comma list of direct,caustic,global (default all)\n"
+    "  --layers LIST            comma list of direct,caustic,global,specular (default all)\n"
     "  --color-depth 8|float    splat layers' precision (default float)\n"
     "  --precision none|diffusion|counter  8-bit handling (default diffusion)\n"
     "  --counter-threshold F    counter: stop shooting past this round-off (default 0.1)\n"
@@ -122,7 +123,7 @@ static const char help_text[] =
     "  [ / ]            selected spot's angle -/+ 2 degrees\n"
     "  S  splat mode     K  kernel        C  precision mode\n"
     "  M                global layer: splats / illumination maps\n"
-    "  1 2 3            direct, caustic, global layer on/off\n"
+    "  1 2 3 4          direct, caustic, global, specular layer on/off\n"
     "  R / Shift+R      splat radius up / down\n"
     "  T / Shift+T      tau up / down\n"
     "  E / Shift+E      exposure up / down\n"
@@ -152,6 +153,7 @@ typedef struct app {
     GLFWwindow *win;
     ps_gl_renderer *gl;
     ps_gl_layers *layers;
+    ps_gl_specular *spec; /* the specular layer's cube maps */
     int width, height;
     ps_camera camera;
     ps_session_frame frame; /* the last refresh's */
@@ -279,6 +281,8 @@ static ps_status open_session(app *a, ps_error *err)
     }
     if (st == PS_OK)
         st = ps_gl_layers_create(a->width, a->height, set.float_buffer, &a->layers, err);
+    if (st == PS_OK)
+        st = ps_gl_specular_create(0, &a->spec, err);
     /* The first batch is traced here, and the thread starts held until the
      * first refresh has drawn it: that refresh (shadow maps, direct light,
      * those splats) then has every core, and the caustic shows at once. */
@@ -322,13 +326,14 @@ static void draw_overlay(app *a)
     int n = snprintf(text, sizeof text,
                      "caustic %llu/%llu  global %llu/%llu  %s\n"
                      "%.3g photons/s  %.1f fps  tau %.3g s  frame %.0f ms\n"
-                     "%s splats  %s kernel  r %.3g/%.3g  layers %s%s%s  global %s  %s  exposure %.3g\n",
+                     "%s splats  %s kernel  r %.3g/%.3g  layers %s%s%s%s  global %s  %s  exposure %.3g\n",
                      (unsigned long long)ce, (unsigned long long)set->caps[0], (unsigned long long)ge,
                      (unsigned long long)set->caps[1], state, rate, a->fps, set->tau, 1000.0 * a->frame_seconds,
                      ps_splat_mode_name(set->splat), ps_kernel_name(set->kernel),
                      ps_session_radius(a->session, PS_MAP_CAUSTIC), ps_session_radius(a->session, PS_MAP_GLOBAL),
                      set->layers & PS_LAYER_DIRECT ? "D" : "-", set->layers & PS_LAYER_CAUSTIC ? "C" : "-",
-                     set->layers & PS_LAYER_GLOBAL ? "G" : "-", ps_global_layer_name(set->global_layer),
+                     set->layers & PS_LAYER_GLOBAL ? "G" : "-", set->layers & PS_LAYER_SPECULAR ? "S" : "-",
+                     ps_global_layer_name(set->global_layer),
                      float_layers ? "float" : ps_precision_name(set->precision),
                      set->exposure);
     if (!float_layers && n > 0 && (size_t)n < sizeof text)
@@ -450,11 +455,18 @@ static ps_status refresh(app *a, ps_error *err)
     }
     if (st != PS_OK)
         return st;
+    /* The specular layer's cube faces, as its time budget allows, before
+     * the view (gl_specular.h); not counted in the splats' drawing time. */
+    st = ps_gl_specular_refresh(a->spec, a->gl, a->session, &a->frame, PS_GL_SPECULAR_FACES_PER_REFRESH, err);
+    if (st != PS_OK)
+        return st;
     double t_draw = ps_now_seconds();
     ps_gl_layers_draw(a->layers, a->gl, &cam, &a->frame);
     if (a->frame.splats > 0)
         ps_gl_finish();
     double draw_seconds = ps_now_seconds() - t_draw;
+    if ((st = ps_gl_specular_layer(a->spec, a->layers, a->gl, a->session, &a->frame, err)) != PS_OK)
+        return st;
     double gains[PS_MAP_COUNT];
     for (int k = 0; k < PS_MAP_COUNT; k++)
         gains[k] = a->frame.map[k].gain;
@@ -760,6 +772,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_1: set_layers(a, set->layers ^ PS_LAYER_DIRECT); break;
     case GLFW_KEY_2: set_layers(a, set->layers ^ PS_LAYER_CAUSTIC); break;
     case GLFW_KEY_3: set_layers(a, set->layers ^ PS_LAYER_GLOBAL); break;
+    case GLFW_KEY_4: set_layers(a, set->layers ^ PS_LAYER_SPECULAR); break;
     case GLFW_KEY_R: scale_radii(a, shift ? 1.0 / KEY_SCALE : KEY_SCALE); break;
     case GLFW_KEY_T: ps_session_set_tau(a->session, fmax(1e-3, set->tau * (shift ? 0.5 : 2.0))); break;
     case GLFW_KEY_E:
@@ -921,7 +934,10 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
 
 /* Whether a script's wait done is over: everything shown (session.h), and
  * nothing the window itself has still to redraw. */
-static bool script_wait_over(app *a) { return !a->redraw && ps_session_settled(a->session); }
+static bool script_wait_over(app *a)
+{
+    return !a->redraw && ps_session_settled(a->session) && ps_gl_specular_done(a->spec, a->session);
+}
 
 /* ---- the session ---------------------------------------------------------------------- */
 
@@ -1134,6 +1150,7 @@ int main(int argc, char **argv)
         st = write_stats(&a, &err);
     uint64_t edits = a.session ? ps_session_edits(a.session) : 0;
     ps_session_destroy(a.session);
+    ps_gl_specular_destroy(a.spec);
     ps_gl_layers_destroy(a.layers);
     ps_gl_renderer_destroy(a.gl);
     ps_platform_close(a.platform);

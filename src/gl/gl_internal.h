@@ -31,6 +31,9 @@ struct ps_gl_renderer {
     GLuint *albedo_tex;
     const struct ps_texture **albedo_src;
     size_t albedo_count;
+    /* Mirrors and glass left out of every mesh pass (the specular layer's
+     * cube maps, gl_specular.c, which look from inside them). */
+    bool skip_specular;
 };
 
 /* Textures (gl_albedo.c). The lit passes and the splats use the materials'
@@ -74,6 +77,12 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
 /* Area lights as the eye sees them, in their radiance times exposure, or
  * black when the direct layer is off. */
 void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct);
+
+/* Layers (gl_layers.c): the depth-stencil buffer every layer shares, and
+ * one more texture (the specular layer, gl_specular.c) added to the
+ * composite times its gain (0: left out). */
+GLuint ps_gl_layers_depth_stencil(const ps_gl_layers *l);
+void ps_gl_layers_set_extra(ps_gl_layers *l, GLuint texture, double gain);
 
 /* Splats (gl_splat.c). */
 void ps_gl_upload_kernel(ps_gl_renderer *r, const ps_kernel_texture *k);

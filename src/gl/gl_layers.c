@@ -31,7 +31,17 @@ struct ps_gl_layers {
     bool imap_drawn; /* LAYER_IMAP_TEX holds maps (else it is black and not composited) */
     GLuint tex[LAYER_TEX_COUNT], fbo[LAYER_TEX_COUNT], depth_stencil;
     bool albedo; /* LAYER_ALBEDO_TEX holds this view's T */
+    GLuint extra_tex; /* the specular layer (gl_specular.c), times extra_gain */
+    double extra_gain;
 };
+
+GLuint ps_gl_layers_depth_stencil(const ps_gl_layers *l) { return l->depth_stencil; }
+
+void ps_gl_layers_set_extra(ps_gl_layers *l, GLuint texture, double gain)
+{
+    l->extra_tex = texture;
+    l->extra_gain = gain;
+}
 
 ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_layers **out, ps_error *err)
 {
@@ -254,6 +264,8 @@ static void composite(ps_gl_layers *l, int target, double direct_gain, const dou
         glDisable(GL_TEXTURE_2D);
         glActiveTexture(GL_TEXTURE0);
     }
+    if (l->extra_tex && l->extra_gain > 0.0)
+        add_texture(l->extra_tex, l->extra_gain);
     glDisable(GL_FRAMEBUFFER_SRGB);
     glDisable(GL_BLEND);
     glBindTexture(GL_TEXTURE_2D, 0);

@@ -85,6 +85,8 @@ void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil)
     }
     for (size_t i = 0; i < m->range_count; i++) {
         const ps_mesh_range *rg = &m->ranges[i];
+        if (r->skip_specular && ps_material_is_specular(&r->in.materials[rg->material]))
+            continue;
         if (with_materials) {
             const ps_material *mat = &r->in.materials[rg->material];
             GLfloat diffuse[4] = {0, 0, 0, 1}, specular[4] = {0, 0, 0, 1};

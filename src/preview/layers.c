@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
-const char *const ps_layer_names[PS_LAYER_COUNT + 1] = {"direct", "caustic", "global", NULL};
+const char *const ps_layer_names[PS_LAYER_COUNT + 1] = {"direct", "caustic", "global", "specular", NULL};
 
 bool ps_layers_parse(const char *text, unsigned *out, char *why, size_t why_size)
 {
@@ -20,7 +20,7 @@ bool ps_layers_parse(const char *text, unsigned *out, char *why, size_t why_size
         while (k < PS_LAYER_COUNT && !(strlen(ps_layer_names[k]) == len && strncmp(item, ps_layer_names[k], len) == 0))
             k++;
         if (k == PS_LAYER_COUNT) {
-            snprintf(why, why_size, "'%.*s' is not direct, caustic or global", (int)len, item);
+            snprintf(why, why_size, "'%.*s' is not direct, caustic, global or specular", (int)len, item);
             return false;
         }
         if (*out & (1u << k)) {

@@ -8,8 +8,9 @@
 
 #include "photon/photon.h"
 
-enum { PS_LAYER_DIRECT = 1, PS_LAYER_CAUSTIC = 2, PS_LAYER_GLOBAL = 4, PS_LAYER_ALL = 7 };
-#define PS_LAYER_COUNT 3
+/* specular: what mirrors and glass show of the other layers (preview/specular.h). */
+enum { PS_LAYER_DIRECT = 1, PS_LAYER_CAUSTIC = 2, PS_LAYER_GLOBAL = 4, PS_LAYER_SPECULAR = 8, PS_LAYER_ALL = 15 };
+#define PS_LAYER_COUNT 4
 
 /* Bit k (1 << k) is ps_layer_names[k]; NULL-terminated. */
 extern const char *const ps_layer_names[PS_LAYER_COUNT + 1];
@@ -17,9 +18,9 @@ extern const char *const ps_layer_names[PS_LAYER_COUNT + 1];
 /* Map k's layer bit. */
 static inline unsigned ps_map_layer(ps_map_kind k) { return k == PS_MAP_CAUSTIC ? PS_LAYER_CAUSTIC : PS_LAYER_GLOBAL; }
 
-/* "direct,caustic,global": any non-empty subset, each name once, to bits.
+/* "direct,caustic,global,specular": any non-empty subset, each name once, to bits.
  * False with the reason in why (no location: the caller's message adds it),
- * e.g. "'specular' is not direct, caustic or global". */
+ * e.g. "'glossy' is not direct, caustic, global or specular". */
 bool ps_layers_parse(const char *text, unsigned *out, char *why, size_t why_size);
 
 #endif

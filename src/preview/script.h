@@ -13,7 +13,7 @@
  *     move light INDEX X Y Z           light INDEX (scene order) to a new position
  *     move object INDEX DX DY DZ       object INDEX (scene order) translated
  *     set splat points|triangles|sprites
- *     set layers LIST                  comma list of direct,caustic,global (>= 1)
+ *     set layers LIST                  comma list of direct,caustic,global,specular (>= 1)
  *     set kernel box|cone|gauss|epanechnikov
  *     set radius R [G]                 caustic splat radius, optionally the global one (> 0)
  *     set tau SECONDS                  (> 0)

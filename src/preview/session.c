@@ -9,6 +9,7 @@
 #include "core/clock.h"
 #include "preview/feed.h"
 #include "preview/repair.h"
+#include "preview/specular.h"
 
 struct ps_session {
     ps_scene *scene;
@@ -17,6 +18,7 @@ struct ps_session {
     ps_tracer *tracer;
     ps_feed *feed;
     ps_preview_mesh mesh, coarse;
+    ps_specular *spec;     /* the specular layer's lookups over mesh */
     ps_preview_lights lights;
     ps_kernel_texture kernel;
     ps_splat_batch batch[PS_MAP_COUNT];
@@ -110,12 +112,17 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
 {
     ps_world_destroy(s->world);
     s->world = NULL;
+    ps_specular_destroy(s->spec);
+    s->spec = NULL;
     ps_preview_mesh_free(&s->mesh);
     ps_preview_mesh_free(&s->coarse);
     ps_status st = ps_world_create(s->scene, NULL, &s->world, err);
     ps_mesh_options mo = ps_mesh_default_options(s->scene);
     if (st == PS_OK)
         st = ps_preview_mesh_build(s->scene, &mo, &s->mesh, err);
+    size_t nm;
+    if (st == PS_OK)
+        st = ps_specular_create(&s->mesh, ps_scene_materials(s->scene, &nm), &s->spec, err);
     /* The scene's own triangles, not subdivided, for depth-only passes:
      * subdividing changes no depth, only how many vertices are lit. */
     mo.max_edge = HUGE_VAL;
@@ -276,6 +283,7 @@ void ps_session_destroy(ps_session *s)
         return;
     free_maps(s);
     ps_world_destroy(s->world);
+    ps_specular_destroy(s->spec);
     ps_preview_mesh_free(&s->mesh);
     ps_preview_mesh_free(&s->coarse);
     ps_preview_lights_free(&s->lights);
@@ -582,6 +590,12 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     if (st != PS_OK)
         return st;
     out->direct = (s->set.layers & PS_LAYER_DIRECT) != 0;
+    /* The specular layer: its lookups for this eye, in incremental sessions
+     * (the window) at most PS_SESSION_SPECULAR_VERTICES a refresh, the rest
+     * in the next ones (the default scene's two spheres: 10^4, 12 ms). */
+    out->specular = (s->set.layers & PS_LAYER_SPECULAR) && !s->illuminance && ps_specular_range_count(s->spec) > 0;
+    if (out->specular)
+        ps_specular_update(s->spec, s->world, cam->eye, inc ? PS_SESSION_SPECULAR_VERTICES : 0);
     out->direct_exposure = inc ? 1.0 : exposure(s);
     out->direct_gain = inc ? exposure(s) : 1.0;
     out->splat = s->set.splat;
@@ -899,6 +913,57 @@ const ps_preview_mesh *ps_session_coarse_mesh(const ps_session *s) { return &s->
 const ps_preview_lights *ps_session_lights(const ps_session *s) { return &s->lights; }
 const ps_kernel_texture *ps_session_kernel(const ps_session *s) { return &s->kernel; }
 const ps_tracer *ps_session_tracer(const ps_session *s) { return s->tracer; }
+ps_specular *ps_session_specular(ps_session *s) { return s->spec; }
+
+ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_frame *view, size_t max_photons,
+                                ps_splat_batch *b, double *radius, ps_error *err)
+{
+    ps_splat_batch_clear(b);
+    ps_splat_batch_reset_carry(b);
+    *radius = s->splat_radius[k];
+    if (!(s->set.layers & ps_map_layer(k)) || s->illuminance)
+        return PS_OK;
+    ps_feed_lock(s->feed);
+    size_t nm;
+    const ps_feed_mark *mk = ps_feed_marks(s->feed, k, &nm);
+    size_t end = 0;
+    uint64_t emitted = 0;
+    for (size_t i = 0; i < nm; i++) {
+        if (end > 0 && mk[i].stored > max_photons)
+            break;
+        end = mk[i].stored;
+        emitted = mk[i].emitted;
+    }
+    ps_status st = PS_OK;
+    if (end > 0 && emitted > 0) {
+        const ps_photon_map *m = &ps_feed_maps(s->feed)[k];
+        ps_splat_params p;
+        memset(&p, 0, sizeof p);
+        p.mode = PS_SPLAT_TRIANGLES;
+        /* The level of detail's cover for the photons left out, grown by
+         * sqrt(arrived / used) (at most PS_RADIUS_GROWTH_MAX), but never past
+         * the larger of the two maps' own radii: a grown global splat would
+         * fill much of a cube face, and the fill is what a face costs. */
+        double arrived = (double)mk[nm - 1].emitted;
+        double grown = radius_at(s, k, emitted) * fmin(PS_RADIUS_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
+        double largest = fmax(s->splat_radius[PS_MAP_CAUSTIC], s->splat_radius[PS_MAP_GLOBAL]);
+        p.radius = fmax(radius_at(s, k, emitted), fmin(grown, largest));
+        p.kernel_mean = s->kernel.mean;
+        p.kernel_extent = s->kernel.extent;
+        p.scale = (double)s->set.caps[k] / (double)emitted; /* radiance: exposure 1 */
+        p.point_size = 1.0;
+        p.precision = PS_PRECISION_NONE;
+        p.levels = 0;
+        p.materials = ps_session_materials(s);
+        p.objects = s->set.stencil_clip ? m->objects : NULL;
+        p.cam = *view;
+        p.threads = s->set.threads;
+        *radius = p.radius;
+        st = ps_splat_build(m->photons, m->materials, end, &p, b, err);
+    }
+    ps_feed_unlock(s->feed);
+    return st;
+}
 double ps_session_radius(const ps_session *s, ps_map_kind k) { return s->splat_radius[k]; }
 
 void ps_session_get_counts(ps_session *s, ps_session_counts *out)

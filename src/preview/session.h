@@ -60,6 +60,9 @@
  * most PS_RADIUS_GROWTH_MAX) so that the fewer photons still cover; the
  * first refresh with the camera still starts the view over in full. */
 #define PS_SESSION_MOVING_SHARE 0.25
+/* The specular layer's eye paths an incremental refresh traces at most
+ * (distinct vertices of mirrors and glass; preview/specular.h). */
+#define PS_SESSION_SPECULAR_VERTICES 32768
 
 typedef struct ps_session_settings {
     /* The photons. */
@@ -159,6 +162,8 @@ typedef struct ps_session_frame {
      * (implied by new_view), the map layers kept. */
     bool lights_changed;
     bool direct;             /* the direct layer is shown (else the scene is drawn black) */
+    bool specular;           /* the specular layer is shown and the scene has mirrors or glass:
+                              * its lookups are traced for this camera (ps_session_specular) */
     double direct_exposure;  /* the exposure GL lights are drawn with */
     double direct_gain;      /* the direct layer's weight in the composite */
     ps_session_layer map[PS_MAP_COUNT];
@@ -259,6 +264,17 @@ const ps_preview_mesh *ps_session_coarse_mesh(const ps_session *s); /* the scene
 const ps_preview_lights *ps_session_lights(const ps_session *s);
 const ps_kernel_texture *ps_session_kernel(const ps_session *s);
 const ps_tracer *ps_session_tracer(const ps_session *s);
+/* The specular layer's lookups over the fine mesh (preview/specular.h). */
+struct ps_specular *ps_session_specular(ps_session *s);
+/* For the specular layer's cube maps: map k's photons so far (at most
+ * max_photons, a prefix ending at a feed mark, scaled by N / n to radiance
+ * at exposure 1) as triangle splats seen from `view` (photons behind its eye
+ * plane are left out), at the radius of that many photons (the schedule's)
+ * grown by sqrt(arrived / drawn) (at most PS_RADIUS_GROWTH_MAX, and never
+ * past the larger map radius); *radius: that radius. Empty when map k's layer is off. Briefly holds the
+ * lock. */
+ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_frame *view, size_t max_photons,
+                                ps_splat_batch *b, double *radius, ps_error *err);
 /* Map k's splat radius for the last refresh (under the radius schedule). */
 double ps_session_radius(const ps_session *s, ps_map_kind k);
 

@@ -1,0 +1,404 @@
+/* gl_specular.c: the specular layer's cube maps and lookups (gl_specular.h). */
+#include "gl/gl_specular.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/clock.h"
+
+#include "gl/gl_internal.h"
+
+/* GL's cube faces in order (+X, -X, +Y, -Y, +Z, -Z) and, for each, the
+ * camera that renders it: texel (s, t) of face +X looks along
+ * (1, -(2t - 1), -(2s - 1)) (the GL spec's table 3.19, sc = -rz, tc = -ry),
+ * so the face's camera has right = (0, 0, -1) and up = (0, -1, 0); likewise
+ * for the others. right x up = -forward: proper rotations, no mirror image. */
+static const float face_axes[6][3][3] = {
+    /* forward, right, up */
+    {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},  {{-1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
+    {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},    {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},
+    {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},   {{0, 0, -1}, {-1, 0, 0}, {0, -1, 0}},
+};
+
+struct ps_gl_specular {
+    int size;
+    GLuint cube[PS_SPECULAR_MAX_CUBES];
+    int cube_count;
+    GLuint fbo, depth_stencil;
+    ps_splat_batch batch;
+    /* The round-robin over (cube, face): the next face, and how many have
+     * been rendered since the scene last changed and since it settled. */
+    int cursor;
+    int since_change, since_settled;
+    unsigned layers;   /* what the cubes were rendered with: the frame's layers */
+    uint64_t edits;
+    bool frozen;       /* filled by a test: never rendered over */
+    bool cubes_changed;  /* a cube completed (or all faces drawn): the layer to redraw */
+    unsigned faces_rendered;
+    /* The time budget: seconds a face took (the last one, finished), and
+     * the share of tau saved up for the next. */
+    double face_seconds, credit;
+    uint64_t arrived; /* photons emitted (both maps) when last looked */
+    /* The layered path's texture. */
+    GLuint layer_tex, layer_fbo;
+    int layer_w, layer_h;
+    GLuint layer_depth;
+    bool layer_valid;
+    float *scaled; /* weights times exposure */
+    size_t scaled_cap;
+};
+
+ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err)
+{
+    *out = NULL;
+    ps_gl_specular *g = calloc(1, sizeof *g);
+    if (!g)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the specular layer");
+    g->size = cube_size > 0 ? cube_size : PS_GL_SPECULAR_CUBE_SIZE;
+    ps_splat_batch_init(&g->batch);
+    glGenFramebuffers(1, &g->fbo);
+    glGenRenderbuffers(1, &g->depth_stencil);
+    glBindRenderbuffer(GL_RENDERBUFFER, g->depth_stencil);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, g->size, g->size);
+    glBindRenderbuffer(GL_RENDERBUFFER, 0);
+    *out = g;
+    return PS_OK;
+}
+
+void ps_gl_specular_destroy(ps_gl_specular *g)
+{
+    if (!g)
+        return;
+    if (g->cube_count)
+        glDeleteTextures(g->cube_count, g->cube);
+    glDeleteFramebuffers(1, &g->fbo);
+    glDeleteRenderbuffers(1, &g->depth_stencil);
+    if (g->layer_tex)
+        glDeleteTextures(1, &g->layer_tex);
+    if (g->layer_fbo)
+        glDeleteFramebuffers(1, &g->layer_fbo);
+    ps_splat_batch_free(&g->batch);
+    free(g->scaled);
+    free(g);
+}
+
+unsigned ps_gl_specular_faces_rendered(const ps_gl_specular *g) { return g->faces_rendered; }
+
+/* Cube textures for n cubes, black until rendered. */
+static void ensure_cubes(ps_gl_specular *g, int n)
+{
+    if (n == g->cube_count)
+        return;
+    if (g->cube_count)
+        glDeleteTextures(g->cube_count, g->cube);
+    g->cube_count = n;
+    g->cursor = 0;
+    g->since_change = g->since_settled = 0;
+    if (n == 0)
+        return;
+    glGenTextures(n, g->cube);
+    float *black = calloc(4 * (size_t)g->size * (size_t)g->size, sizeof *black);
+    for (int c = 0; c < n; c++) {
+        glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[c]);
+        for (int f = 0; f < 6; f++)
+            glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_RGBA16F, g->size, g->size, 0, GL_RGBA, GL_FLOAT,
+                         black);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    }
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    free(black);
+}
+
+void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value)
+{
+    ensure_cubes(g, ps_specular_cube_count(ps_session_specular(s)));
+    size_t n = (size_t)g->size * (size_t)g->size;
+    float *texels = malloc(4 * n * sizeof *texels);
+    if (!texels)
+        return;
+    for (size_t i = 0; i < n; i++)
+        texels[4 * i] = texels[4 * i + 1] = texels[4 * i + 2] = value, texels[4 * i + 3] = 1.0f;
+    for (int c = 0; c < g->cube_count; c++) {
+        glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[c]);
+        for (int f = 0; f < 6; f++)
+            glTexSubImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, 0, 0, g->size, g->size, GL_RGBA, GL_FLOAT, texels);
+    }
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    free(texels);
+    g->frozen = true;
+    g->cubes_changed = true;
+}
+
+/* Face f of cube c: the preview seen from the cube's centre, mirrors and
+ * glass left out, at exposure 1. */
+static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *fr, int c,
+                             int f, ps_error *err)
+{
+    const ps_specular *sp = ps_session_specular(s);
+    ps_camera_frame cam;
+    memset(&cam, 0, sizeof cam);
+    cam.eye = ps_specular_cube_centre(sp, c);
+    cam.forward = ps_v3(face_axes[f][0][0], face_axes[f][0][1], face_axes[f][0][2]);
+    cam.right = ps_v3(face_axes[f][1][0], face_axes[f][1][1], face_axes[f][1][2]);
+    cam.up = ps_v3(face_axes[f][2][0], face_axes[f][2][1], face_axes[f][2][2]);
+    cam.tan_half_fov = 1.0;
+    cam.aspect = 1.0;
+    cam.width = cam.height = g->size;
+    /* The shadow maps hold every object: made before the objects are left out. */
+    if (fr->direct && r->opt.shadows && !r->shadows_valid)
+        ps_gl_make_shadow_maps(r);
+
+    glBindFramebuffer(GL_FRAMEBUFFER, g->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, g->cube[c], 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, g->depth_stencil);
+    r->skip_specular = true;
+    ps_gl_begin_frame(r, &cam, 1.0, fr->direct);
+    ps_status st = PS_OK;
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
+        double radius;
+        st = ps_session_env_splats(s, (ps_map_kind)k, &cam, PS_GL_SPECULAR_ENV_PHOTONS, &g->batch, &radius, err);
+        if (st == PS_OK)
+            ps_gl_draw_splats(r, &g->batch, PS_SPLAT_TRIANGLES, radius, 1.0);
+    }
+    /* Textured surfaces (map_Kd) as the eye sees them: the face times T. */
+    if (st == PS_OK)
+        ps_gl_multiply_albedo(r);
+    r->skip_specular = false;
+    g->faces_rendered++;
+    return st;
+}
+
+ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
+                                 int faces, ps_error *err)
+{
+    if (!f->specular || g->frozen)
+        return PS_OK;
+    ps_specular *sp = ps_session_specular(s);
+    ensure_cubes(g, ps_specular_cube_count(sp));
+    int total = 6 * g->cube_count;
+    if (total == 0)
+        return PS_OK;
+    /* What the cubes show changed: a new round. */
+    unsigned layers = ps_session_get_settings(s)->layers;
+    if (layers != g->layers || ps_session_edits(s) != g->edits || f->lights_changed) {
+        g->layers = layers;
+        g->edits = ps_session_edits(s);
+        g->since_change = g->since_settled = 0;
+    }
+    /* Settled: every photon has arrived (the feed ended; a new view of the
+     * same photons changes no cube), and since the last arrived a whole
+     * round was drawn: nothing new to show. */
+    ps_session_counts counts;
+    ps_session_get_counts(s, &counts);
+    uint64_t arrived = counts.map[0].emitted + counts.map[1].emitted;
+    /* Held for good (paused, or the error counter stopped it): as ended. */
+    bool settled = counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL);
+    if (arrived != g->arrived || !settled) {
+        g->arrived = arrived;
+        g->since_settled = 0;
+    }
+    if (settled && g->since_settled >= total && g->since_change >= total)
+        return PS_OK;
+    /* Settled but not yet drawn from the last photons: the round is finished
+     * over the next PS_GL_SPECULAR_SETTLE_REFRESHES refreshes whatever the
+     * budget, so that the picture is soon whole as a snapshot's. */
+    int n = faces <= 0 || faces > total ? total
+            : settled ? (total + PS_GL_SPECULAR_SETTLE_REFRESHES - 1) / PS_GL_SPECULAR_SETTLE_REFRESHES
+                      : faces;
+    /* A new view (the first picture, the first after an edit, a moving
+     * camera) comes as soon as without the layer: its faces wait. */
+    if (faces > 0 && f->new_view)
+        return PS_OK;
+    if (faces > 0 && !settled) {
+        /* A face only when the refreshes' share of tau has saved up for one
+         * (it took face_seconds last time; the first comes at once). */
+        g->credit = fmin(g->credit + PS_GL_SPECULAR_TIME_SHARE * ps_session_get_settings(s)->tau,
+                         fmax(g->face_seconds, PS_GL_SPECULAR_TIME_SHARE * ps_session_get_settings(s)->tau));
+        if (g->credit < g->face_seconds)
+            return PS_OK;
+        g->credit -= g->face_seconds;
+    }
+    GLint old_fbo = 0, vp[4];
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glGetIntegerv(GL_VIEWPORT, vp);
+    double view[16], proj[16];
+    memcpy(view, r->view, sizeof view);
+    memcpy(proj, r->proj, sizeof proj);
+    int width = r->width, height = r->height;
+    double eye_extent = r->eye_extent;
+    ps_status st = PS_OK;
+    double t0 = ps_now_seconds();
+    for (int i = 0; i < n && st == PS_OK; i++) {
+        st = render_face(g, r, s, f, g->cursor / 6, g->cursor % 6, err);
+        g->cursor = (g->cursor + 1) % total;
+        /* The layer is redrawn when a cube is whole again, not each face. */
+        if (g->cursor % 6 == 0)
+            g->cubes_changed = true;
+    }
+    if (faces > 0) {
+        glFinish(); /* llvmpipe draws when flushed: the face's own time */
+        g->face_seconds = (ps_now_seconds() - t0) / n;
+    }
+    g->since_change += n;
+    g->since_settled += n;
+    /* Back to the view. */
+    memcpy(r->view, view, sizeof view);
+    memcpy(r->proj, proj, sizeof proj);
+    r->width = width, r->height = height;
+    r->eye_extent = eye_extent;
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    glViewport(vp[0], vp[1], vp[2], vp[3]);
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(r->proj);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(r->view);
+    return st;
+}
+
+bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s)
+{
+    unsigned layers = ps_session_get_settings(s)->layers;
+    int cubes = ps_specular_cube_count(ps_session_specular(s));
+    if (g->frozen || !(layers & PS_LAYER_SPECULAR) || ps_session_illuminance(s) || cubes == 0)
+        return true;
+    if (g->cube_count != cubes || g->layers != layers || g->edits != ps_session_edits(s) || g->cubes_changed)
+        return false;
+    ps_session_counts counts;
+    ps_session_get_counts(s, &counts);
+    int total = 6 * cubes;
+    bool settled = counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL);
+    return settled && counts.map[0].emitted + counts.map[1].emitted == g->arrived && g->since_settled >= total &&
+           g->since_change >= total;
+}
+
+/* The weights of term k times exposure (the arrays as they are at 1). */
+static const float *weights(ps_gl_specular *g, const ps_specular *sp, int k, size_t n, double exposure)
+{
+    const float *w = ps_specular_weights(sp, k);
+    if (exposure == 1.0)
+        return w;
+    if (g->scaled_cap < 3 * n) {
+        float *p = realloc(g->scaled, 3 * n * sizeof *p);
+        if (!p)
+            return w;
+        g->scaled = p;
+        g->scaled_cap = 3 * n;
+    }
+    for (size_t i = 0; i < 3 * n; i++)
+        g->scaled[i] = (float)(w[i] * exposure);
+    return g->scaled;
+}
+
+/* The first `terms` lookups of every vertex (the heaviest first). */
+static void draw_terms(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure, int terms)
+{
+    ps_specular *sp = ps_session_specular(s);
+    const ps_preview_mesh *mesh = ps_session_mesh(s);
+    size_t nr = ps_specular_range_count(sp);
+    if (nr == 0 || g->cube_count == 0)
+        return;
+    const ps_specular_range *ranges = ps_specular_ranges(sp);
+    size_t n = ranges[nr - 1].offset + mesh->ranges[ranges[nr - 1].range].count;
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(r->proj);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(r->view);
+    glDisable(GL_LIGHTING);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    glActiveTexture(GL_TEXTURE0);
+    glEnable(GL_TEXTURE_CUBE_MAP);
+    glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glEnableClientState(GL_COLOR_ARRAY);
+    glEnableClientState(GL_TEXTURE_COORD_ARRAY);
+    for (int k = 0; k < terms; k++) {
+        const float *w = weights(g, sp, k, n, exposure);
+        const float *d = ps_specular_dirs(sp, k);
+        for (size_t i = 0; i < nr; i++) {
+            const ps_mesh_range *rg = &mesh->ranges[ranges[i].range];
+            glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[ranges[i].cube]);
+            glVertexPointer(3, GL_FLOAT, 0, mesh->positions + 3 * rg->first);
+            glColorPointer(3, GL_FLOAT, 0, w + 3 * ranges[i].offset);
+            glTexCoordPointer(3, GL_FLOAT, 0, d + 3 * ranges[i].offset);
+            glDrawArrays(GL_TRIANGLES, 0, (GLsizei)rg->count);
+        }
+    }
+    glDisableClientState(GL_TEXTURE_COORD_ARRAY);
+    glDisableClientState(GL_COLOR_ARRAY);
+    glDisableClientState(GL_VERTEX_ARRAY);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    glDisable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+    glDisable(GL_TEXTURE_CUBE_MAP);
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+}
+
+void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure)
+{
+    draw_terms(g, r, s, exposure, PS_SPECULAR_TERMS);
+}
+
+ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_renderer *r, ps_session *s,
+                               const ps_session_frame *f, ps_error *err)
+{
+    GLuint depth = ps_gl_layers_depth_stencil(l);
+    if (!g->layer_tex || g->layer_w != r->width || g->layer_h != r->height || g->layer_depth != depth) {
+        if (!g->layer_tex)
+            glGenTextures(1, &g->layer_tex);
+        if (!g->layer_fbo)
+            glGenFramebuffers(1, &g->layer_fbo);
+        g->layer_w = r->width, g->layer_h = r->height, g->layer_depth = depth;
+        glBindTexture(GL_TEXTURE_2D, g->layer_tex);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, g->layer_w, g->layer_h, 0, GL_RGBA, GL_FLOAT, NULL);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        GLint old_fbo = 0;
+        glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, g->layer_fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, g->layer_tex, 0);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth);
+        bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+        glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+        g->layer_valid = false;
+        if (!complete)
+            return ps_error_set(err, PS_ERR_IO, "the GL implementation cannot render the specular layer (RGBA32F %dx%d)",
+                                g->layer_w, g->layer_h);
+    }
+    bool changed = ps_specular_take_changed(ps_session_specular(s));
+    if (f->specular && (changed || g->cubes_changed || f->new_view || f->lights_changed || !g->layer_valid)) {
+        GLint old_fbo = 0;
+        glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, g->layer_fbo);
+        glViewport(0, 0, g->layer_w, g->layer_h);
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glClearColor(0, 0, 0, 0);
+        glClear(GL_COLOR_BUFFER_BIT); /* colour only: the depth is the view's prepass */
+        /* A moving camera's level of detail: the heaviest lookup only (one
+         * pass instead of PS_SPECULAR_TERMS); all again once it stops. */
+        if (g->faces_rendered > 0 || g->frozen) /* black cubes draw black: the first picture saves them */
+            draw_terms(g, r, s, f->direct_exposure, f->moving ? 1 : PS_SPECULAR_TERMS);
+        glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+        g->cubes_changed = false;
+        g->layer_valid = true;
+    }
+    ps_gl_specular_set_gain(g, l, f->specular ? f->direct_gain : 0.0);
+    return PS_OK;
+}
+
+void ps_gl_specular_set_gain(ps_gl_specular *g, ps_gl_layers *l, double gain)
+{
+    ps_gl_layers_set_extra(l, g->layer_tex, gain);
+}

@@ -1,0 +1,75 @@
+/* gl_specular.h: the `specular` layer in fixed-function GL (issue 15):
+ * environment cube maps rendered from each mirror or glass object's centre
+ * with the preview itself, and the objects drawn with the per-vertex
+ * lookups and Fresnel weights that preview/specular.h traces on the CPU.
+ *
+ * A cube map is six faces of PS_GL_SPECULAR_CUBE_SIZE^2 RGBA16F texels,
+ * rendered as the view is (the depth prepass, the direct layer with its
+ * shadow maps, the area lights, then the caustic and global splats of the
+ * photons so far, at most PS_GL_SPECULAR_ENV_PHOTONS a map, a prefix with
+ * the level of detail's grown radius), every mirror and glass object left
+ * out (the lookups trace through them on the CPU), at exposure 1: radiance.
+ * Faces are refreshed round-robin while photons arrive, as
+ * PS_GL_SPECULAR_TIME_SHARE of tau allows (a face every few refreshes, the
+ * first one at the first refresh after a new view, never in one: the first
+ * picture, the first after an edit and a moving camera's come as fast as
+ * without the layer), the last round once they all arrived
+ * over a few refreshes whatever the budget, all at once for a single frame and a snapshot's last
+ * picture; the objects are redrawn when a cube is whole again. They are kept
+ * while only the camera moves; a new layer set, an edit or new GL lights
+ * start a new round. The objects are then drawn PS_SPECULAR_TERMS times,
+ * each pass one lookup direction (texture coordinates into the object's
+ * cube) modulated by its weight (vertex colours), added together. */
+#ifndef PS_GL_GL_SPECULAR_H
+#define PS_GL_GL_SPECULAR_H
+
+#include "gl/gl_render.h"
+#include "preview/specular.h"
+
+#define PS_GL_SPECULAR_CUBE_SIZE 128
+#define PS_GL_SPECULAR_FACES_PER_REFRESH 1
+/* Past the first round, faces take at most this share of tau on average. */
+#define PS_GL_SPECULAR_TIME_SHARE 0.15
+#define PS_GL_SPECULAR_ENV_PHOTONS 8192
+/* Once every photon has arrived, the last round is drawn over this many
+ * refreshes, budget or not. */
+#define PS_GL_SPECULAR_SETTLE_REFRESHES 4
+
+typedef struct ps_gl_specular ps_gl_specular;
+
+/* cube_size 0: PS_GL_SPECULAR_CUBE_SIZE. Needs a current context. */
+ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err);
+void ps_gl_specular_destroy(ps_gl_specular *g); /* accepts NULL */
+
+/* Before drawing refresh f of session s: up to `faces` cube faces rendered
+ * (0: every face of every cube), when f shows the specular layer. Leaves the
+ * renderer's view, the viewport and the framebuffer binding as they were. */
+ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
+                                 int faces, ps_error *err);
+/* The specular objects' lookups times exposure added into the bound
+ * framebuffer over the renderer's current view (its depth already there). */
+void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure);
+/* The layered path (the window, snap --time in float): the specular layer
+ * as a texture of l's size sharing l's depth, redrawn when the cubes, the
+ * lookups or the view changed (while the camera moves, with the heaviest
+ * lookup only: one pass instead of PS_SPECULAR_TERMS), and added to l's
+ * composite times f's direct gain (0 when f does not show it). */
+ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_renderer *r, ps_session *s,
+                               const ps_session_frame *f, ps_error *err);
+/* The layer's weight in l's composite: the gain, or 0 to leave it out (a
+ * layer read alone). */
+void ps_gl_specular_set_gain(ps_gl_specular *g, ps_gl_layers *l, double gain);
+
+/* Whether the cube maps show every photon and the objects were redrawn
+ * from them (or the layer is not shown): nothing left to refresh. A
+ * script's `wait done` waits for it too. */
+bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s);
+
+/* For tests: every face of every cube filled with radiance `value` (a
+ * furnace), marked fresh so that refreshes keep it. */
+void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value);
+
+/* What ran: cube faces rendered so far. */
+unsigned ps_gl_specular_faces_rendered(const ps_gl_specular *g);
+
+#endif

@@ -1,0 +1,110 @@
+/* specular.h: the `specular` layer's lookups, GL-free: what mirrors and glass
+ * show, as per-vertex directions into environment cube maps with Fresnel
+ * weights (issue 15; Larsen & Christensen, section 6, draw specular
+ * reflections from a dynamic environment cube map).
+ *
+ * Every mirror or dielectric object of the session's fine mesh gets a cube
+ * map rendered by src/gl (gl_specular.c) from its centre (the centre of its
+ * vertices' bounding box), showing the other layers of the scene around it
+ * with every mirror and glass object left out. For each vertex of such an
+ * object the eye ray is traced on the CPU with the project's own geometry
+ * (ps_world) and Fresnel code (scene/bsdf.h), as the reference renderer's
+ * eye paths do: mirror reflection, Fresnel reflection and refraction, total
+ * internal reflection, the exit through the far side of the glass, other
+ * mirrors and glass objects on the way, up to PS_SPECULAR_MAX_DEPTH
+ * surfaces. Each path ends on a diffuse or glossy surface at a point P (or
+ * leaves the scene); its lookup direction is P - centre, the direction in
+ * which the cube map sees that very point (a distance-corrected lookup: a
+ * plain reflection-map lookup would assume the environment infinitely far).
+ * The weight is the product of the reflectances, Fresnel factors and tints
+ * on the way. A vertex keeps its PS_SPECULAR_TERMS heaviest paths; the
+ * weight of the others is added to the kept path nearest in direction, so
+ * that no energy is lost (a furnace stays at 1).
+ *
+ * Departures, said where they show (docs/preview.md): the cube map shows P
+ * only if nothing diffuse lies between the centre and P; lookups are
+ * interpolated over the mesh's triangles (Gouraud); area lights are seen in
+ * the cube map as the direct layer draws them, point and spot lights not at
+ * all (as in photosplat-ref). Glossy lobes are not part of this layer (as in
+ * photosplat-ref's `specular` component, which is what mirrors and glass
+ * show). */
+#ifndef PS_PREVIEW_SPECULAR_H
+#define PS_PREVIEW_SPECULAR_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "core/status.h"
+#include "core/vec.h"
+#include "photon/world.h"
+#include "preview/mesh.h"
+#include "scene/scene.h"
+
+/* Lookups a vertex: each one a drawing pass of the object. */
+#define PS_SPECULAR_TERMS 4
+/* Surfaces one eye path meets at most (the reference's own bound is 16;
+ * past 8 mirror or glass bounces little weight is left). */
+#define PS_SPECULAR_MAX_DEPTH 16
+/* Paths with less weight than this (of a unit eye ray) are not followed. */
+#define PS_SPECULAR_MIN_WEIGHT 1e-4
+/* Paths collected a vertex before the heaviest are kept. */
+#define PS_SPECULAR_MAX_PATHS 64
+/* Cube maps at most; objects past these share the nearest cube. */
+#define PS_SPECULAR_MAX_CUBES 8
+
+typedef struct ps_specular ps_specular;
+
+/* One mesh range drawn with the lookups. */
+typedef struct ps_specular_range {
+    size_t range;     /* index into the mesh's ranges */
+    size_t offset;    /* its first vertex in the lookup arrays */
+    int cube;         /* the cube map it looks up */
+} ps_specular_range;
+
+/* The mirror and dielectric ranges of `mesh` (materials indexed by its
+ * ranges), their cube maps' centres; no lookups yet. A mesh with none gives
+ * a set of 0 ranges. mesh and materials must outlive it. */
+ps_status ps_specular_create(const ps_preview_mesh *mesh, const ps_material *materials, ps_specular **out,
+                             ps_error *err);
+void ps_specular_destroy(ps_specular *sp); /* accepts NULL */
+
+size_t ps_specular_range_count(const ps_specular *sp);
+const ps_specular_range *ps_specular_ranges(const ps_specular *sp);
+int ps_specular_cube_count(const ps_specular *sp);
+ps_vec3 ps_specular_cube_centre(const ps_specular *sp, int cube);
+
+/* Traces the lookups for an eye at `eye` through `world` (the session's:
+ * the same surfaces as the mesh), at most max_vertices distinct vertices
+ * this call (0: all). A new eye starts over; the vertices not traced again
+ * yet keep their last lookups. Returns how many distinct vertices are left
+ * for this eye (0: all done). Deterministic: a vertex's lookups depend only
+ * on the scene and the eye. */
+size_t ps_specular_update(ps_specular *sp, const ps_world *world, ps_vec3 eye, size_t max_vertices);
+/* Whether the lookups have changed since the last ps_specular_take_changed. */
+bool ps_specular_take_changed(ps_specular *sp);
+/* Every vertex traced again at the next update (geometry or materials moved). */
+void ps_specular_invalidate(ps_specular *sp);
+
+/* Lookup term k (< PS_SPECULAR_TERMS) of the lookup arrays' vertices, in
+ * the ranges' order from their offsets: an xyz direction from the cube's
+ * centre, and an rgb weight (0 where a vertex has fewer paths). */
+const float *ps_specular_dirs(const ps_specular *sp, int k);
+const float *ps_specular_weights(const ps_specular *sp, int k);
+
+/* ---- for tests --------------------------------------------------------------- */
+
+/* One path's end: its lookup direction from `centre` (or the direction it
+ * leaves in, far away, when it meets nothing) and its weight. */
+typedef struct ps_specular_term {
+    ps_vec3 dir;
+    ps_rgb weight;
+} ps_specular_term;
+/* The eye ray from `eye` to surface point p (normal n, on the winding's side)
+ * of material m, traced as above: up to PS_SPECULAR_TERMS terms into out,
+ * their count returned; *dropped: the weight of the paths cut short by depth
+ * or the weight floor (not added to any term). */
+int ps_specular_trace_point(const ps_world *world, const ps_material *materials, const ps_material *m, ps_vec3 eye,
+                            ps_vec3 p, ps_vec3 n, ps_vec3 centre, ps_specular_term out[PS_SPECULAR_TERMS],
+                            double *dropped);
+
+#endif

@@ -1,0 +1,304 @@
+/* test_gl_specular.c: the specular layer (gl/gl_specular.h over OSMesa, float
+ * buffers) against closed forms and the reference renderer: a planar
+ * mirror showing the floor's direct light at the mirrored point, a mirror
+ * and a glass sphere in a furnace (cube maps of radiance 1), and the default
+ * scene's spheres against photosplat-ref's `specular` component. */
+#include "test.h"
+
+#include <GL/osmesa.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_render.h"
+#include "gl/gl_specular.h"
+#include "photon/world.h"
+#include "preview/session.h"
+#include "render/render.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+typedef struct rig {
+    ps_scene *scene;
+    ps_session *session;
+    OSMesaContext ctx;
+    float *buffer;
+    ps_gl_renderer *gl;
+    ps_gl_specular *spec;
+    ps_camera_frame cam;
+    int w, h;
+} rig;
+
+static void rig_make(rig *r, ps_scene *scene, int w, int h)
+{
+    memset(r, 0, sizeof *r);
+    ps_error err;
+    r->scene = scene;
+    r->w = w, r->h = h;
+    ps_session_settings set = ps_session_default_settings(scene);
+    set.caps[0] = set.caps[1] = 0; /* no photons: the direct light and what mirrors show of it */
+    set.float_buffer = true;
+    set.precision = PS_PRECISION_NONE;
+    assert_int_equal(ps_session_create(scene, &set, &r->session, &err), PS_OK);
+    assert_int_equal(ps_session_trace_all(r->session, &err), PS_OK);
+    r->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    assert_non_null(r->ctx);
+    r->buffer = malloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
+    assert_true(OSMesaMakeCurrent(r->ctx, r->buffer, GL_FLOAT, w, h));
+    ps_gl_options go = {true, true, 0};
+    ps_gl_scene gs = ps_gl_scene_of(r->session);
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(r->session), &go, &r->gl, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_create(0, &r->spec, &err), PS_OK);
+    r->cam = ps_camera_frame_make(ps_scene_camera(scene), w, h);
+}
+
+static void rig_free(rig *r)
+{
+    ps_gl_specular_destroy(r->spec);
+    ps_gl_renderer_destroy(r->gl);
+    OSMesaDestroyContext(r->ctx);
+    free(r->buffer);
+    ps_session_destroy(r->session);
+    ps_scene_destroy(r->scene);
+}
+
+static ps_scene *load_text(const char *text)
+{
+    ps_scene *s;
+    ps_error err;
+    if (ps_scene_load_text(text, "inline.scn", "", NULL, &s, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    return s;
+}
+
+/* The specular layer alone (the scene black, still hiding what lies
+ * behind), its cube maps rendered whole unless `filled`. */
+static ps_image specular_alone(rig *r, bool filled)
+{
+    ps_error err;
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(r->session, &r->cam, &f, &err), PS_OK);
+    assert_true(f.specular);
+    if (!filled)
+        assert_int_equal(ps_gl_specular_refresh(r->spec, r->gl, r->session, &f, 0, &err), PS_OK);
+    ps_gl_begin_frame(r->gl, &r->cam, 1.0, false);
+    ps_gl_specular_draw(r->spec, r->gl, r->session, 1.0);
+    ps_image img;
+    assert_int_equal(ps_gl_read(r->gl, &img, &err), PS_OK);
+    return img;
+}
+
+/* The object the eye sees first through pixel (x, y), or -1. */
+static int first_object(const ps_world *w, const ps_camera_frame *cam, int x, int y)
+{
+    ps_surface sp;
+    return ps_world_intersect(w, ps_camera_ray(cam, x + 0.5, y + 0.5), INFINITY, &sp) ? (int)sp.object : -1;
+}
+
+/* Pixel (x, y) and all within `margin` of it see the same object. */
+static bool inside_object(const ps_world *w, const ps_camera_frame *cam, int x, int y, int margin, int *object)
+{
+    int o = first_object(w, cam, x, y);
+    for (int dy = -margin; dy <= margin; dy++)
+        for (int dx = -margin; dx <= margin; dx++)
+            if (x + dx < 0 || y + dy < 0 || x + dx >= cam->width || y + dy >= cam->height ||
+                first_object(w, cam, x + dx, y + dy) != o)
+                return false;
+    *object = o;
+    return o >= 0;
+}
+
+/* A camera looking into a vertical mirror sees the floor in front of it:
+ * at pixel p the reflected ray reaches floor point q, whose radiance is
+ * albedo / pi * I h / d^3 (I = P / 4 pi, h the light's height, d its
+ * distance). Every mirror pixel within 2 % of that. */
+#define MIRROR_LIGHT_Y 1.2
+#define MIRROR_LIGHT_Z 0.3
+#define MIRROR_POWER 50.0
+#define MIRROR_ALBEDO 0.5
+
+static void planar_mirror_shows_the_floor(void **state)
+{
+    (void)state;
+    char text[1024];
+    snprintf(text, sizeof text,
+             "camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
+             "material white diffuse albedo %g %g %g\n"
+             "material mirror mirror reflectance 1 1 1\n"
+             "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0 material white\n"
+             "quad corner -1 0 -1 edge1 2 0 0 edge2 0 1.5 0 material mirror\n"
+             "light point position 0 %g %g power %g %g %g\n",
+             MIRROR_ALBEDO, MIRROR_ALBEDO, MIRROR_ALBEDO, MIRROR_LIGHT_Y, MIRROR_LIGHT_Z, MIRROR_POWER, MIRROR_POWER,
+             MIRROR_POWER);
+    rig r;
+    rig_make(&r, load_text(text), 128, 128);
+    ps_image img = specular_alone(&r, false);
+    const ps_world *w = ps_session_world(r.session);
+    size_t counted = 0;
+    double worst = 0.0, sum = 0.0;
+    for (int y = 0; y < r.h; y++)
+        for (int x = 0; x < r.w; x++) {
+            int o;
+            if (!inside_object(w, &r.cam, x, y, 1, &o) || o != 1)
+                continue;
+            ps_ray ray = ps_camera_ray(&r.cam, x + 0.5, y + 0.5);
+            ps_vec3 m = ps_ray_at(ray, (-1.0 - ray.o.z) / ray.d.z);
+            ps_vec3 d = ps_v3(ray.d.x, ray.d.y, -ray.d.z);
+            if (!(d.y < 0.0))
+                continue;
+            ps_vec3 q = ps_v3_add(m, ps_v3_scale(d, -m.y / d.y));
+            /* Away from the floor's edges, where a pixel's triangle has a
+             * vertex whose path leaves the floor, and from the mirror's
+             * foot, whose bottom vertices lie on the floor itself. */
+            if (fabs(q.x) > 1.5 || q.z > 1.5 || q.z < -0.6)
+                continue;
+            ps_vec3 to_light = ps_v3_sub(ps_v3(0, MIRROR_LIGHT_Y, MIRROR_LIGHT_Z), q);
+            double dist = ps_v3_len(to_light);
+            double want = MIRROR_ALBEDO * PS_INV_PI * (MIRROR_POWER / (4.0 * PS_PI)) * MIRROR_LIGHT_Y / (dist * dist * dist);
+            double got = ps_image_at(&img, x, y)[1];
+            double e = fabs(got / want - 1.0);
+            if (e > worst && getenv("PS_TEST_VERBOSE"))
+                print_message("  %d %d q %.3f %.3f %.3f got %g want %g\n", x, y, q.x, q.y, q.z, got, want);
+            worst = fmax(worst, e);
+            sum += e;
+            counted++;
+        }
+    print_message("planar mirror: %zu pixels, mean error %.3f %%, worst %.3f %%\n", counted, 100.0 * sum / counted,
+                  100.0 * worst);
+    assert_true(counted > 1000);
+    assert_true(worst < 0.02);
+    ps_image_destroy(&img);
+    rig_free(&r);
+}
+
+/* A furnace: every cube texel radiance 1. A perfect mirror sphere then
+ * shows 1 (within 1 %), a clear glass one 1 (within 2 %: what its reflected
+ * and refracted paths carry adds up, less what is cut short). */
+static void furnace(const char *material, double tol)
+{
+    char text[512];
+    snprintf(text, sizeof text,
+             "camera eye 0 0 3 target 0 0 0 up 0 1 0 fov 40\n"
+             "material m %s\n"
+             "sphere center 0 0 0 radius 0.8 material m\n"
+             "light point position 0 3 0 power 1 1 1\n",
+             material);
+    rig r;
+    rig_make(&r, load_text(text), 64, 64);
+    ps_gl_specular_fill(r.spec, r.session, 1.0f);
+    ps_image img = specular_alone(&r, true);
+    const ps_world *w = ps_session_world(r.session);
+    size_t counted = 0;
+    double worst = 0.0;
+    for (int y = 0; y < r.h; y++)
+        for (int x = 0; x < r.w; x++) {
+            int o;
+            if (!inside_object(w, &r.cam, x, y, 2, &o))
+                continue;
+            for (int c = 0; c < 3; c++)
+                worst = fmax(worst, fabs(ps_image_at(&img, x, y)[c] - 1.0));
+            counted++;
+        }
+    print_message("furnace, %s: %zu pixels, worst %.3f %% off 1\n", material, counted, 100.0 * worst);
+    assert_true(counted > 500);
+    assert_true(worst < tol);
+    ps_image_destroy(&img);
+    rig_free(&r);
+}
+
+static void furnace_mirror_sphere(void **state)
+{
+    (void)state;
+    furnace("mirror reflectance 1 1 1", 0.01);
+}
+
+static void furnace_glass_sphere(void **state)
+{
+    (void)state;
+    furnace("dielectric ior 1.5", 0.02);
+}
+
+/* The default scene's sphere pixels with the direct and specular layers
+ * against the reference renderer's `specular` component with no photon
+ * maps (the direct light seen in the mirror and through the glass): the
+ * mean within 3 %, and after a 3x3 box filter most pixels within 10 %. */
+#define DEFAULT_SIZE 128
+#define DEFAULT_SPP 16
+
+static void default_scene_against_reference(void **state)
+{
+    (void)state;
+    ps_scene *scene;
+    ps_error err;
+    assert_int_equal(ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err), PS_OK);
+    rig r;
+    rig_make(&r, scene, DEFAULT_SIZE, DEFAULT_SIZE);
+    ps_session_set_layers(r.session, PS_LAYER_DIRECT | PS_LAYER_SPECULAR);
+    ps_image got = specular_alone(&r, false);
+    const ps_world *w = ps_session_world(r.session);
+    ps_light_sampler *ls;
+    assert_int_equal(ps_light_sampler_create(scene, &ls, &err), PS_OK);
+    ps_render_maps maps = {NULL, NULL, NULL, NULL};
+    ps_render_options o;
+    memset(&o, 0, sizeof o);
+    o.width = o.height = DEFAULT_SIZE;
+    o.spp = DEFAULT_SPP;
+    o.light_samples = 1;
+    o.seed = 1;
+    o.threads = 2;
+    o.component = PS_COMPONENT_SPECULAR;
+    o.filter = PS_FILTER_BOX;
+    o.caustic.k = o.global.k = 1;
+    o.caustic.max_radius = o.global.max_radius = 0.01;
+    ps_image want;
+    ps_render_stats st;
+    assert_int_equal(ps_render(w, ls, &maps, &o, &want, &st, &err), PS_OK);
+    ps_light_sampler_destroy(ls);
+    double sum_got = 0.0, sum_want = 0.0;
+    size_t counted = 0, within = 0;
+    for (int y = 1; y < r.h - 1; y++)
+        for (int x = 1; x < r.w - 1; x++) {
+            int obj;
+            if (!inside_object(w, &r.cam, x, y, 2, &obj))
+                continue;
+            ps_surface sp;
+            size_t nm;
+            if (!ps_world_intersect(w, ps_camera_ray(&r.cam, x + 0.5, y + 0.5), INFINITY, &sp) ||
+                !ps_material_is_specular(&ps_scene_materials(scene, &nm)[sp.material]))
+                continue;
+            double fg = 0.0, fw = 0.0;
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++)
+                    for (int c = 0; c < 3; c++) {
+                        fg += ps_image_at(&got, x + dx, y + dy)[c];
+                        fw += ps_image_at(&want, x + dx, y + dy)[c];
+                    }
+            for (int c = 0; c < 3; c++) {
+                sum_got += ps_image_at(&got, x, y)[c];
+                sum_want += ps_image_at(&want, x, y)[c];
+            }
+            counted++;
+            within += fabs(fg - fw) <= 0.1 * fw;
+        }
+    print_message("default scene, spheres: %zu pixels, mean %.4f against %.4f (%.2f %%), %.1f %% of the pixels within "
+                  "10 %% after a 3x3 box\n",
+                  counted, sum_got / (3.0 * counted), sum_want / (3.0 * counted), 100.0 * (sum_got / sum_want - 1.0),
+                  100.0 * within / counted);
+    assert_true(counted > 1000);
+    assert_true(fabs(sum_got / sum_want - 1.0) < 0.03);
+    assert_true(within > 0.85 * counted);
+    ps_image_destroy(&got);
+    ps_image_destroy(&want);
+    rig_free(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(planar_mirror_shows_the_floor),
+        cmocka_unit_test(furnace_mirror_sphere),
+        cmocka_unit_test(furnace_glass_sphere),
+        cmocka_unit_test(default_scene_against_reference),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
