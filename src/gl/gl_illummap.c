@@ -12,17 +12,9 @@ void ps_gl_draw_illummap(ps_gl_renderer *r, const float *colors)
     const ps_preview_mesh *m = r->in.mesh;
     if (!colors || m->vertex_count == 0)
         return;
-    glMatrixMode(GL_PROJECTION);
-    glLoadMatrixd(r->proj);
-    glMatrixMode(GL_MODELVIEW);
-    glLoadMatrixd(r->view);
-    glDisable(GL_LIGHTING);
+    ps_gl_begin_additive_pass(r);
     glDisable(GL_TEXTURE_2D);
     glDisable(GL_STENCIL_TEST);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LEQUAL); /* the prepass is pushed back (gl_render.c) */
-    glDepthMask(GL_FALSE);
-    glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
     glShadeModel(GL_SMOOTH);
     glEnableClientState(GL_VERTEX_ARRAY);

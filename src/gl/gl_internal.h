@@ -48,6 +48,12 @@ void ps_gl_draw_albedo(const ps_gl_renderer *r);
 /* The bound buffer times T (nothing when the scene has no textures). */
 void ps_gl_multiply_albedo(const ps_gl_renderer *r);
 
+/* An additive pass over what the frame drew (splats, illumination maps, the
+ * specular lookups): the camera's matrices, no lighting, the depth test
+ * against the prepass (GL_LEQUAL, no writes), blending on; the caller picks
+ * the blend function (gl_render.c). */
+void ps_gl_begin_additive_pass(const ps_gl_renderer *r);
+
 /* Matrices, column-major as GL's (gl_render.c). */
 void ps_gl_mat_mul(const double a[16], const double b[16], double out[16]);
 /* gluLookAt with an orthonormal frame (right, up, -forward). */

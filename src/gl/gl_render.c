@@ -288,3 +288,16 @@ void ps_gl_renderer_destroy(ps_gl_renderer *r)
         glDeleteTextures(1, &r->kernel_tex);
     free(r);
 }
+
+void ps_gl_begin_additive_pass(const ps_gl_renderer *r)
+{
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(r->proj);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(r->view);
+    glDisable(GL_LIGHTING);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL); /* the prepass is pushed back */
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+}

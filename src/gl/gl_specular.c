@@ -304,15 +304,7 @@ static void draw_terms(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, doub
         return;
     const ps_specular_range *ranges = ps_specular_ranges(sp);
     size_t n = ranges[nr - 1].offset + mesh->ranges[ranges[nr - 1].range].count;
-    glMatrixMode(GL_PROJECTION);
-    glLoadMatrixd(r->proj);
-    glMatrixMode(GL_MODELVIEW);
-    glLoadMatrixd(r->view);
-    glDisable(GL_LIGHTING);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LEQUAL);
-    glDepthMask(GL_FALSE);
-    glEnable(GL_BLEND);
+    ps_gl_begin_additive_pass(r);
     glBlendFunc(GL_ONE, GL_ONE);
     glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
     glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);

@@ -35,15 +35,7 @@ void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode
 {
     if (b->vertex_count == 0)
         return;
-    glMatrixMode(GL_PROJECTION);
-    glLoadMatrixd(r->proj);
-    glMatrixMode(GL_MODELVIEW);
-    glLoadMatrixd(r->view);
-    glDisable(GL_LIGHTING);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LEQUAL);
-    glDepthMask(GL_FALSE);
-    glEnable(GL_BLEND);
+    ps_gl_begin_additive_pass(r);
     glEnableClientState(GL_VERTEX_ARRAY);
     glEnableClientState(GL_COLOR_ARRAY);
     glVertexPointer(3, GL_FLOAT, 0, b->positions);
