@@ -9,6 +9,7 @@
 
 #include "photon/tracer.h"
 #include "photon/world.h"
+#include "preview/feed.h"
 #include "preview/session.h"
 #include "scene/scene.h"
 
@@ -215,12 +216,61 @@ static void repair_keeps_what_it_should(void **state)
     ps_scene_destroy(scene);
 }
 
+/* What reads the maps by their batch marks (a refresh's budget, the specular
+ * layer's cube maps: ps_session_env_splats) reads what it would after a
+ * fresh trace: the repair's end puts the marks back where a fresh feed's
+ * rounds end. Caps of several rounds (PS_FEED_BATCH), a prefix of a round. */
+static void marks_after_a_repair_are_a_fresh_feeds(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = ps_session_default_settings(scene);
+    set.caps[PS_MAP_CAUSTIC] = 3 * PS_FEED_BATCH;
+    set.caps[PS_MAP_GLOBAL] = PS_FEED_BATCH;
+    set.seed = SEED;
+    set.threads = 2;
+    ps_session *s;
+    ps_error err;
+    assert_int_equal(ps_session_create(scene, &set, &s, &err), PS_OK);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    apply(s, MOVE_MIRROR, 0);
+    ps_session_changes ch;
+    assert_int_equal(ps_session_update(s, &ch, &err), PS_OK);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    ps_scene *copy;
+    assert_int_equal(ps_scene_clone(scene, &copy, &err), PS_OK);
+    ps_session *fresh;
+    assert_int_equal(ps_session_create(copy, &set, &fresh, &err), PS_OK);
+    assert_int_equal(ps_session_trace_all(fresh, &err), PS_OK);
+    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 64, 64);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        ps_splat_batch a, b;
+        ps_splat_batch_init(&a);
+        ps_splat_batch_init(&b);
+        double ra, rb;
+        assert_int_equal(ps_session_env_splats(s, (ps_map_kind)k, &cam, PS_FEED_BATCH, &a, &ra, &err), PS_OK);
+        assert_int_equal(ps_session_env_splats(fresh, (ps_map_kind)k, &cam, PS_FEED_BATCH, &b, &rb, &err), PS_OK);
+        assert_true(a.splats > 0 && a.splats < ps_session_maps(s)[k].count); /* a prefix */
+        assert_int_equal(a.vertex_count, b.vertex_count);
+        assert_true(ra == rb);
+        assert_memory_equal(a.positions, b.positions, 3 * a.vertex_count * sizeof(float));
+        assert_memory_equal(a.colors, b.colors, 4 * a.vertex_count * sizeof(float));
+        ps_splat_batch_free(&a);
+        ps_splat_batch_free(&b);
+    }
+    ps_session_destroy(fresh);
+    ps_scene_destroy(copy);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(each_edit_equals_a_fresh_trace),
         cmocka_unit_test(edits_mid_repair),
         cmocka_unit_test(repair_keeps_what_it_should),
+        cmocka_unit_test(marks_after_a_repair_are_a_fresh_feeds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -32,7 +32,7 @@ struct ps_gl_specular {
     int cursor;
     int since_change, since_settled;
     unsigned layers;   /* what the cubes were rendered with: the frame's layers */
-    uint64_t edits;
+    uint64_t edits, epoch; /* what the cubes were drawn from (a change starts a round) */
     bool frozen;       /* filled by a test: never rendered over */
     bool cubes_changed;  /* a cube completed (or all faces drawn): the layer to redraw */
     unsigned faces_rendered;
@@ -185,9 +185,11 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
         return PS_OK;
     /* What the cubes show changed: a new round. */
     unsigned layers = ps_session_get_settings(s)->layers;
-    if (layers != g->layers || ps_session_edits(s) != g->edits || f->lights_changed) {
+    if (layers != g->layers || ps_session_edits(s) != g->edits || ps_session_maps_epoch(s) != g->epoch ||
+        f->lights_changed) {
         g->layers = layers;
         g->edits = ps_session_edits(s);
+        g->epoch = ps_session_maps_epoch(s);
         g->since_change = g->since_settled = 0;
     }
     /* Settled: every photon has arrived (the feed ended; a new view of the

@@ -181,6 +181,20 @@ static ps_status retrace_batch(ps_feed *f, int k, ps_error *err)
     return st;
 }
 
+/* Where round r of map k ends (the index past its last photon), given where
+ * the round before ended: its share of r + 1 rounds of PS_FEED_BATCH photons
+ * of the largest cap, at least one more. */
+static uint64_t round_end(const ps_feed *f, int k, uint64_t r, uint64_t prev_end)
+{
+    uint64_t biggest = 0;
+    for (int j = 0; j < PS_MAP_COUNT; j++)
+        if (f->active[j] && f->cap[j] > biggest)
+            biggest = f->cap[j];
+    double share = (double)(r + 1) * PS_FEED_BATCH / (double)biggest;
+    uint64_t until = share >= 1.0 ? f->cap[k] : (uint64_t)((double)f->cap[k] * share);
+    return until <= prev_end ? prev_end + 1 : until;
+}
+
 /* One round: each active map up to its share of the next PS_FEED_BATCH
  * photons of the largest cap, so that all maps finish together. False when
  * every map has reached its cap (or on an error, in *st). */
@@ -202,18 +216,11 @@ static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
         }
     if (repairing)
         return *st == PS_OK && !f->store_limited;
-    uint64_t biggest = 0;
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        if (f->active[k] && f->cap[k] > biggest)
-            biggest = f->cap[k];
     bool more = false;
     for (int k = 0; k < PS_MAP_COUNT && *st == PS_OK; k++) {
         if (!f->active[k] || f->next[k] >= f->cap[k])
             continue;
-        double share = (double)(f->round + 1) * PS_FEED_BATCH / (double)biggest;
-        uint64_t until = share >= 1.0 ? f->cap[k] : (uint64_t)((double)f->cap[k] * share);
-        if (until <= f->next[k])
-            until = f->next[k] + 1;
+        uint64_t until = round_end(f, k, f->round, f->next[k]);
         *st = batch(f, k, f->next[k], until - f->next[k], err);
         f->next[k] = until;
         more = more || f->next[k] < f->cap[k];
@@ -403,19 +410,39 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
     ps_photon_map_init(&out, (ps_map_kind)k);
     if (!ps_photon_map_reserve_exact(&out, m->count ? m->count : 1))
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory reordering %zu photons", m->count);
+    /* The marks made again where a fresh feed's rounds end (round_end), so
+     * that whatever reads a prefix of the map by its marks (a refresh's
+     * budget, the specular layer's cube maps) reads what it would from a
+     * fresh trace: the repair's own marks stand for its order. */
+    ps_feed_mark *marks = malloc((f->mark_count[k] + f->repair_end[k] / batch_of(f, k) + 2) * sizeof *marks);
+    if (!marks) {
+        ps_photon_map_free(&out);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory reordering %zu photons", m->count);
+    }
+    size_t nmarks = 0;
+    uint64_t r = 0, boundary = round_end(f, k, 0, 0);
     size_t kept = 0, re = f->kept_end[k];
     const ps_path_rec *rec = f->paths[k].rec;
     for (uint64_t i = 0; i < f->repair_end[k]; i++) {
-        if (rec[i].flags & REC_PENDING)
-            continue;
-        size_t *from = (rec[i].flags & REC_RETRACED) ? &re : &kept;
-        size_t n = rec[i].stored;
-        memcpy(out.photons + out.count, m->photons + *from, n * sizeof *m->photons);
-        memcpy(out.materials + out.count, m->materials + *from, n * sizeof *m->materials);
-        memcpy(out.objects + out.count, m->objects + *from, n * sizeof *m->objects);
-        out.count += n;
-        *from += n;
+        if (!(rec[i].flags & REC_PENDING)) {
+            size_t *from = (rec[i].flags & REC_RETRACED) ? &re : &kept;
+            size_t n = rec[i].stored;
+            memcpy(out.photons + out.count, m->photons + *from, n * sizeof *m->photons);
+            memcpy(out.materials + out.count, m->materials + *from, n * sizeof *m->materials);
+            memcpy(out.objects + out.count, m->objects + *from, n * sizeof *m->objects);
+            out.count += n;
+            *from += n;
+        }
+        if (i + 1 == boundary) {
+            marks[nmarks++] = (ps_feed_mark){out.count, boundary};
+            boundary = round_end(f, k, ++r, boundary);
+        }
     }
+    /* Past the repair the feed's own rounds went on as a fresh one's (the
+     * retraced first, so a mark there counts what index order counts). */
+    for (size_t j = 0; j < f->mark_count[k]; j++)
+        if (f->marks[k][j].emitted > f->repair_end[k])
+            marks[nmarks++] = f->marks[k][j];
     /* Those traced past the repair follow in order. */
     size_t rest = m->count - re;
     memcpy(out.photons + out.count, m->photons + re, rest * sizeof *m->photons);
@@ -426,9 +453,11 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
     pthread_mutex_lock(&f->lock);
     ps_photon_map_free(m);
     *m = out;
-    f->mark_count[k] = 0;
-    ps_feed_mark mk = {m->count, m->counters.emitted};
-    f->marks[k][f->mark_count[k]++] = mk; /* room: the marks only shrank */
+    if (nmarks == 0 || marks[nmarks - 1].emitted != m->counters.emitted) /* stopped mid-round */
+        marks[nmarks++] = (ps_feed_mark){m->count, m->counters.emitted};
+    free(f->marks[k]);
+    f->marks[k] = marks;
+    f->mark_count[k] = f->mark_cap[k] = nmarks;
     f->generation++;
     pthread_mutex_unlock(&f->lock);
     for (uint64_t i = 0; i < f->repair_end[k]; i++)

@@ -64,6 +64,7 @@ struct ps_session {
     bool repaired;         /* the last update repaired the maps (else restarted them) */
     bool skip_prime;       /* ... and every map kept photons: no first round to prime */
     uint64_t feed_gen;     /* the feed's generation the drawn prefixes belong to */
+    uint64_t maps_epoch;   /* ps_session_maps_epoch */
     ps_feed_repair_count repair;
 };
 
@@ -191,6 +192,7 @@ static void forget_drawn(ps_session *s)
     s->counter_stopped = false;
     s->view_dirty = true;
     s->feed_gen = 0;
+    s->maps_epoch++;
 }
 
 static ps_status new_feed(ps_session *s, ps_error *err)
@@ -496,6 +498,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         /* The feed put a map back in index order: a drawn prefix that was
          * not all of it is other photons now. */
         s->feed_gen = gen;
+        s->maps_epoch++;
         for (int k = 0; k < PS_MAP_COUNT; k++)
             if (s->drawn[k] != ps_feed_maps(s->feed)[k].count)
                 s->view_dirty = true;
@@ -914,6 +917,7 @@ const ps_preview_lights *ps_session_lights(const ps_session *s) { return &s->lig
 const ps_kernel_texture *ps_session_kernel(const ps_session *s) { return &s->kernel; }
 const ps_tracer *ps_session_tracer(const ps_session *s) { return s->tracer; }
 ps_specular *ps_session_specular(ps_session *s) { return s->spec; }
+uint64_t ps_session_maps_epoch(const ps_session *s) { return s->maps_epoch; }
 
 ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_frame *view, size_t max_photons,
                                 ps_splat_batch *b, double *radius, ps_error *err)

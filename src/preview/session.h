@@ -275,6 +275,11 @@ struct ps_specular *ps_session_specular(ps_session *s);
  * lock. */
 ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_frame *view, size_t max_photons,
                                 ps_splat_batch *b, double *radius, ps_error *err);
+/* A count that changes whenever the maps hold other photons, or the same in
+ * another order, than a prefix of what they held (a new feed, a repair, the
+ * repair's end putting a map back in index order): what was made from the
+ * maps (the specular layer's cube maps) is to be made again. */
+uint64_t ps_session_maps_epoch(const ps_session *s);
 /* Map k's splat radius for the last refresh (under the radius schedule). */
 double ps_session_radius(const ps_session *s, ps_map_kind k);
 
