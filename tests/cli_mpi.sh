@@ -90,7 +90,8 @@ expect_match "bad scene: reported once" "$(grep -c "^$bad_scene" "$cli_tmp/err")
 # ranks exist, SIGNAL goes to mpirun (TARGET mpirun) or to rank 1 (TARGET rank).
 long_run() {
     rm -f "$cli_tmp/g.png"
-    "${mpirun_[@]}" -np 2 "$mpi" "$scene" --size 400x300 --threads 1 -o "$cli_tmp/g.png" \
+    # --quality final: long enough (about 30 s) that the signal comes midway even on an idle machine.
+    "${mpirun_[@]}" -np 2 "$mpi" "$scene" --size 400x300 --quality final --threads 1 -o "$cli_tmp/g.png" \
         >"$cli_tmp/out" 2>"$cli_tmp/err" &
     local m=$! i
     for i in $(seq 100); do

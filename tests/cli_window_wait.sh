@@ -38,16 +38,29 @@ cat >"$cli_tmp/wait.txt" <<SCRIPT
 0.3  screenshot $cli_tmp/b.png
 0.4  quit
 SCRIPT
-expect_success "session with waits" xrun "$win" "$scene" "${common[@]}" --script "$cli_tmp/wait.txt" \
-    --stats "$cli_tmp/wait.json"
+# The photon layers: the maps after the edits are a fresh trace's, so the
+# picture is the same bytes.
+expect_success "session with waits" xrun "$win" "$scene" "${common[@]}" --layers direct,caustic,global \
+    --script "$cli_tmp/wait.txt" --stats "$cli_tmp/wait.json"
 s=$cli_tmp/wait.json
 diff=$("$bin/photosplat-compare" "$cli_tmp/b.png" "$cli_tmp/a.png")
 echo "after the caps, moved away and back: $diff"
-# The same picture, but for the specular layer's eye paths, which follow the
-# glass sphere's centre to its last bit (0.35 + 0.1 - 0.1 is 0.34999999999999996)
-# and may branch otherwise at a vertex: a code or so in a few pixels.
 rmse=$(sed -n 's/^rmse=\([^ ]*\).*/\1/p' <<<"$diff")
-awk_true "$rmse < 1.0 / 255" && ok || bad "the picture after moving back differs: $diff"
+awk_true "$rmse == 0" && ok || bad "the picture after moving back differs: $diff"
+# With the specular layer too: close, not the same. Its eye paths follow the
+# glass sphere's centre to its last bit (0.35 + 0.1 - 0.1 is
+# 0.34999999999999996) and branch otherwise at some vertices; and the first
+# settled picture's glass sphere differs in some runs (rmse up to 0.008 of
+# the picture, docs/preview.md: a known defect).
+cp "$cli_tmp/first.png" "$cli_tmp/first-maps.png"
+cp "$cli_tmp/a.png" "$cli_tmp/a-maps.png"
+expect_success "session with waits, specular layer" xrun "$win" "$scene" "${common[@]}" --script "$cli_tmp/wait.txt"
+diff=$("$bin/photosplat-compare" "$cli_tmp/b.png" "$cli_tmp/a.png")
+echo "with the specular layer, moved away and back: $diff"
+relmse=$(sed -n 's/.*relmse=\([^ ]*\).*/\1/p' <<<"$diff")
+awk_true "$relmse < 1e-3" && ok || bad "with the specular layer, the picture after moving back differs: $diff"
+cp "$cli_tmp/first-maps.png" "$cli_tmp/first.png" # the checks below are of the first session
+cp "$cli_tmp/a-maps.png" "$cli_tmp/a.png"
 early=$("$bin/photosplat-compare" "$cli_tmp/first.png" "$cli_tmp/a.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
 echo "the first refresh against the capped picture: rmse $early"
 awk_true "$early > 0.001" && ok || bad "wait done did not wait: the first refresh already equals it (rmse $early)"
@@ -68,7 +81,8 @@ awk_true "$bytes >= $stored * $PHOTON_BYTES && $bytes <= 2 * $stored * $PHOTON_B
 # global ones), before the caps; wait done ends there too.
 limit=20000
 printf '0 wait done\n0 screenshot %s\n0.1 quit\n' "$cli_tmp/limited.png" >"$cli_tmp/limited.txt"
-expect_success "memory cap" xrun "$win" "$scene" "${common[@]}" --max-photons $limit --script "$cli_tmp/limited.txt" \
+expect_success "memory cap" xrun "$win" "$scene" "${common[@]}" --layers direct,caustic,global --max-photons $limit \
+    --script "$cli_tmp/limited.txt" \
     --stats "$cli_tmp/limited.json"
 s=$cli_tmp/limited.json
 stored=$(($(stat_of stored_caustic "$s") + $(stat_of stored_global "$s")))
