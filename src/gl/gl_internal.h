@@ -54,6 +54,10 @@ void ps_gl_multiply_albedo(const ps_gl_renderer *r);
  * the blend function (gl_render.c). */
 void ps_gl_begin_additive_pass(const ps_gl_renderer *r);
 
+/* The bound cube map sampled linearly, clamped at its faces' edges (IES
+ * tables, the specular layer's environment maps; gl_render.c). */
+void ps_gl_cube_linear_clamped(void);
+
 /* Matrices, column-major as GL's (gl_render.c). */
 void ps_gl_mat_mul(const double a[16], const double b[16], double out[16]);
 /* gluLookAt with an orthonormal frame (right, up, -forward). */

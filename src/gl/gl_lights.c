@@ -112,11 +112,7 @@ ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err)
                              GL_LUMINANCE, GL_UNSIGNED_SHORT, p->texels + (size_t)f * p->size * p->size);
             /* Linear within a face and across its edges: the table's
              * intensity is continuous over directions. */
-            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-            glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+            ps_gl_cube_linear_clamped();
         }
         glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
         glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
