@@ -244,6 +244,11 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     }
     g->since_change += n;
     g->since_settled += n;
+    /* The last round done: the layer from every face of it. A round need not
+     * start at a cube's first face, so the faces it drew last may be the
+     * first ones of a cube, which completed no cube above. */
+    if (settled && g->since_settled >= total)
+        g->cubes_changed = true;
     /* Back to the view. */
     memcpy(r->view, view, sizeof view);
     memcpy(r->proj, proj, sizeof proj);
