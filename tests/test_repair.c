@@ -95,6 +95,19 @@ static void assert_same_maps(const ps_photon_map *a, const ps_photon_map *b)
     }
 }
 
+/* The session's maps, traced on to their caps, against a fresh trace of the
+ * (edited) scene: photon for photon. */
+static void traced_equals_fresh(ps_session *s, const ps_scene *scene)
+{
+    ps_error err;
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    ps_photon_map fresh[PS_MAP_COUNT];
+    fresh_trace(scene, fresh);
+    assert_same_maps(ps_session_maps(s), fresh);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_free(&fresh[k]);
+}
+
 typedef enum edit_kind { MOVE_POINT, MOVE_SPOT, MOVE_MIRROR, MOVE_GLASS, MOVE_FLOOR, POWER, ANGLE, EDIT_KINDS } edit_kind;
 
 static void apply(ps_session *s, edit_kind e, int step)
@@ -142,13 +155,7 @@ static void each_edit_equals_a_fresh_trace(void **state)
         for (int step = 0; step < 2; step++) {
             apply(s, (edit_kind)e, step);
             update(s, kept, retraced);
-            ps_error err;
-            assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
-            ps_photon_map fresh[PS_MAP_COUNT];
-            fresh_trace(scene, fresh);
-            assert_same_maps(ps_session_maps(s), fresh);
-            for (int k = 0; k < PS_MAP_COUNT; k++)
-                ps_photon_map_free(&fresh[k]);
+            traced_equals_fresh(s, scene);
         }
         ps_session_destroy(s);
         ps_scene_destroy(scene);
@@ -166,13 +173,7 @@ static void edits_mid_repair(void **state)
         apply(s, (edit_kind)e, e);
         update(s, kept, retraced); /* nothing retraced yet: the next edit starts from what is kept */
     }
-    ps_error err;
-    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
-    ps_photon_map fresh[PS_MAP_COUNT];
-    fresh_trace(scene, fresh);
-    assert_same_maps(ps_session_maps(s), fresh);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_free(&fresh[k]);
+    traced_equals_fresh(s, scene);
     ps_session_destroy(s);
     ps_scene_destroy(scene);
 }
