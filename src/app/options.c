@@ -129,9 +129,16 @@ uint64_t ps_photon_cap(int maps, uint64_t bytes_each)
 ps_status ps_check_run_memory(const char *prog, uint64_t photons, uint64_t photon_bytes, int width, int height,
                               uint64_t pixel_bytes, ps_error *err)
 {
+    return ps_check_run_memory_extra(prog, photons, photon_bytes, width, height, pixel_bytes, 0, err);
+}
+
+ps_status ps_check_run_memory_extra(const char *prog, uint64_t photons, uint64_t photon_bytes, int width, int height,
+                                    uint64_t pixel_bytes, uint64_t extra_bytes, ps_error *err)
+{
     uint64_t pixels = (uint64_t)(width > 0 ? width : 0) * (uint64_t)(height > 0 ? height : 0);
     uint64_t a = ps_memory_mul(photons, photon_bytes), b = ps_memory_mul(pixels, pixel_bytes);
     uint64_t total = a > UINT64_MAX - b ? UINT64_MAX : a + b;
+    total = total > UINT64_MAX - extra_bytes ? UINT64_MAX : total + extra_bytes;
     char what[128];
     if (pixels)
         snprintf(what, sizeof what, "%llu photons and a %dx%d image", (unsigned long long)photons, width, height);

@@ -110,5 +110,9 @@ uint64_t ps_photon_cap(int maps, uint64_t bytes_each);
  * not fit in the memory budget, before anything is allocated. */
 ps_status ps_check_run_memory(const char *prog, uint64_t photons, uint64_t photon_bytes, int width, int height,
                               uint64_t pixel_bytes, ps_error *err);
+/* The same with extra_bytes more held whatever the image (the specular
+ * layer's cube maps, ps_specular_plan_bytes). */
+ps_status ps_check_run_memory_extra(const char *prog, uint64_t photons, uint64_t photon_bytes, int width, int height,
+                                    uint64_t pixel_bytes, uint64_t extra_bytes, ps_error *err);
 
 #endif

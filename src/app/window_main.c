@@ -27,6 +27,7 @@
 #include "image/image.h"
 #include "preview/script.h"
 #include "preview/session.h"
+#include "preview/specular_glossy.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
 
@@ -34,7 +35,10 @@
  * a quarter of the fill, for a refresh soon after the move. */
 #define WIN_SHADOW_SIZE 512
 /* The memory plan (ps_check_run_memory): a pixel is the float splat layers,
- * the linear and the shown composite, and the window's own colour and depth. */
+ * the linear and the shown composite, and the window's own colour and depth;
+ * the specular layer's texture, cube maps and glossy levels come on top
+ * (ps_specular_plan_bytes: 10.3 MB at most for 8 cubes, 4.2 MB more a 512^2
+ * texture). */
 #define WIN_PIXEL_BYTES (3 * 4 * sizeof(float) + 4 * sizeof(float) + 4 + 4 + 4)
 /* Camera controls, as in Blender: degrees of orbit per pixel dragged, the
  * dolly factor per wheel notch, pan in units of the target distance per pixel. */
@@ -1136,8 +1140,10 @@ int main(int argc, char **argv)
         const ps_scene_defaults *def = ps_scene_get_defaults(a.scene);
         uint64_t photons =
             ps_shared_photons(&a.o.c, def, PS_MAP_CAUSTIC) + ps_shared_photons(&a.o.c, def, PS_MAP_GLOBAL);
-        st = ps_check_run_memory("photosplat", photons, PS_PREVIEW_PHOTON_BYTES, a.o.c.width ? a.o.c.width : def->width,
-                                 a.o.c.height ? a.o.c.height : def->height, WIN_PIXEL_BYTES, &err);
+        int w = a.o.c.width ? a.o.c.width : def->width, h = a.o.c.height ? a.o.c.height : def->height;
+        /* With the specular layer's cube maps, levels and texture (at most). */
+        st = ps_check_run_memory_extra("photosplat", photons, PS_PREVIEW_PHOTON_BYTES, w, h, WIN_PIXEL_BYTES,
+                                       ps_specular_plan_bytes(PS_GL_SPECULAR_CUBE_SIZE, w, h), &err);
     }
     if (st != PS_OK) {
         ps_script_destroy(a.script);

@@ -8,6 +8,8 @@
 #include "core/clock.h"
 
 #include "gl/gl_internal.h"
+#include "gl/gl_specular_blur.h"
+#include "preview/specular_glossy.h"
 
 /* GL's cube faces in order (+X, -X, +Y, -Y, +Z, -Z) and, for each, the
  * camera that renders it: texel (s, t) of face +X looks along
@@ -47,6 +49,7 @@ struct ps_gl_specular {
     bool layer_valid;
     float *scaled; /* weights times exposure */
     size_t scaled_cap;
+    ps_gl_glossy *glossy; /* the glossy objects' blurred levels (gl_specular_blur.h) */
 };
 
 ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err)
@@ -56,6 +59,11 @@ ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *e
     if (!g)
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the specular layer");
     g->size = cube_size > 0 ? cube_size : PS_GL_SPECULAR_CUBE_SIZE;
+    ps_status st = ps_gl_glossy_create(&g->glossy, err);
+    if (st != PS_OK) {
+        free(g);
+        return st;
+    }
     ps_splat_batch_init(&g->batch);
     glGenFramebuffers(1, &g->fbo);
     glGenRenderbuffers(1, &g->depth_stencil);
@@ -79,6 +87,7 @@ void ps_gl_specular_destroy(ps_gl_specular *g)
     if (g->layer_fbo)
         glDeleteFramebuffers(1, &g->layer_fbo);
     ps_splat_batch_free(&g->batch);
+    ps_gl_glossy_destroy(g->glossy);
     free(g->scaled);
     free(g);
 }
@@ -126,6 +135,14 @@ void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value)
     }
     glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
     free(texels);
+    /* The glossy levels blurred from those faces, as a refresh would. */
+    ps_error err;
+    if (ps_gl_glossy_sync(g->glossy, s, g->cube_count, g->size, &err) == PS_OK) {
+        for (int c = 0; c < g->cube_count; c++)
+            for (int f = 0; f < 6; f++)
+                ps_gl_glossy_read_face(g->glossy, c, f, g->cube[c], g->size);
+        ps_gl_glossy_blur(g->glossy, 0);
+    }
     g->frozen = true;
     g->cubes_changed = true;
 }
@@ -153,6 +170,9 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, g->cube[c], 0);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, g->depth_stencil);
     r->skip_specular = true;
+    bool hide = r->in.hide_emitters;
+    if (ps_gl_glossy_only(g->glossy, c)) /* their lobes' are the direct layer's (gl_specular_blur.h) */
+        r->in.hide_emitters = true;
     ps_gl_begin_frame(r, &cam, 1.0, fr->direct);
     ps_status st = PS_OK;
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
@@ -165,6 +185,7 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
     if (st == PS_OK)
         ps_gl_multiply_albedo(r);
     r->skip_specular = false;
+    r->in.hide_emitters = hide;
     g->faces_rendered++;
     return st;
 }
@@ -179,6 +200,12 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     int total = 6 * g->cube_count;
     if (total == 0)
         return PS_OK;
+    /* The glossy levels: a face a refresh from what was read before. */
+    ps_status gst = ps_gl_glossy_sync(g->glossy, s, g->cube_count, g->size, err);
+    if (gst != PS_OK)
+        return gst;
+    if (faces > 0 && ps_gl_glossy_blur(g->glossy, PS_GL_GLOSSY_FACES_PER_REFRESH) && !ps_gl_glossy_pending(g->glossy))
+        g->cubes_changed = true;
     /* What the cubes show changed: a new round. */
     unsigned layers = ps_session_get_settings(s)->layers;
     if (layers != g->layers || ps_session_edits(s) != g->edits || ps_session_maps_epoch(s) != g->epoch ||
@@ -233,11 +260,14 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     double t0 = ps_now_seconds();
     for (int i = 0; i < n && st == PS_OK; i++) {
         st = render_face(g, r, s, f, g->cursor / 6, g->cursor % 6, err);
+        ps_gl_glossy_read_face(g->glossy, g->cursor / 6, g->cursor % 6, g->cube[g->cursor / 6], g->size);
         g->cursor = (g->cursor + 1) % total;
         /* The layer is redrawn when a cube is whole again, not each face. */
         if (g->cursor % 6 == 0)
             g->cubes_changed = true;
     }
+    if (faces <= 0 && ps_gl_glossy_blur(g->glossy, 0)) /* all at once: the levels too */
+        g->cubes_changed = true;
     if (faces > 0) {
         glFinish(); /* llvmpipe draws when flushed: the face's own time */
         g->face_seconds = (ps_now_seconds() - t0) / n;
@@ -269,7 +299,8 @@ bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s)
     int cubes = ps_specular_cube_count(ps_session_specular(s));
     if (g->frozen || !(layers & PS_LAYER_SPECULAR) || ps_session_illuminance(s) || cubes == 0)
         return true;
-    if (g->cube_count != cubes || g->layers != layers || g->edits != ps_session_edits(s) || g->cubes_changed)
+    if (g->cube_count != cubes || g->layers != layers || g->edits != ps_session_edits(s) || g->cubes_changed ||
+        ps_gl_glossy_pending(g->glossy))
         return false;
     ps_session_counts counts;
     ps_session_get_counts(s, &counts);
@@ -323,7 +354,10 @@ static void draw_terms(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, doub
         const float *d = ps_specular_dirs(sp, k);
         for (size_t i = 0; i < nr; i++) {
             const ps_mesh_range *rg = &mesh->ranges[ranges[i].range];
-            glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[ranges[i].cube]);
+            /* Glossy ranges read the cube's blurred level (gl_specular_blur.h). */
+            GLuint level = ps_gl_glossy_texture(g->glossy, ranges[i].cube);
+            bool glossy = level && ps_glossy_wants(&ps_session_materials(s)[rg->material]);
+            glBindTexture(GL_TEXTURE_CUBE_MAP, glossy ? level : g->cube[ranges[i].cube]);
             glVertexPointer(3, GL_FLOAT, 0, mesh->positions + 3 * rg->first);
             glColorPointer(3, GL_FLOAT, 0, w + 3 * ranges[i].offset);
             glTexCoordPointer(3, GL_FLOAT, 0, d + 3 * ranges[i].offset);

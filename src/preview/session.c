@@ -10,6 +10,7 @@
 #include "preview/feed.h"
 #include "preview/repair.h"
 #include "preview/specular.h"
+#include "preview/specular_glossy.h"
 
 struct ps_session {
     ps_scene *scene;
@@ -57,6 +58,7 @@ struct ps_session {
     const ps_material *imap_mats;/* ... (colours are remade only when these or the maps change) */
     size_t lobe_drawn;
     ps_material *lobe_mats;
+    ps_material *nolobe_mats; /* the splats' while the specular layer draws the lobes (specular_glossy.h) */
     /* Selective repair (repair.h): the scene the maps were traced for, the
      * box path records are quantised in, what the last edit kept. */
     ps_repair_state traced;
@@ -295,6 +297,7 @@ void ps_session_destroy(ps_session *s)
     free(s->white);
     ps_illummap_destroy(s->imap);
     free(s->lobe_mats);
+    free(s->nolobe_mats);
     ps_repair_state_free(&s->traced);
     free(s);
 }
@@ -439,7 +442,9 @@ static ps_status imap_refresh(ps_session *s, const ps_photon_map *m, const ps_ca
     const uint32_t *lo;
     size_t nl = ps_illummap_lobe(s->imap, &lp, &lm, &lo), from = inc ? s->lobe_drawn : 0;
     s->splat_radius[k] = radius_at(s, k, emitted);
-    if (nl > from && !s->illuminance) {
+    /* While the specular layer shows, the lobes are its (specular_glossy.h). */
+    bool lobes_here = !((s->set.layers & PS_LAYER_SPECULAR) && ps_glossy_any(s->spec, &s->mesh, ps_session_materials(s)));
+    if (nl > from && !s->illuminance && lobes_here) {
         size_t nmat;
         ps_scene_materials(s->scene, &nmat);
         ps_illummap_lobe_materials(ps_session_materials(s), nmat, s->lobe_mats);
@@ -527,7 +532,17 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     double t0 = ps_now_seconds();
     const ps_material *materials = ps_session_materials(s);
     double wanted = 0.0, lost = 0.0;
-    ps_status st = PS_OK;
+    size_t nmat;
+    ps_scene_materials(s->scene, &nmat);
+    /* The global photons' glossy lobes are the specular layer's while it
+     * shows (specular_glossy.h); the caustic ones' are not (lights seen
+     * through glass in a glossy surface: no cube map shows them). */
+    bool spec_on = (s->set.layers & PS_LAYER_SPECULAR) && !s->illuminance;
+    const ps_material *global_mats;
+    ps_status st =
+        ps_glossy_splat_materials(s->spec, &s->mesh, materials, nmat, spec_on, &s->nolobe_mats, &global_mats, err);
+    if (st != PS_OK)
+        return st;
     ps_feed_lock(s->feed);
     const ps_photon_map *maps = ps_feed_maps(s->feed);
     if (out->new_view)
@@ -576,7 +591,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         p.point_size = s->set.point_size;
         p.precision = s->set.precision;
         p.levels = float_splats(s) ? 0 : 255;
-        p.materials = materials;
+        p.materials = k == PS_MAP_GLOBAL ? global_mats : materials;
         p.objects = s->set.stencil_clip ? m->objects + from : NULL;
         p.cam = *cam;
         st = ps_splat_build(m->photons + from, m->materials + from, end - from, &p, b, err);

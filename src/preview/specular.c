@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "preview/specular_glossy.h"
 #include "scene/bsdf.h"
 
 /* A path that meets nothing is looked up this many scene diagonals away
@@ -146,7 +147,7 @@ ps_status ps_specular_create(const ps_preview_mesh *mesh, const ps_material *mat
     ps_aabb box[PS_SPECULAR_MAX_CUBES];
     for (size_t r = 0; r < mesh->range_count; r++) {
         const ps_mesh_range *rg = &mesh->ranges[r];
-        if (!ps_material_is_specular(&materials[rg->material]) || rg->count == 0)
+        if (!ps_specular_wants(&materials[rg->material]) || rg->count == 0)
             continue;
         ps_aabb b = ps_aabb_empty();
         for (size_t v = 0; v < rg->count; v++)
@@ -431,8 +432,11 @@ size_t ps_specular_update(ps_specular *sp, const ps_world *world, ps_vec3 eye, s
         const float *nn = sp->mesh->normals + 3 * v;
         c.centre = sp->centre[lr->cube];
         ps_specular_term t[PS_SPECULAR_TERMS];
-        int count = trace_point(&c, range_material(sp, lr->range), eye, vertex_pos(sp->mesh, v),
-                                ps_v3(nn[0], nn[1], nn[2]), t);
+        const ps_material *m = range_material(sp, lr->range);
+        int count = ps_glossy_wants(m) /* the lobe's lookup (specular_glossy.h) */
+                        ? ps_glossy_trace_point(world, c.materials, m, eye, vertex_pos(sp->mesh, v),
+                                                ps_v3(nn[0], nn[1], nn[2]), c.centre, t, NULL)
+                        : trace_point(&c, m, eye, vertex_pos(sp->mesh, v), ps_v3(nn[0], nn[1], nn[2]), t);
         for (int j = 0; j < PS_SPECULAR_TERMS; j++) {
             float dv[3] = {0, 0, 1}, wv[3] = {0, 0, 0};
             if (j < count) {

@@ -1,0 +1,208 @@
+/* specular_glossy.c: glossy lobes in the specular layer (specular_glossy.h). */
+#include "preview/specular_glossy.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+bool ps_glossy_wants(const ps_material *m) { return m->type == PS_MAT_GLOSSY && ps_rgb_max(m->specular) > 0.0; }
+
+bool ps_specular_wants(const ps_material *m) { return ps_material_is_specular(m) || ps_glossy_wants(m); }
+
+double ps_glossy_lobe_exponent(const ps_material *m) { return m->exponent + 1.0; }
+
+int ps_glossy_level_size(double m, int base_size)
+{
+    /* The lobe's full width at half maximum: cos^m(a) = 1/2. A face spans
+     * pi / 2. */
+    double width = 2.0 * acos(pow(0.5, 1.0 / fmax(m, 1e-3)));
+    double want = PS_GLOSSY_TEXELS_PER_WIDTH * 0.5 * PS_PI / width;
+    int size = PS_GLOSSY_MIN_LEVEL;
+    while (size < want && size < PS_GLOSSY_MAX_LEVEL)
+        size *= 2;
+    return size < base_size ? size : base_size;
+}
+
+bool ps_glossy_any(const ps_specular *sp, const ps_preview_mesh *mesh, const ps_material *materials)
+{
+    const ps_specular_range *r = ps_specular_ranges(sp);
+    for (size_t i = 0; i < ps_specular_range_count(sp); i++)
+        if (ps_glossy_wants(&materials[mesh->ranges[r[i].range].material]))
+            return true;
+    return false;
+}
+
+void ps_glossy_diffuse_materials(const ps_material *materials, size_t n, ps_material *out)
+{
+    for (size_t i = 0; i < n; i++) {
+        out[i] = materials[i];
+        if (ps_glossy_wants(&out[i]))
+            out[i].specular = ps_rgb_gray(0.0);
+    }
+}
+
+ps_status ps_glossy_splat_materials(const ps_specular *sp, const ps_preview_mesh *mesh, const ps_material *materials,
+                                    size_t n, bool layer_on, ps_material **store, const ps_material **out,
+                                    ps_error *err)
+{
+    *out = materials;
+    if (!layer_on || !sp || !ps_glossy_any(sp, mesh, materials))
+        return PS_OK;
+    ps_material *m = realloc(*store, (n ? n : 1) * sizeof *m);
+    if (!m)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for %zu materials", n);
+    *store = m;
+    ps_glossy_diffuse_materials(materials, n, m);
+    *out = m;
+    return PS_OK;
+}
+
+int ps_glossy_trace_point(const ps_world *world, const ps_material *materials, const ps_material *m, ps_vec3 eye,
+                          ps_vec3 p, ps_vec3 n, ps_vec3 centre, ps_specular_term out[PS_SPECULAR_TERMS],
+                          double *dropped)
+{
+    /* The mirror direction's path is a perfect mirror's. */
+    ps_material mirror;
+    memset(&mirror, 0, sizeof mirror);
+    mirror.type = PS_MAT_MIRROR;
+    mirror.reflectance = ps_rgb_gray(1.0);
+    int k = ps_specular_trace_point(world, materials, &mirror, eye, p, n, centre, out, dropped);
+    ps_vec3 d = ps_v3_sub(p, eye);
+    double len = ps_v3_len(d);
+    double nl = ps_v3_len(n);
+    /* n . r = -(d . n) on the side the eye sees. */
+    double cos_r = len > 0.0 && nl > 0.0 ? fabs(ps_v3_dot(d, n)) / (len * nl) : 0.0;
+    ps_rgb w = ps_rgb_scale(m->specular, cos_r);
+    for (int i = 0; i < k; i++)
+        out[i].weight = ps_rgb_mul(out[i].weight, w);
+    return k;
+}
+
+/* GL's cube faces: the major axis and how sc, tc map onto the others. */
+ps_vec3 ps_cube_dir(int face, double s, double t)
+{
+    double sc = 2.0 * s - 1.0, tc = 2.0 * t - 1.0;
+    ps_vec3 d;
+    switch (face) {
+    case 0: d = ps_v3(1.0, -tc, -sc); break;
+    case 1: d = ps_v3(-1.0, -tc, sc); break;
+    case 2: d = ps_v3(sc, 1.0, tc); break;
+    case 3: d = ps_v3(sc, -1.0, -tc); break;
+    case 4: d = ps_v3(sc, -tc, 1.0); break;
+    default: d = ps_v3(-sc, -tc, -1.0); break;
+    }
+    return ps_v3_norm(d);
+}
+
+struct ps_glossy_filter {
+    int in_size, out_size;
+    double m, floor_cos;
+    /* The level's texels: unit directions and solid angles (6 out_size^2),
+     * and the kept input averaged to them (rgb). */
+    float *dir, *omega, *kept;
+};
+
+ps_status ps_glossy_filter_create(int in_size, int out_size, double m, ps_glossy_filter **out, ps_error *err)
+{
+    *out = NULL;
+    if (in_size <= 0 || out_size <= 0 || out_size > in_size || !(m > 0.0))
+        return ps_error_set(err, PS_ERR_RANGE, "glossy level: sizes %d -> %d, exponent %g", in_size, out_size, m);
+    ps_glossy_filter *f = calloc(1, sizeof *f);
+    size_t n = 6 * (size_t)out_size * (size_t)out_size;
+    if (f) {
+        f->dir = malloc(3 * n * sizeof *f->dir);
+        f->omega = malloc(n * sizeof *f->omega);
+        f->kept = calloc(3 * n, sizeof *f->kept);
+    }
+    if (!f || !f->dir || !f->omega || !f->kept) {
+        ps_glossy_filter_destroy(f);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for a glossy level of %d^2", out_size);
+    }
+    f->in_size = in_size, f->out_size = out_size, f->m = m;
+    /* cos^m = floor: past it the terms are left out. */
+    f->floor_cos = exp(log(PS_GLOSSY_LOBE_FLOOR) / m);
+    int b = out_size;
+    for (int face = 0; face < 6; face++)
+        for (int j = 0; j < b; j++)
+            for (int i = 0; i < b; i++) {
+                size_t k = ((size_t)face * b + j) * b + i;
+                ps_vec3 d = ps_cube_dir(face, (i + 0.5) / b, (j + 0.5) / b);
+                f->dir[3 * k] = (float)d.x, f->dir[3 * k + 1] = (float)d.y, f->dir[3 * k + 2] = (float)d.z;
+                /* A texel of side 2 / b on the unit-distance face plane at
+                 * (u, v) subtends (2 / b)^2 / (1 + u^2 + v^2)^(3/2). */
+                double u = 2.0 * (i + 0.5) / b - 1.0, v = 2.0 * (j + 0.5) / b - 1.0;
+                f->omega[k] = (float)(4.0 / ((double)b * b) / pow(1.0 + u * u + v * v, 1.5));
+            }
+    *out = f;
+    return PS_OK;
+}
+
+void ps_glossy_filter_destroy(ps_glossy_filter *f)
+{
+    if (!f)
+        return;
+    free(f->dir);
+    free(f->omega);
+    free(f->kept);
+    free(f);
+}
+
+int ps_glossy_filter_out_size(const ps_glossy_filter *f) { return f->out_size; }
+double ps_glossy_filter_exponent(const ps_glossy_filter *f) { return f->m; }
+
+void ps_glossy_filter_set_face(ps_glossy_filter *f, int face, const float *rgba)
+{
+    int a = f->in_size, b = f->out_size;
+    float *dst = f->kept + 3 * (size_t)face * b * b;
+    for (int j = 0; j < b; j++)
+        for (int i = 0; i < b; i++) {
+            /* The input texels whose index scales into this one: a box. */
+            int i0 = i * a / b, i1 = (i + 1) * a / b, j0 = j * a / b, j1 = (j + 1) * a / b;
+            double sum[3] = {0, 0, 0};
+            for (int y = j0; y < j1; y++)
+                for (int x = i0; x < i1; x++)
+                    for (int c = 0; c < 3; c++)
+                        sum[c] += rgba[4 * ((size_t)y * a + x) + c];
+            double cnt = (double)(i1 - i0) * (j1 - j0);
+            for (int c = 0; c < 3; c++)
+                dst[3 * ((size_t)j * b + i) + c] = (float)(sum[c] / cnt);
+        }
+}
+
+void ps_glossy_filter_face(const ps_glossy_filter *f, int face, float *rgba)
+{
+    int b = f->out_size;
+    size_t n = 6 * (size_t)b * b;
+    const float fc = (float)f->floor_cos;
+    for (int j = 0; j < b; j++)
+        for (int i = 0; i < b; i++) {
+            size_t o = ((size_t)face * b + j) * b + i;
+            float ox = f->dir[3 * o], oy = f->dir[3 * o + 1], oz = f->dir[3 * o + 2];
+            double sum[3] = {0, 0, 0}, wsum = 0.0;
+            for (size_t k = 0; k < n; k++) {
+                float c = ox * f->dir[3 * k] + oy * f->dir[3 * k + 1] + oz * f->dir[3 * k + 2];
+                if (c <= fc)
+                    continue;
+                double w = f->omega[k] * exp(f->m * log((double)c));
+                wsum += w;
+                sum[0] += w * f->kept[3 * k];
+                sum[1] += w * f->kept[3 * k + 1];
+                sum[2] += w * f->kept[3 * k + 2];
+            }
+            float *t = rgba + 4 * ((size_t)j * b + i);
+            for (int c = 0; c < 3; c++)
+                t[c] = (float)(wsum > 0.0 ? sum[c] / wsum : 0.0);
+            t[3] = 1.0f;
+        }
+}
+
+uint64_t ps_specular_plan_bytes(int cube_size, int width, int height)
+{
+    uint64_t cube = 6 * (uint64_t)cube_size * (uint64_t)cube_size * 4 * 2; /* RGBA16F */
+    uint64_t level = 6 * (uint64_t)PS_GLOSSY_MAX_LEVEL * PS_GLOSSY_MAX_LEVEL;
+    /* A level: the texture (RGBA16F), the kept texels, directions and solid
+     * angles (7 floats), one face's upload (RGBA floats), and one read-back
+     * face of the cube (RGBA floats). */
+    uint64_t glossy = level * (4 * 2 + 7 * 4) + level / 6 * 4 * 4 + (uint64_t)cube_size * cube_size * 4 * 4;
+    return PS_SPECULAR_MAX_CUBES * (cube + glossy) + (uint64_t)width * (uint64_t)height * 4 * 4;
+}
