@@ -150,23 +150,45 @@ void ps_glossy_filter_destroy(ps_glossy_filter *f)
 int ps_glossy_filter_out_size(const ps_glossy_filter *f) { return f->out_size; }
 double ps_glossy_filter_exponent(const ps_glossy_filter *f) { return f->m; }
 
+/* Each input texel is split bilinearly over the four level texels about it
+ * (a tent, clamped at the face's edges), and each level texel is its share's
+ * weighted mean: a bright texel keeps its centroid, where a box average would
+ * move it to the level texel's centre (half a level texel: 9.5 % of the
+ * lobe's peak off the brute force in test_specular_glossy, 32 -> 16). */
 void ps_glossy_filter_set_face(ps_glossy_filter *f, int face, const float *rgba)
 {
     int a = f->in_size, b = f->out_size;
     float *dst = f->kept + 3 * (size_t)face * b * b;
-    for (int j = 0; j < b; j++)
-        for (int i = 0; i < b; i++) {
-            /* The input texels whose index scales into this one: a box. */
-            int i0 = i * a / b, i1 = (i + 1) * a / b, j0 = j * a / b, j1 = (j + 1) * a / b;
-            double sum[3] = {0, 0, 0};
-            for (int y = j0; y < j1; y++)
-                for (int x = i0; x < i1; x++)
-                    for (int c = 0; c < 3; c++)
-                        sum[c] += rgba[4 * ((size_t)y * a + x) + c];
-            double cnt = (double)(i1 - i0) * (j1 - j0);
-            for (int c = 0; c < 3; c++)
-                dst[3 * ((size_t)j * b + i) + c] = (float)(sum[c] / cnt);
+    size_t n = (size_t)b * b;
+    double *acc = calloc(4 * n, sizeof *acc);
+    if (!acc)
+        return; /* the level keeps this face as it was */
+    for (int y = 0; y < a; y++) {
+        double fy = (y + 0.5) * b / a - 0.5;
+        int j0 = (int)floor(fy);
+        double ty = fy - j0;
+        for (int x = 0; x < a; x++) {
+            double fx = (x + 0.5) * b / a - 0.5;
+            int i0 = (int)floor(fx);
+            double tx = fx - i0;
+            const float *src = rgba + 4 * ((size_t)y * a + x);
+            for (int dj = 0; dj < 2; dj++)
+                for (int di = 0; di < 2; di++) {
+                    double w = (di ? tx : 1.0 - tx) * (dj ? ty : 1.0 - ty);
+                    if (w <= 0.0)
+                        continue;
+                    int i = i0 + di, j = j0 + dj;
+                    i = i < 0 ? 0 : i >= b ? b - 1 : i;
+                    j = j < 0 ? 0 : j >= b ? b - 1 : j;
+                    double *t = acc + 4 * ((size_t)j * b + i);
+                    t[0] += w * src[0], t[1] += w * src[1], t[2] += w * src[2], t[3] += w;
+                }
         }
+    }
+    for (size_t k = 0; k < n; k++)
+        for (int c = 0; c < 3; c++)
+            dst[3 * k + c] = (float)(acc[4 * k + 3] > 0.0 ? acc[4 * k + c] / acc[4 * k + 3] : 0.0);
+    free(acc);
 }
 
 void ps_glossy_filter_face(const ps_glossy_filter *f, int face, float *rgba)

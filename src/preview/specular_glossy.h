@@ -89,8 +89,9 @@ ps_status ps_glossy_filter_create(int in_size, int out_size, double m, ps_glossy
 void ps_glossy_filter_destroy(ps_glossy_filter *f); /* accepts NULL */
 int ps_glossy_filter_out_size(const ps_glossy_filter *f);
 double ps_glossy_filter_exponent(const ps_glossy_filter *f);
-/* Face `face` of the input (in_size^2 RGBA, rows in t): kept, box-averaged
- * to out_size. Faces not given yet are black. */
+/* Face `face` of the input (in_size^2 RGBA, rows in t): kept, brought to
+ * out_size by a tent (each input texel split bilinearly over the level
+ * texels about it). Faces not given yet are black. */
 void ps_glossy_filter_set_face(ps_glossy_filter *f, int face, const float *rgba);
 /* Face `face` of the level (out_size^2 RGBA, alpha 1): each texel the
  * solid-angle weighted sum of the kept texels times cos^m of their angle
