@@ -94,13 +94,35 @@ ps_vec3 ps_cube_dir(int face, double s, double t)
     return ps_v3_norm(d);
 }
 
+/* A face's texels in TILES x TILES tiles: a tile wholly outside an output
+ * texel's lobe (past its floor) is skipped whole, so that a face of a lobe
+ * reaching 31 degrees (e + 1 = 61) visits a tenth of the cube, not all. */
+#define TILES 8
+/* cos^m tabulated over [floor_cos, 1] at this many intervals, linearly
+ * interpolated (the error is below 10^-7 of the peak at m = 1000). */
+#define LOBE_TABLE 4096
+
 struct ps_glossy_filter {
     int in_size, out_size;
     double m, floor_cos;
     /* The level's texels: unit directions and solid angles (6 out_size^2),
      * and the kept input averaged to them (rgb). */
     float *dir, *omega, *kept;
+    /* Per tile (6 TILES^2): its centre's direction, and the cosine below
+     * which an output direction's lobe cannot reach the tile (the lobe's
+     * floor angle plus the tile's own angular radius). */
+    float tile_dir[6 * TILES * TILES][3], tile_cos[6 * TILES * TILES];
+    float lobe[LOBE_TABLE + 2];
 };
+
+static float lobe_at(const ps_glossy_filter *f, float c)
+{
+    float x = (c - (float)f->floor_cos) / (float)(1.0 - f->floor_cos) * LOBE_TABLE;
+    int i = (int)x;
+    if (i >= LOBE_TABLE)
+        return f->lobe[LOBE_TABLE];
+    return f->lobe[i] + (x - (float)i) * (f->lobe[i + 1] - f->lobe[i]);
+}
 
 ps_status ps_glossy_filter_create(int in_size, int out_size, double m, ps_glossy_filter **out, ps_error *err)
 {
@@ -132,6 +154,23 @@ ps_status ps_glossy_filter_create(int in_size, int out_size, double m, ps_glossy
                  * (u, v) subtends (2 / b)^2 / (1 + u^2 + v^2)^(3/2). */
                 double u = 2.0 * (i + 0.5) / b - 1.0, v = 2.0 * (j + 0.5) / b - 1.0;
                 f->omega[k] = (float)(4.0 / ((double)b * b) / pow(1.0 + u * u + v * v, 1.5));
+            }
+    for (int i = 0; i <= LOBE_TABLE + 1; i++)
+        f->lobe[i] = (float)pow(fmin(1.0, f->floor_cos + (1.0 - f->floor_cos) * i / LOBE_TABLE), m);
+    double floor_angle = acos(fmin(1.0, f->floor_cos));
+    for (int face = 0; face < 6; face++)
+        for (int tj = 0; tj < TILES; tj++)
+            for (int ti = 0; ti < TILES; ti++) {
+                int t = (face * TILES + tj) * TILES + ti;
+                ps_vec3 c = ps_cube_dir(face, (ti + 0.5) / TILES, (tj + 0.5) / TILES);
+                double radius = 0.0;
+                for (int k = 0; k < 4; k++) {
+                    ps_vec3 e = ps_cube_dir(face, (double)(ti + (k & 1)) / TILES, (double)(tj + (k >> 1)) / TILES);
+                    radius = fmax(radius, acos(fmin(1.0, ps_v3_dot(c, e))));
+                }
+                f->tile_dir[t][0] = (float)c.x, f->tile_dir[t][1] = (float)c.y, f->tile_dir[t][2] = (float)c.z;
+                /* A little slack for the floats' rounding. */
+                f->tile_cos[t] = (float)cos(fmin(PS_PI, floor_angle + radius + 1e-3));
             }
     *out = f;
     return PS_OK;
@@ -194,22 +233,29 @@ void ps_glossy_filter_set_face(ps_glossy_filter *f, int face, const float *rgba)
 void ps_glossy_filter_face(const ps_glossy_filter *f, int face, float *rgba)
 {
     int b = f->out_size;
-    size_t n = 6 * (size_t)b * b;
     const float fc = (float)f->floor_cos;
     for (int j = 0; j < b; j++)
         for (int i = 0; i < b; i++) {
             size_t o = ((size_t)face * b + j) * b + i;
             float ox = f->dir[3 * o], oy = f->dir[3 * o + 1], oz = f->dir[3 * o + 2];
             double sum[3] = {0, 0, 0}, wsum = 0.0;
-            for (size_t k = 0; k < n; k++) {
-                float c = ox * f->dir[3 * k] + oy * f->dir[3 * k + 1] + oz * f->dir[3 * k + 2];
-                if (c <= fc)
+            for (int t = 0; t < 6 * TILES * TILES; t++) {
+                if (ox * f->tile_dir[t][0] + oy * f->tile_dir[t][1] + oz * f->tile_dir[t][2] < f->tile_cos[t])
                     continue;
-                double w = f->omega[k] * exp(f->m * log((double)c));
-                wsum += w;
-                sum[0] += w * f->kept[3 * k];
-                sum[1] += w * f->kept[3 * k + 1];
-                sum[2] += w * f->kept[3 * k + 2];
+                int tf = t / (TILES * TILES), ti = t % TILES, tj = t / TILES % TILES;
+                int x0 = ti * b / TILES, x1 = (ti + 1) * b / TILES, y0 = tj * b / TILES, y1 = (tj + 1) * b / TILES;
+                for (int y = y0; y < y1; y++)
+                    for (int x = x0; x < x1; x++) {
+                        size_t k = ((size_t)tf * b + y) * b + x;
+                        float c = ox * f->dir[3 * k] + oy * f->dir[3 * k + 1] + oz * f->dir[3 * k + 2];
+                        if (c <= fc)
+                            continue;
+                        double w = f->omega[k] * lobe_at(f, c);
+                        wsum += w;
+                        sum[0] += w * f->kept[3 * k];
+                        sum[1] += w * f->kept[3 * k + 1];
+                        sum[2] += w * f->kept[3 * k + 2];
+                    }
             }
             float *t = rgba + 4 * ((size_t)j * b + i);
             for (int c = 0; c < 3; c++)

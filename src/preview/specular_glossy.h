@@ -37,13 +37,14 @@
 #include "scene/scene.h"
 
 /* A blurred level's side at most (and at least PS_GLOSSY_MIN_LEVEL): one face
- * of 32^2 costs 32^2 x 6 x 32^2 lobe terms, 5-10 ms. */
+ * of 32^2 weighs 32^2 texels by the lobe over the tiles of the cube it
+ * reaches. */
 #define PS_GLOSSY_MAX_LEVEL 32
 #define PS_GLOSSY_MIN_LEVEL 8
 /* A level's texels per lobe width (full width at half maximum) at least. */
 #define PS_GLOSSY_TEXELS_PER_WIDTH 4.0
 /* Lobe terms below this fraction of the peak are left out of the sums. */
-#define PS_GLOSSY_LOBE_FLOOR 1e-6
+#define PS_GLOSSY_LOBE_FLOOR 1e-4
 
 /* Whether the layer draws material m: mirrors, dielectrics, and glossy
  * materials with a lobe. */
