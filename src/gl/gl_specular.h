@@ -19,7 +19,8 @@
  * while only the camera moves; a new layer set, an edit or new GL lights
  * start a new round. The objects are then drawn PS_SPECULAR_TERMS times,
  * each pass one lookup direction (texture coordinates into the object's
- * cube) modulated by its weight (vertex colours), added together. */
+ * cube) modulated by its weight (vertex colours), added together. Glossy
+ * objects look up their cube's blurred level instead (gl_specular_blur.h). */
 #ifndef PS_GL_GL_SPECULAR_H
 #define PS_GL_GL_SPECULAR_H
 

@@ -25,9 +25,9 @@
  * only if nothing diffuse lies between the centre and P; lookups are
  * interpolated over the mesh's triangles (Gouraud); area lights are seen in
  * the cube map as the direct layer draws them, point and spot lights not at
- * all (as in photosplat-ref). Glossy lobes are not part of this layer (as in
- * photosplat-ref's `specular` component, which is what mirrors and glass
- * show). */
+ * all (as in photosplat-ref). Glossy objects are in the set too, each with a
+ * cube of its own and one lookup a vertex along its mirror direction into a
+ * blurred level (preview/specular_glossy.h). */
 #ifndef PS_PREVIEW_SPECULAR_H
 #define PS_PREVIEW_SPECULAR_H
 
