@@ -200,11 +200,13 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     int total = 6 * g->cube_count;
     if (total == 0)
         return PS_OK;
-    /* The glossy levels: a face a refresh from what was read before. */
+    /* The glossy levels: a face a refresh from what was read before (not in
+     * a new view's refresh, which comes as fast as without the layer). */
     ps_status gst = ps_gl_glossy_sync(g->glossy, s, g->cube_count, g->size, err);
     if (gst != PS_OK)
         return gst;
-    if (faces > 0 && ps_gl_glossy_blur(g->glossy, PS_GL_GLOSSY_FACES_PER_REFRESH) && !ps_gl_glossy_pending(g->glossy))
+    if (faces > 0 && !f->new_view && ps_gl_glossy_blur(g->glossy, PS_GL_GLOSSY_FACES_PER_REFRESH) &&
+        !ps_gl_glossy_pending(g->glossy))
         g->cubes_changed = true;
     /* What the cubes show changed: a new round. */
     unsigned layers = ps_session_get_settings(s)->layers;

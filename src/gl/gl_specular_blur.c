@@ -99,11 +99,17 @@ ps_status ps_gl_glossy_sync(ps_gl_glossy *g, ps_session *s, int cube_count, int 
         l->only = !other[c];
         l->m = m[c];
         l->in_size = cube_size;
-        l->pending = 0x3f;
+        l->pending = 0; /* black, as the cube is, until its faces are read */
+        float *black = calloc(4 * (size_t)b * b, sizeof *black);
+        if (!black) {
+            drop_level(l);
+            return ps_error_set(err, PS_ERR_NOMEM, "out of memory for a glossy level of %d^2", b);
+        }
         glGenTextures(1, &l->tex);
         glBindTexture(GL_TEXTURE_CUBE_MAP, l->tex);
         for (int f = 0; f < 6; f++)
-            glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_RGBA16F, b, b, 0, GL_RGBA, GL_FLOAT, NULL);
+            glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_RGBA16F, b, b, 0, GL_RGBA, GL_FLOAT, black);
+        free(black);
         ps_gl_cube_linear_clamped();
         glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
     }
