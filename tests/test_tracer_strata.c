@@ -102,7 +102,7 @@ static void one_map(rig *a, rig *b, ps_map_kind k, uint64_t n, double frac)
         memcpy(pa, ta.map.photons + ta.off[o], na * sizeof *pa);
         ps_tracer_repower(b->tracer, k, &src[i], ta.paths.thr + ta.off[o], na, pa);
         assert_memory_equal(pa, tb.map.photons + tb.off[i], na * sizeof *pa);
-        assert_memory_equal(ta.paths.thr + ta.off[o], tb.paths.thr + tb.off[i], na * sizeof *pa->rgbe * 3);
+        assert_memory_equal(ta.paths.thr + ta.off[o], tb.paths.thr + tb.off[i], na * sizeof(ps_path_thr));
         assert_memory_equal(ta.map.materials + ta.off[o], tb.map.materials + tb.off[i], na * sizeof(uint16_t));
         assert_memory_equal(ta.map.objects + ta.off[o], tb.map.objects + tb.off[i], na * sizeof(uint32_t));
         photons += na;
