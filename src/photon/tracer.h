@@ -17,9 +17,12 @@
  * so the photon array is byte-identical for any thread count or batching.
  *
  * Departure from the thesis: it seeds a pseudo-random generator with the
- * photon number; we also use the quasi-random Halton point at that number for
- * emission (Keller's quasi-Monte Carlo photon map), which keeps the same
- * determinism and makes the maps visibly smoother for the same photon count. */
+ * photon number; we also use a quasi-random Halton point for emission
+ * (Keller's quasi-Monte Carlo photon map), which keeps the same determinism
+ * and makes the maps visibly smoother for the same photon count. Departure
+ * from Keller: one Halton sequence per stratum, at the photon's rank in it,
+ * not one for the whole map at the photon's index (so that an edit of one
+ * stratum's share leaves the others' photons as they were; docs/repair.md). */
 #ifndef PS_PHOTON_TRACER_H
 #define PS_PHOTON_TRACER_H
 

@@ -461,7 +461,7 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
     out.count += rest;
     free(f->paths[k].thr);
     f->paths[k].thr = thr;
-    f->paths[k].tcount = f->paths[k].tcap = m->count ? m->count : 1;
+    f->paths[k].tcap = m->count ? m->count : 1;
     f->paths[k].tcount = m->count;
     out.counters = m->counters;
     pthread_mutex_lock(&f->lock);
