@@ -40,6 +40,7 @@ typedef struct stratum {
     double cdf; /* cumulative share, normalised; the last is 1 */
     ps_rgb power; /* the light's, when planned: stored power = T x power / count */
     uint64_t key;
+    uint64_t dither_key;        /* its photons' RGBE dithers (photon_dither) */
     double rotation[EMIT_DIMS]; /* Cranley-Patterson shifts of its emission numbers */
 } stratum;
 
@@ -57,6 +58,9 @@ typedef struct map_plan {
     double *scale;
     uint64_t *prefix;
     size_t granules;
+    /* With records (a session that repairs): each index's stratum, so that
+     * a repair's photon sources read it instead of recomputing it. */
+    uint8_t *seq;
 } map_plan;
 
 struct ps_tracer {
@@ -294,6 +298,7 @@ ps_status ps_tracer_create(const ps_world *w, const ps_tracer_options *opt, ps_t
             stratum *sk = &p->strata[q];
             uint64_t id = ((uint64_t)sk->light + 1) << 32 ^ (uint64_t)(sk->target + 1);
             sk->key = ps_hash64(h ^ ps_hash64(id ^ 0x2545f4914f6cdd1dULL));
+            sk->dither_key = ps_hash64(sk->key ^ 0x9fb21c651e98df25ULL);
             uint64_t r = sk->key;
             for (int d = 0; d < EMIT_DIMS; d++) {
                 r = ps_hash64(r + (uint64_t)d + 1);
@@ -320,6 +325,7 @@ void ps_tracer_destroy(ps_tracer *t)
         free(t->plans[k].counts);
         free(t->plans[k].scale);
         free(t->plans[k].prefix);
+        free(t->plans[k].seq);
     }
     ps_light_sampler_destroy(t->lights);
     free(t->skips);
@@ -380,7 +386,7 @@ static size_t stratum_of(const map_plan *p, uint64_t i)
 
 /* Counts, normalisation and the rank table for `total` photons; false when
  * out of memory for the table. */
-static bool count_strata(map_plan *p, uint64_t total)
+static bool count_strata(map_plan *p, uint64_t total, bool keep_seq)
 {
     if (p->counted && p->counted_total == total)
         return true;
@@ -392,11 +398,21 @@ static bool count_strata(map_plan *p, uint64_t total)
         return false;
     p->prefix = prefix;
     p->granules = granules;
+    free(p->seq);
+    p->seq = NULL;
+    if (keep_seq && p->count <= UINT8_MAX + 1 && total <= SIZE_MAX) {
+        p->seq = malloc(total ? (size_t)total : 1);
+        if (!p->seq)
+            return false;
+    }
     memset(p->counts, 0, p->count * sizeof *p->counts);
     for (uint64_t i = 0; i < total; i++) {
         if (i % RANK_GRANULE == 0)
             memcpy(prefix + (size_t)(i / RANK_GRANULE) * p->count, p->counts, p->count * sizeof *p->counts);
-        p->counts[stratum_of(p, i)]++;
+        size_t k = stratum_of(p, i);
+        p->counts[k]++;
+        if (p->seq)
+            p->seq[i] = (uint8_t)k;
     }
     if (total % RANK_GRANULE == 0)
         memcpy(prefix + (size_t)(total / RANK_GRANULE) * p->count, p->counts, p->count * sizeof *p->counts);
@@ -434,7 +450,7 @@ static void rank_of(const map_plan *p, rank_cursor *c, uint64_t i, size_t *k, ui
 uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light, uint64_t total)
 {
     map_plan *p = &t->plans[kind];
-    if (!p->enabled || !count_strata(p, total))
+    if (!p->enabled || !count_strata(p, total, t->opt.records))
         return 0;
     uint64_t n = 0;
     for (size_t k = 0; k < p->count; k++)
@@ -446,7 +462,7 @@ uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light,
 uint64_t ps_tracer_stratum_photons(ps_tracer *t, ps_map_kind kind, uint32_t light, int64_t target, uint64_t total)
 {
     map_plan *p = &t->plans[kind];
-    if (!p->enabled || !count_strata(p, total))
+    if (!p->enabled || !count_strata(p, total, t->opt.records))
         return 0;
     for (size_t k = 0; k < p->count; k++)
         if (p->strata[k].light == light && p->strata[k].target == target)
@@ -480,12 +496,14 @@ static ps_rgb stored_power(const ps_path_thr *thr, ps_rgb light_power, double sc
     return ps_rgb_scale(ps_rgb_mul(T, light_power), scale);
 }
 
-/* The RGBE dither of the s-th photon that path (stratum key, j) stores: from
- * the photon's own identity, not its PCG stream, so that a repair can round
- * its new power the same way without retracing it. */
-static double photon_dither(uint64_t key, uint64_t j, unsigned s)
+/* The RGBE dither of the s-th photon (s < 256: trace_photon's limit) that
+ * path j of a stratum stores: from the photon's own identity, not its PCG
+ * stream, so that a repair can round its new power the same way without
+ * retracing it. One SplitMix64 finaliser of (stratum, j, s) is uniform
+ * enough for a dither. */
+static double photon_dither(uint64_t dither_key, uint64_t j, unsigned s)
 {
-    uint64_t h = ps_hash64(ps_hash64(key ^ 0x9fb21c651e98df25ULL) ^ ps_hash64(j) ^ ((uint64_t)s << 56));
+    uint64_t h = ps_hash64(dither_key ^ (j << 8 | (uint64_t)s));
     return (double)(h >> 11) * (1.0 / 9007199254740992.0);
 }
 
@@ -515,7 +533,7 @@ static void store(const ps_tracer *t, chunk_out *out, path_ctx *pc, const ps_sur
 {
     ps_path_thr T = round_thr(thr);
     ps_rgb power = stored_power(&T, pc->st->power, pc->scale);
-    double dither = photon_dither(pc->st->key, pc->j, pc->stored++);
+    double dither = photon_dither(pc->st->dither_key, pc->j, pc->stored++);
     if (!ps_photon_map_push(&out->map, ps_photon_pack(sp->p, power, d, n, dither), (uint16_t)sp->material,
                             sp->object)) {
         out->failed = true;
@@ -763,7 +781,7 @@ static ps_status trace_some(ps_tracer *t, ps_map_kind kind, uint64_t first, uint
     map_plan *plan = &t->plans[kind];
     if (!plan->enabled || count == 0)
         return PS_OK;
-    if (!count_strata(plan, total))
+    if (!count_strata(plan, total, t->opt.records))
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning %llu photons", path,
                             (unsigned long long)total);
 
@@ -897,10 +915,10 @@ ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind,
     const char *path = ps_scene_path(b->scene);
     map_plan *pa = &a->plans[kind], *pb = &b->plans[kind];
     for (uint64_t i = 0; i < end; i++)
-        out[i] = (ps_photon_source){PS_SOURCE_NONE, 0, UINT32_MAX};
+        out[i] = (ps_photon_source){PS_SOURCE_NONE, 0, UINT32_MAX, false};
     if (!pb->enabled)
         return PS_OK;
-    if (!count_strata(pb, total) || (pa->enabled && !count_strata(pa, total)))
+    if (!count_strata(pb, total, b->opt.records) || (pa->enabled && !count_strata(pa, total, a->opt.records)))
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning %llu photons", path,
                             (unsigned long long)total);
     /* b's stratum kb is a's match[kb] when both sample the same way. */
@@ -922,27 +940,35 @@ ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind,
             if (same_sampling(&pa->strata[ka], sb))
                 match[kb] = ka;
     }
+    /* end <= total: the kept sequences cover it. */
+#define STRATUM(p, i) ((p)->seq ? (size_t)(p)->seq[i] : stratum_of(p, i))
     if (pa->enabled) {
         /* a's indices below end, by stratum and rank. */
         for (uint64_t i = 0; i < end; i++)
-            start[stratum_of(pa, i) + 1]++;
+            start[STRATUM(pa, i) + 1]++;
         for (size_t ka = 0; ka < pa->count; ka++)
             start[ka + 1] += start[ka];
         uint64_t *fill = rank + pb->count;
         for (uint64_t i = 0; i < end; i++) {
-            size_t ka = stratum_of(pa, i);
+            size_t ka = STRATUM(pa, i);
             byrank[start[ka] + fill[ka]++] = i;
         }
     }
     for (uint64_t i = 0; i < end; i++) {
-        size_t kb = stratum_of(pb, i);
+        size_t kb = STRATUM(pb, i);
         uint64_t j = rank[kb]++;
         out[i].stratum = (uint32_t)kb;
         out[i].rank = j;
         size_t ka = match[kb];
-        if (ka != SIZE_MAX && j < start[ka + 1] - start[ka])
+        if (ka != SIZE_MAX && j < start[ka + 1] - start[ka]) {
             out[i].from = byrank[start[ka] + j];
+            /* The same light power and count: the stored bytes are already
+             * those of b's trace (the same T, dither and product). */
+            out[i].repower = memcmp(&pa->strata[ka].power, &pb->strata[kb].power, sizeof(ps_rgb)) != 0 ||
+                             memcmp(&pa->scale[ka], &pb->scale[kb], sizeof(double)) != 0;
+        }
     }
+#undef STRATUM
     free(match), free(start), free(byrank), free(rank);
     return PS_OK;
 }
@@ -954,13 +980,13 @@ void ps_tracer_repower(ps_tracer *t, ps_map_kind kind, const ps_photon_source *s
     const stratum *st = &p->strata[src->stratum];
     for (size_t s = 0; s < n; s++)
         ps_rgbe_encode(stored_power(&thr[s], st->power, p->scale[src->stratum]),
-                       photon_dither(st->key, src->rank, (unsigned)s), ph[s].rgbe);
+                       photon_dither(st->dither_key, src->rank, (unsigned)s), ph[s].rgbe);
 }
 
 uint32_t ps_tracer_photon_light(ps_tracer *t, ps_map_kind kind, uint64_t i, uint64_t total)
 {
     map_plan *p = &t->plans[kind];
-    if (!p->enabled || !count_strata(p, total))
+    if (!p->enabled || !count_strata(p, total, t->opt.records))
         return UINT32_MAX;
     return p->strata[stratum_of(p, i)].light;
 }

@@ -160,6 +160,8 @@ typedef struct ps_photon_source {
     uint64_t from;    /* a's index, or PS_SOURCE_NONE */
     uint64_t rank;    /* its rank in b's stratum */
     uint32_t stratum; /* b's stratum */
+    bool repower;     /* its power differs in b (the light's power or the
+                       * stratum's count changed): ps_tracer_repower */
 } ps_photon_source;
 ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total, uint64_t end,
                                    const bool *resampled, size_t light_count, ps_photon_source *out,

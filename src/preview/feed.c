@@ -518,16 +518,29 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
         return ps_error_set(err, PS_ERR_NOMEM, "the %s map's path records are incomplete", ps_map_name((ps_map_kind)k));
     ps_photon_source *src = malloc(end * sizeof *src);
     size_t *off = malloc((end + 1) * sizeof *off);
-    ps_photon_map *m = &f->maps[k];
-    ps_path_store *np = &f->paths[k];
-    size_t room = om->count ? om->count : 1;
-    if (!src || !off || !ps_photon_map_reserve_exact(m, room) || !ps_path_store_reserve(np, end) ||
-        !PS_RESERVE(np->thr, np->tcap, room)) {
+    if (!src || !off) {
         free(src), free(off);
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
     }
     ps_status st = fns->sources(fns->ctx, (ps_map_kind)k, end, src, err);
-    const ps_path_rec *orec = op->rec;
+    /* Every kept photon at its own index (the plans share every count: an
+     * object moved, a power edit of a lone light): compact in place, as
+     * the map's kept photons only move down. Else gather into new arrays. */
+    bool in_place = true;
+    for (uint64_t i = 0; i < end && in_place; i++)
+        in_place = src[i].from == PS_SOURCE_NONE || src[i].from == i;
+    ps_photon_map *m = &f->maps[k];
+    ps_path_store *np = &f->paths[k];
+    size_t room = om->count ? om->count : 1;
+    if (st == PS_OK && in_place) {
+        *m = *om, *np = *op;
+        ps_photon_map_init(om, (ps_map_kind)k), ps_path_store_init(op);
+        om = m, op = np;
+    } else if (st == PS_OK && (!ps_photon_map_reserve_exact(m, room) || !ps_path_store_reserve(np, end) ||
+                               !PS_RESERVE(np->thr, np->tcap, room))) {
+        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
+    }
+    ps_path_rec *orec = op->rec;
     off[0] = 0;
     for (uint64_t i = 0; i < end; i++)
         off[i + 1] = off[i] + ((orec[i].flags & REC_PENDING) ? 0 : orec[i].stored);
@@ -538,15 +551,25 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
         ps_path_rec *r = &np->rec[i];
         if (o < end && !(orec[o].flags & REC_PENDING) && fns->keep(fns->ctx, (ps_map_kind)k, o, op, &orec[o])) {
             size_t n = orec[o].stored;
-            memcpy(m->photons + to, om->photons + off[o], n * sizeof *m->photons);
-            memcpy(m->materials + to, om->materials + off[o], n * sizeof *m->materials);
-            memcpy(m->objects + to, om->objects + off[o], n * sizeof *m->objects);
-            memcpy(np->thr + to, op->thr + off[o], n * sizeof *np->thr);
+            /* In place, source and destination may overlap (to <= off[o]). */
+            if (n == 1) { /* most paths: plain copies, no calls */
+                m->photons[to] = om->photons[off[o]];
+                m->materials[to] = om->materials[off[o]];
+                m->objects[to] = om->objects[off[o]];
+                np->thr[to] = op->thr[off[o]];
+            } else if (!in_place || to != off[o]) {
+                memmove(m->photons + to, om->photons + off[o], n * sizeof *m->photons);
+                memmove(m->materials + to, om->materials + off[o], n * sizeof *m->materials);
+                memmove(m->objects + to, om->objects + off[o], n * sizeof *m->objects);
+                memmove(np->thr + to, op->thr + off[o], n * sizeof *np->thr);
+            }
             /* The same path, maybe of a light with another power, maybe one of
              * more or fewer photons of its stratum: its power set anew, as
              * the edited scene's trace sets it. */
-            ps_tracer_repower(f->tracer, (ps_map_kind)k, &src[i], np->thr + to, n, m->photons + to);
-            *r = orec[o];
+            if (src[i].repower)
+                ps_tracer_repower(f->tracer, (ps_map_kind)k, &src[i], np->thr + to, n, m->photons + to);
+            if (r != &orec[o])
+                *r = orec[o];
             r->flags = 0;
             to += n;
         } else if (!PS_RESERVE(f->pending[k], cap, at + 1)) {
@@ -577,12 +600,16 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
     /* The kept records point into the old pool: take it whole; the pool is
      * rewritten once half of it is garbage, so it stays within twice what
      * the records use (the soak's memory stays flat over hundreds of edits). */
-    np->vert = op->vert, np->vcount = op->vcount, np->vcap = op->vcap;
-    op->vert = NULL, op->vcount = op->vcap = 0;
+    if (!in_place) {
+        np->vert = op->vert, np->vcount = op->vcount, np->vcap = op->vcap;
+        op->vert = NULL, op->vcount = op->vcap = 0;
+    }
     if (!compact_paths(np))
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for path records");
-    ps_photon_map_free(om);
-    ps_path_store_free(op);
+    if (!in_place) {
+        ps_photon_map_free(om);
+        ps_path_store_free(op);
+    }
     f->pending_count[k] = at;
     f->kept_end[k] = to;
     f->repairing[k] = at > 0;
