@@ -261,7 +261,10 @@ static void mirror_caustic_image(void **state)
     printf("mirror caustic, %s: %d pixels, worst %.2f %%, mean %.2f %% off the analytic value\n",
            q < 0 ? "box filter" : ps_quality_name((ps_quality)q), n, 100 * worst, 100 * sum_err / n);
     assert_true(n > 100);
-    assert_true(worst < 0.03);
+    /* Draft's photons leave the worst of these pixels 2.9-3.7 % off over
+     * seeds 1-5 (noise: the mean stays -0.3 %); the others are within 3 %. */
+    assert_true(worst < (q == PS_QUALITY_DRAFT ? 0.04 : 0.03));
+    assert_true(fabs(sum_err / n) < 0.005); /* no bias */
     ps_image_destroy(&img);
     render_rig_free(&r);
     }

@@ -178,10 +178,52 @@ static void edits_mid_repair(void **state)
     ps_scene_destroy(scene);
 }
 
-/* Moving the spot keeps exactly the point light's global photons, the
- * tracer's count of them; a power edit of two lights changes both lights'
- * photon counts, so every photon's power: nothing kept. Moving the mirror
- * keeps the global paths clear of its two boxes: some, not all. */
+/* Photons of each stratum (light, target) of map k below its cap. */
+typedef struct strata_counts {
+    uint64_t n[2][8];
+} strata_counts;
+
+static strata_counts counts_of(ps_session *s, ps_map_kind k)
+{
+    strata_counts c;
+    const uint64_t caps[PS_MAP_COUNT] = {CAUSTIC_CAP, GLOBAL_CAP};
+    for (uint32_t l = 0; l < 2; l++)
+        for (int64_t target = -1; target < 7; target++)
+            c.n[l][target + 1] =
+                ps_tracer_stratum_photons((ps_tracer *)ps_session_tracer(s), k, l, target, caps[k]);
+    return c;
+}
+
+/* The photons a repair traces because strata grew: the sum of the growth of
+ * each stratum that samples as before (`same`: per light). */
+static uint64_t growth(const strata_counts *a, const strata_counts *b, const bool same[2])
+{
+    uint64_t g = 0;
+    for (int l = 0; l < 2; l++)
+        for (int t = 0; t < 8; t++)
+            if (same[l] && b->n[l][t] > a->n[l][t])
+                g += b->n[l][t] - a->n[l][t];
+    return g;
+}
+
+static uint64_t kept_of(const strata_counts *a, const strata_counts *b, const bool same[2], int only_target)
+{
+    uint64_t g = 0;
+    for (int l = 0; l < 2; l++)
+        for (int t = 0; t < 8; t++)
+            if (same[l] && (only_target < 0 || t == only_target + 1))
+                g += a->n[l][t] < b->n[l][t] ? a->n[l][t] : b->n[l][t];
+    return g;
+}
+
+/* What each edit keeps, against the tracer's own counts of each stratum:
+ * moving the spot keeps exactly the point light's global photons and, of the
+ * caustic ones, the point light's up to the fewer of its old and new counts
+ * per caustic cone; a power edit and a colour edit keep every photon and
+ * trace only the strata's growth; moving the mirror keeps the caustic
+ * photons of the glass sphere's cones clear of the mirror's boxes (some,
+ * never more than the fewer of their counts) and retraces all of the
+ * mirror's; a moved floor keeps the caustic paths clear of it. */
 static void repair_keeps_what_it_should(void **state)
 {
     (void)state;
@@ -189,30 +231,61 @@ static void repair_keeps_what_it_should(void **state)
     ps_session *s = open_traced(scene);
     uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
     uint64_t point = ps_tracer_light_photons((ps_tracer *)ps_session_tracer(s), PS_MAP_GLOBAL, 0, GLOBAL_CAP);
+    strata_counts c0 = counts_of(s, PS_MAP_CAUSTIC);
     apply(s, MOVE_SPOT, 0);
     update(s, kept, retraced);
+    strata_counts c1 = counts_of(s, PS_MAP_CAUSTIC);
+    const bool point_only[2] = {true, false}, both[2] = {true, true};
     assert_true(point > GLOBAL_CAP / 2 && point < GLOBAL_CAP);
     assert_int_equal(kept[PS_MAP_GLOBAL], point);
     assert_int_equal(retraced[PS_MAP_GLOBAL], GLOBAL_CAP - point);
+    assert_int_equal(kept[PS_MAP_CAUSTIC], kept_of(&c0, &c1, point_only, -1));
+    assert_true(kept[PS_MAP_CAUSTIC] > CAUSTIC_CAP / 10);
+    fprintf(stderr, "move the spot: kept %llu of %d caustic, %llu of %d global photon paths\n",
+            (unsigned long long)kept[PS_MAP_CAUSTIC], CAUSTIC_CAP, (unsigned long long)kept[PS_MAP_GLOBAL], GLOBAL_CAP);
     ps_error err;
     assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
 
+    /* Power: both maps' shares change (two lights), no photon's path. */
+    strata_counts g0 = counts_of(s, PS_MAP_GLOBAL);
+    c0 = counts_of(s, PS_MAP_CAUSTIC);
     apply(s, POWER, 0);
     update(s, kept, retraced);
-    assert_int_equal(kept[PS_MAP_GLOBAL], 0);
-    assert_int_equal(kept[PS_MAP_CAUSTIC], 0);
-    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    strata_counts g1 = counts_of(s, PS_MAP_GLOBAL);
+    c1 = counts_of(s, PS_MAP_CAUSTIC);
+    assert_true(memcmp(&g0, &g1, sizeof g0) != 0); /* the counts did change */
+    assert_int_equal(retraced[PS_MAP_GLOBAL], growth(&g0, &g1, both));
+    assert_int_equal(retraced[PS_MAP_CAUSTIC], growth(&c0, &c1, both));
+    assert_true(retraced[PS_MAP_GLOBAL] > 0 && retraced[PS_MAP_GLOBAL] < GLOBAL_CAP / 10);
+    fprintf(stderr, "power: traced %llu caustic, %llu global photon paths (the strata's growth)\n",
+            (unsigned long long)retraced[PS_MAP_CAUSTIC], (unsigned long long)retraced[PS_MAP_GLOBAL]);
+    traced_equals_fresh(s, scene);
 
+    /* Colour with the same flux: the same shares, nothing retraced. */
+    assert_int_equal(ps_session_set_light_power(s, 1, ps_rgb_make(40, 50, 60), &err), PS_OK);
+    update(s, kept, retraced);
+    assert_int_equal(retraced[PS_MAP_GLOBAL], 0);
+    assert_int_equal(retraced[PS_MAP_CAUSTIC], 0);
+    traced_equals_fresh(s, scene);
+
+    c0 = counts_of(s, PS_MAP_CAUSTIC);
     apply(s, MOVE_MIRROR, 0);
     update(s, kept, retraced);
-    assert_int_equal(kept[PS_MAP_CAUSTIC], 0); /* its caustic cones moved: every share changed */
+    c1 = counts_of(s, PS_MAP_CAUSTIC);
+    uint64_t glass = kept_of(&c0, &c1, both, GLASS), mirror = c1.n[0][MIRROR + 1] + c1.n[1][MIRROR + 1];
+    assert_true(mirror > 0);
+    assert_true(kept[PS_MAP_CAUSTIC] > glass / 2 && kept[PS_MAP_CAUSTIC] <= glass);
+    assert_true(retraced[PS_MAP_CAUSTIC] >= mirror);
+    fprintf(stderr, "move the mirror: kept %llu caustic (of %llu the glass sphere's cones keep), %llu global\n",
+            (unsigned long long)kept[PS_MAP_CAUSTIC], (unsigned long long)glass, (unsigned long long)kept[PS_MAP_GLOBAL]);
     assert_true(kept[PS_MAP_GLOBAL] > GLOBAL_CAP / 2 && kept[PS_MAP_GLOBAL] < GLOBAL_CAP);
-    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    traced_equals_fresh(s, scene);
 
     /* A diffuse wall moved: the caustic cones stay, the caustic paths clear of it stay. */
     apply(s, MOVE_FLOOR, 0);
     update(s, kept, retraced);
     assert_true(kept[PS_MAP_CAUSTIC] > 0 && kept[PS_MAP_CAUSTIC] < CAUSTIC_CAP);
+    traced_equals_fresh(s, scene);
     ps_session_destroy(s);
     ps_scene_destroy(scene);
 }

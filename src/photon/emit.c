@@ -306,6 +306,7 @@ bool ps_light_emit(const ps_light_sampler *ls, uint32_t l, const ps_caustic_cone
     }
     out->ray = ps_ray_make(origin, dir);
     out->power = ps_rgb_scale(L->power, weight);
+    out->weight = weight;
     out->normal = normal;
     return true;
 }

@@ -39,7 +39,10 @@ typedef struct ps_caustic_cone {
  * (or of the flux into the caustic cone); the tracer divides by the photon count. */
 typedef struct ps_emission {
     ps_ray ray;     /* unit direction */
-    ps_rgb power;
+    ps_rgb power;   /* the light's power times weight */
+    double weight;  /* what the sample carries of the light's power, whatever that power is:
+                     * the tracer carries it apart from the power, so that a power or colour
+                     * edit is an exact rescale (docs/repair.md) */
     ps_vec3 normal; /* the emitter's normal at the origin (0 for point and spot) */
 } ps_emission;
 

@@ -67,6 +67,7 @@ void ps_path_store_free(ps_path_store *s)
 {
     free(s->rec);
     free(s->vert);
+    free(s->thr);
     ps_path_store_init(s);
 }
 
@@ -95,11 +96,29 @@ void ps_path_add_vertex(ps_path_store *s, ps_path_vertex v)
     s->rec[s->count - 1].vertices++;
 }
 
+void ps_path_add_thr(ps_path_store *s, ps_path_thr t)
+{
+    if (s->failed || !PS_RESERVE(s->thr, s->tcap, s->tcount + 1)) {
+        s->failed = true;
+        return;
+    }
+    s->thr[s->tcount++] = t;
+}
+
+static void append_thr(ps_path_store *dst, const ps_path_store *src)
+{
+    if (src->tcount)
+        memcpy(dst->thr + dst->tcount, src->thr, src->tcount * sizeof *src->thr);
+    dst->tcount += src->tcount;
+}
+
 bool ps_path_store_append(ps_path_store *dst, const ps_path_store *src)
 {
     if (src->vcount > UINT32_MAX - dst->vcount || !PS_RESERVE(dst->rec, dst->cap, dst->count + src->count) ||
-        !PS_RESERVE(dst->vert, dst->vcap, dst->vcount + src->vcount))
+        !PS_RESERVE(dst->vert, dst->vcap, dst->vcount + src->vcount) ||
+        !PS_RESERVE(dst->thr, dst->tcap, dst->tcount + src->tcount))
         return false;
+    append_thr(dst, src);
     for (size_t k = 0; k < src->count; k++) {
         ps_path_rec r = src->rec[k];
         r.first += (uint32_t)dst->vcount;
@@ -113,8 +132,10 @@ bool ps_path_store_append(ps_path_store *dst, const ps_path_store *src)
 
 bool ps_path_store_put(ps_path_store *dst, const ps_path_store *src, const uint64_t *idx)
 {
-    if (src->vcount > UINT32_MAX - dst->vcount || !PS_RESERVE(dst->vert, dst->vcap, dst->vcount + src->vcount))
+    if (src->vcount > UINT32_MAX - dst->vcount || !PS_RESERVE(dst->vert, dst->vcap, dst->vcount + src->vcount) ||
+        !PS_RESERVE(dst->thr, dst->tcap, dst->tcount + src->tcount))
         return false;
+    append_thr(dst, src);
     for (size_t k = 0; k < src->count; k++) {
         ps_path_rec r = src->rec[k];
         r.first += (uint32_t)dst->vcount;

@@ -18,10 +18,19 @@
 
 /* Emission uses Halton dimensions 1..4 (dimension 0 picks the light and caustic cone). */
 #define EMIT_DIMS 4
+/* The rank table (rank_cursor) keeps each stratum's photon count before
+ * every RANK_GRANULE-th index: finding photon i's rank scans at most this many. */
+#define RANK_GRANULE 256
 
 /* One way photons leave: a light, and for caustic photons the caustic cone
  * around one specular object. Photon indices are shared between strata in
- * proportion to `share` (the flux each is expected to carry). */
+ * proportion to `share` (the flux each is expected to carry).
+ *
+ * Each stratum has its own photon stream: its identity (light, target) and the
+ * seed give `key`, and its j-th photon (the j-th index that falls to it) takes
+ * its emission numbers from the Halton point j, shifted by `rotation`, and its
+ * path from the PCG stream (key, map, j). So photon (stratum, j) does not
+ * change when another stratum's share does (tests/test_tracer_strata.c). */
 typedef struct stratum {
     uint32_t light;
     int64_t target; /* caustic: the object the caustic cone is aimed at; -1: none */
@@ -29,6 +38,10 @@ typedef struct stratum {
     ps_caustic_cone caustic_cone;
     double share;
     double cdf; /* cumulative share, normalised; the last is 1 */
+    ps_rgb power; /* the light's, when planned: stored power = T x power / count */
+    uint64_t key;
+    uint64_t dither_key;        /* its photons' RGBE dithers (photon_dither) */
+    double rotation[EMIT_DIMS]; /* Cranley-Patterson shifts of its emission numbers */
 } stratum;
 
 typedef struct map_plan {
@@ -36,12 +49,18 @@ typedef struct map_plan {
     uint32_t stream;
     stratum *strata;
     size_t count, cap;
-    double rotation[1 + EMIT_DIMS]; /* Cranley-Patterson shifts from the seed */
-    /* Normalisation for `counted_total` photons: scale[s] = 1 / photons of s. */
+    double rotation0; /* the shift of Halton dimension 0 (the stratum choice) */
+    /* Normalisation for `counted_total` photons: scale[s] = 1 / photons of s;
+     * prefix[g * count + s]: photons of s below index g * RANK_GRANULE. */
     uint64_t counted_total;
     bool counted;
     uint64_t *counts;
     double *scale;
+    uint64_t *prefix;
+    size_t granules;
+    /* With records (a session that repairs): each index's stratum, so that
+     * a repair's photon sources read it instead of recomputing it. */
+    uint8_t *seq;
 } map_plan;
 
 struct ps_tracer {
@@ -84,7 +103,7 @@ static ps_status add_skip(ps_tracer *t, const char *pass, const char *fmt, ...)
 }
 
 static bool add_stratum(map_plan *p, uint32_t light, int64_t target, const ps_caustic_cone *caustic_cone,
-                        double share)
+                        double share, ps_rgb power)
 {
     if (!PS_RESERVE(p->strata, p->cap, p->count + 1))
         return false;
@@ -96,6 +115,7 @@ static bool add_stratum(map_plan *p, uint32_t light, int64_t target, const ps_ca
     if (caustic_cone)
         s->caustic_cone = *caustic_cone;
     s->share = share;
+    s->power = power;
     return true;
 }
 
@@ -190,7 +210,7 @@ static ps_status plan_maps(ps_tracer *t, ps_error *err)
 
     /* Global map: every light, in proportion to its flux. */
     for (uint32_t l = 0; l < nl; l++)
-        if (!add_stratum(global, l, -1, NULL, ps_rgb_sum(lights[l].power)))
+        if (!add_stratum(global, l, -1, NULL, ps_rgb_sum(lights[l].power), lights[l].power))
             return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
     finish_plan(global);
 
@@ -208,7 +228,7 @@ static ps_status plan_maps(ps_tracer *t, ps_error *err)
         if (!(flux > 0.0))
             continue;
         if (!t->opt.caustic_cones) {
-            if (!add_stratum(caustic, l, -1, NULL, flux))
+            if (!add_stratum(caustic, l, -1, NULL, flux, lights[l].power))
                 return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
             continue;
         }
@@ -223,7 +243,7 @@ static ps_status plan_maps(ps_tracer *t, ps_error *err)
             if (!ps_light_caustic_cone(t->lights, l, c, r, &caustic_cone))
                 continue;
             double share = flux * ps_light_caustic_cone_share(t->lights, l, &caustic_cone);
-            if (!add_stratum(caustic, l, (int64_t)o, &caustic_cone, share))
+            if (!add_stratum(caustic, l, (int64_t)o, &caustic_cone, share, lights[l].power))
                 return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning the photon maps", path);
             caustic_cones++;
         }
@@ -270,11 +290,20 @@ ps_status ps_tracer_create(const ps_world *w, const ps_tracer_options *opt, ps_t
     }
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         map_plan *p = &t->plans[k];
-        /* Independent shifts per map and seed: the maps never share samples. */
+        /* Independent shifts per map and seed: the maps never share samples;
+         * and per stratum, from its identity only (not its place in the plan). */
         uint64_t h = ps_hash64(t->opt.seed ^ ps_hash64(p->stream));
-        for (int d = 0; d <= EMIT_DIMS; d++) {
-            h = ps_hash64(h + (uint64_t)d);
-            p->rotation[d] = (double)(h >> 11) * (1.0 / 9007199254740992.0);
+        p->rotation0 = (double)(ps_hash64(h) >> 11) * (1.0 / 9007199254740992.0);
+        for (size_t q = 0; q < p->count; q++) {
+            stratum *sk = &p->strata[q];
+            uint64_t id = ((uint64_t)sk->light + 1) << 32 ^ (uint64_t)(sk->target + 1);
+            sk->key = ps_hash64(h ^ ps_hash64(id ^ 0x2545f4914f6cdd1dULL));
+            sk->dither_key = ps_hash64(sk->key ^ 0x9fb21c651e98df25ULL);
+            uint64_t r = sk->key;
+            for (int d = 0; d < EMIT_DIMS; d++) {
+                r = ps_hash64(r + (uint64_t)d + 1);
+                sk->rotation[d] = (double)(r >> 11) * (1.0 / 9007199254740992.0);
+            }
         }
         p->counts = calloc(p->count ? p->count : 1, sizeof *p->counts);
         p->scale = calloc(p->count ? p->count : 1, sizeof *p->scale);
@@ -295,6 +324,8 @@ void ps_tracer_destroy(ps_tracer *t)
         free(t->plans[k].strata);
         free(t->plans[k].counts);
         free(t->plans[k].scale);
+        free(t->plans[k].prefix);
+        free(t->plans[k].seq);
     }
     ps_light_sampler_destroy(t->lights);
     free(t->skips);
@@ -341,7 +372,7 @@ static double shift(double u, double by)
  * proportional to its flux for every total, not just on average. */
 static size_t stratum_of(const map_plan *p, uint64_t i)
 {
-    double u = shift(van_der_corput(i), p->rotation[0]);
+    double u = shift(van_der_corput(i), p->rotation0);
     size_t lo = 0, hi = p->count - 1;
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
@@ -353,30 +384,90 @@ static size_t stratum_of(const map_plan *p, uint64_t i)
     return lo;
 }
 
-static void count_strata(map_plan *p, uint64_t total)
+/* Counts, normalisation and the rank table for `total` photons; false when
+ * out of memory for the table. */
+static bool count_strata(map_plan *p, uint64_t total, bool keep_seq)
 {
     if (p->counted && p->counted_total == total)
-        return;
+        return true;
+    size_t granules = (size_t)(total / RANK_GRANULE) + 1;
+    if (granules > SIZE_MAX / sizeof *p->prefix / p->count)
+        return false;
+    uint64_t *prefix = realloc(p->prefix, granules * p->count * sizeof *prefix);
+    if (!prefix)
+        return false;
+    p->prefix = prefix;
+    p->granules = granules;
+    free(p->seq);
+    p->seq = NULL;
+    if (keep_seq && p->count <= UINT8_MAX + 1 && total <= SIZE_MAX) {
+        p->seq = malloc(total ? (size_t)total : 1);
+        if (!p->seq)
+            return false;
+    }
     memset(p->counts, 0, p->count * sizeof *p->counts);
-    for (uint64_t i = 0; i < total; i++)
-        p->counts[stratum_of(p, i)]++;
+    for (uint64_t i = 0; i < total; i++) {
+        if (i % RANK_GRANULE == 0)
+            memcpy(prefix + (size_t)(i / RANK_GRANULE) * p->count, p->counts, p->count * sizeof *p->counts);
+        size_t k = stratum_of(p, i);
+        p->counts[k]++;
+        if (p->seq)
+            p->seq[i] = (uint8_t)k;
+    }
+    if (total % RANK_GRANULE == 0)
+        memcpy(prefix + (size_t)(total / RANK_GRANULE) * p->count, p->counts, p->count * sizeof *p->counts);
     for (size_t k = 0; k < p->count; k++)
         p->scale[k] = p->counts[k] ? 1.0 / (double)p->counts[k] : 0.0;
     p->counted_total = total;
     p->counted = true;
+    return true;
+}
+
+/* Photon i's stratum and rank among that stratum's indices, for ascending
+ * indices i below the counted total: `counts` holds each stratum's photons
+ * below `at`. */
+typedef struct rank_cursor {
+    uint64_t at;
+    uint64_t *counts;
+    bool valid;
+} rank_cursor;
+
+static void rank_of(const map_plan *p, rank_cursor *c, uint64_t i, size_t *k, uint64_t *j)
+{
+    if (!c->valid || i < c->at || i - c->at >= RANK_GRANULE) {
+        size_t g = (size_t)(i / RANK_GRANULE);
+        memcpy(c->counts, p->prefix + g * p->count, p->count * sizeof *c->counts);
+        c->at = (uint64_t)g * RANK_GRANULE;
+        c->valid = true;
+    }
+    for (; c->at < i; c->at++)
+        c->counts[stratum_of(p, c->at)]++;
+    *k = stratum_of(p, i);
+    *j = c->counts[*k]++;
+    c->at = i + 1;
 }
 
 uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light, uint64_t total)
 {
     map_plan *p = &t->plans[kind];
-    if (!p->enabled)
+    if (!p->enabled || !count_strata(p, total, t->opt.records))
         return 0;
-    count_strata(p, total);
     uint64_t n = 0;
     for (size_t k = 0; k < p->count; k++)
         if (p->strata[k].light == light)
             n += p->counts[k];
     return n;
+}
+
+uint64_t ps_tracer_stratum_photons(ps_tracer *t, ps_map_kind kind, uint32_t light, int64_t target, uint64_t total)
+{
+    map_plan *p = &t->plans[kind];
+    if (!p->enabled || !count_strata(p, total, t->opt.records))
+        return 0;
+    for (size_t k = 0; k < p->count; k++)
+        if (p->strata[k].light == light && p->strata[k].target == target)
+            return p->counts[k];
+    return 0;
 }
 
 /* ---- one photon's path --------------------------------------------------- */
@@ -395,42 +486,95 @@ static void vertex(const ps_tracer *t, chunk_out *out, ps_vec3 p)
         ps_path_add_vertex(&out->paths, ps_path_quantize(&t->quant, p));
 }
 
-static void store(chunk_out *out, const ps_surface *sp, ps_rgb power, ps_vec3 d, ps_vec3 n, double dither)
+/* A stored photon's power: its light-independent throughput T (rounded to
+ * float once, as the path record keeps it) times the light's power times 1 /
+ * the photons of its stratum. The tracer and ps_tracer_repower compute it the
+ * same way, so a power or colour edit rescales kept photons bit for bit. */
+static ps_rgb stored_power(const ps_path_thr *thr, ps_rgb light_power, double scale)
 {
+    ps_rgb T = {thr->t[0], thr->t[1], thr->t[2]};
+    return ps_rgb_scale(ps_rgb_mul(T, light_power), scale);
+}
+
+/* The RGBE dither of the s-th photon (s < 256: trace_photon's limit) that
+ * path j of a stratum stores: from the photon's own identity, not its PCG
+ * stream, so that a repair can round its new power the same way without
+ * retracing it. One SplitMix64 finaliser of (stratum, j, s) is uniform
+ * enough for a dither. */
+static double photon_dither(uint64_t dither_key, uint64_t j, unsigned s)
+{
+    uint64_t h = ps_hash64(dither_key ^ (j << 8 | (uint64_t)s));
+    return (double)(h >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* T rounded to float, once: the stored power is computed from the rounded
+ * value, as ps_tracer_repower computes it from the record. Through a volatile:
+ * GCC 12.2 at -O2 (its SLP vectoriser) otherwise multiplies the unrounded
+ * double into the power of two channels while it stores the rounded one, and
+ * a repair's power then differs in the last mantissa bit (found by
+ * tests/test_repair.c). */
+static ps_path_thr round_thr(ps_rgb T)
+{
+    volatile float v[3] = {(float)T.r, (float)T.g, (float)T.b};
+    ps_path_thr r = {{v[0], v[1], v[2]}};
+    return r;
+}
+
+/* One path's identity while it is traced. */
+typedef struct path_ctx {
+    const stratum *st;
+    double scale;
+    uint64_t j;
+    unsigned stored;
+} path_ctx;
+
+static void store(const ps_tracer *t, chunk_out *out, path_ctx *pc, const ps_surface *sp, ps_rgb thr, ps_vec3 d,
+                  ps_vec3 n)
+{
+    ps_path_thr T = round_thr(thr);
+    ps_rgb power = stored_power(&T, pc->st->power, pc->scale);
+    double dither = photon_dither(pc->st->dither_key, pc->j, pc->stored++);
     if (!ps_photon_map_push(&out->map, ps_photon_pack(sp->p, power, d, n, dither), (uint16_t)sp->material,
                             sp->object)) {
         out->failed = true;
         return;
     }
+    if (t->opt.records)
+        ps_path_add_thr(&out->paths, T);
     out->map.counters.stored++;
 }
 
-static void trace_path(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk_out *out)
+/* Photon i of the map, the j-th of stratum k. */
+static void trace_path(const ps_tracer *t, ps_map_kind kind, size_t k, uint64_t j, chunk_out *out)
 {
     const map_plan *plan = &t->plans[kind];
     const ps_world *w = t->world;
     ps_trace_counters *c = &out->map.counters;
     c->emitted++;
 
-    /* Emission: the stratum and the four emission numbers are Halton
-     * coordinates of index i; the rest of the path draws from its own PCG. */
-    size_t k = stratum_of(plan, i);
+    /* Emission: the stratum is Halton dimension 0 of index i; the four
+     * emission numbers are the Halton point of its rank j in the stratum,
+     * shifted by the stratum's own rotation; the rest of the path draws from
+     * the stratum's PCG stream at j. */
     const stratum *st = &plan->strata[k];
     double u[EMIT_DIMS];
     for (unsigned d = 0; d < EMIT_DIMS; d++)
-        u[d] = shift(ps_halton(d + 1, i), plan->rotation[d + 1]);
+        u[d] = shift(ps_halton(d + 1, j), st->rotation[d]);
     ps_emission e;
     if (!ps_light_emit(t->lights, st->light, st->has_caustic_cone ? &st->caustic_cone : NULL, u, &e) ||
         plan->scale[k] == 0.0) {
         c->empty++;
         return;
     }
-    ps_rgb power = ps_rgb_scale(e.power, plan->scale[k]);
+    path_ctx pc = {st, plan->scale[k], j, 0};
+    /* The throughput without the light's power: what the photon carries
+     * of it (the power itself is multiplied in at the store). */
+    ps_rgb power = {e.weight, e.weight, e.weight};
     ps_ray ray = e.ray;
     if (ps_v3_len2(e.normal) > 0.0) /* leave an emitting surface (mesh lights are geometry too) */
         ray.o = ps_v3_madd(ray.o, e.normal, ps_world_epsilon(w));
     vertex(t, out, ray.o);
-    ps_rng rng = ps_rng_make(t->opt.seed, plan->stream, i);
+    ps_rng rng = ps_rng_make(st->key, plan->stream, j);
     bool diffuse_seen = false;
 
     for (int bounce = 0;; bounce++) {
@@ -472,11 +616,11 @@ static void trace_path(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk_o
         case PS_MAT_DIFFUSE:
         case PS_MAT_GLOSSY: {
             if (kind == PS_MAP_CAUSTIC) { /* light, specular bounces, here: a caustic */
-                store(out, &sp, power, d, ns, ps_rng_uniform(&rng));
+                store(t, out, &pc, &sp, power, d, ns);
                 return;
             }
             if (diffuse_seen || t->opt.global_direct)
-                store(out, &sp, power, d, ns, ps_rng_uniform(&rng));
+                store(t, out, &pc, &sp, power, d, ns);
             /* Russian roulette on the albedo: the expected power leaving is the
              * power arriving times the albedo, with no photon made heavier than
              * the albedo's colour ratio. */
@@ -539,15 +683,15 @@ static void trace_path(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk_o
 }
 
 /* One photon, and with records its path's record. */
-static void trace_photon(const ps_tracer *t, ps_map_kind kind, uint64_t i, chunk_out *out)
+static void trace_photon(const ps_tracer *t, ps_map_kind kind, size_t k, uint64_t j, chunk_out *out)
 {
     if (!t->opt.records) {
-        trace_path(t, kind, i, out);
+        trace_path(t, kind, k, j, out);
         return;
     }
     size_t before = out->map.count;
     ps_path_begin(&out->paths);
-    trace_path(t, kind, i, out);
+    trace_path(t, kind, k, j, out);
     if (out->paths.failed || out->map.count - before > UINT8_MAX) {
         out->failed = true;
         return;
@@ -574,19 +718,31 @@ typedef struct trace_job {
 static void *worker(void *arg)
 {
     trace_job *job = arg;
+    const map_plan *plan = &job->t->plans[job->kind];
+    rank_cursor cur = {0, malloc(plan->count * sizeof *cur.counts), false};
     for (;;) {
         /* Stop between chunks when asked to, or when the map is full. */
-        if (ps_cancelled(job->t->opt.cancel) || atomic_load(&job->over))
+        if (ps_cancelled(job->t->opt.cancel) || atomic_load(&job->over)) {
+            free(cur.counts);
             return NULL;
+        }
         size_t k = atomic_fetch_add(&job->next, 1);
-        if (k >= job->chunks)
+        if (k >= job->chunks) {
+            free(cur.counts);
             return NULL;
+        }
         uint64_t lo = job->first + (uint64_t)k * PS_PHOTON_CHUNK;
         uint64_t hi = lo + PS_PHOTON_CHUNK;
         if (hi > job->first + job->count)
             hi = job->first + job->count;
-        for (uint64_t i = lo; i < hi && !job->outs[k].failed; i++)
-            trace_photon(job->t, job->kind, job->list ? job->list[i - job->first] : i, &job->outs[k]);
+        if (!cur.counts)
+            job->outs[k].failed = true;
+        for (uint64_t i = lo; i < hi && !job->outs[k].failed; i++) {
+            size_t s;
+            uint64_t j;
+            rank_of(plan, &cur, job->list ? job->list[i - job->first] : i, &s, &j);
+            trace_photon(job->t, job->kind, s, j, &job->outs[k]);
+        }
         size_t n = job->outs[k].map.count;
         uint64_t stored = atomic_fetch_add(&job->stored, n) + n;
         if (job->room && stored > job->room)
@@ -625,7 +781,9 @@ static ps_status trace_some(ps_tracer *t, ps_map_kind kind, uint64_t first, uint
     map_plan *plan = &t->plans[kind];
     if (!plan->enabled || count == 0)
         return PS_OK;
-    count_strata(plan, total);
+    if (!count_strata(plan, total, t->opt.records))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning %llu photons", path,
+                            (unsigned long long)total);
 
     trace_job job;
     memset(&job, 0, sizeof job);
@@ -720,10 +878,11 @@ ps_status ps_traced_join_paths(ps_traced *r, ps_path_store *dst, const uint64_t 
     if (!r || !r->outs)
         return PS_OK;
     /* All or nothing: room first, then copies that cannot fail. */
-    size_t nv = 0, nr = 0;
+    size_t nv = 0, nr = 0, nt = 0;
     for (size_t k = 0; k < r->chunks; k++)
-        nv += r->outs[k].paths.vcount, nr += r->outs[k].paths.count;
+        nv += r->outs[k].paths.vcount, nr += r->outs[k].paths.count, nt += r->outs[k].paths.tcount;
     if (nv > UINT32_MAX - dst->vcount || !PS_RESERVE(dst->vert, dst->vcap, dst->vcount + nv) ||
+        !PS_RESERVE(dst->thr, dst->tcap, dst->tcount + nt) ||
         (!idx && !PS_RESERVE(dst->rec, dst->cap, dst->count + nr)))
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for path records", r->path);
     for (size_t k = 0; k < r->chunks; k++) {
@@ -741,62 +900,94 @@ ps_status ps_traced_join_paths(ps_traced *r, ps_path_store *dst, const uint64_t 
 ps_path_quant ps_tracer_path_quant(const ps_tracer *t) { return t->quant; }
 bool ps_tracer_records(const ps_tracer *t) { return t->opt.records; }
 
-bool ps_tracer_same_source(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t i, uint64_t total,
-                           uint32_t *light)
+static bool same_sampling(const stratum *sa, const stratum *sb)
 {
+    if (sa->light != sb->light || sa->target != sb->target || sa->has_caustic_cone != sb->has_caustic_cone ||
+        sa->key != sb->key || memcmp(sa->rotation, sb->rotation, sizeof sa->rotation) != 0)
+        return false;
+    return !sa->has_caustic_cone || memcmp(&sa->caustic_cone, &sb->caustic_cone, sizeof sa->caustic_cone) == 0;
+}
+
+ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total, uint64_t end,
+                                   const bool *resampled, size_t light_count, ps_photon_source *out,
+                                   ps_error *err)
+{
+    const char *path = ps_scene_path(b->scene);
     map_plan *pa = &a->plans[kind], *pb = &b->plans[kind];
-    *light = UINT32_MAX;
-    if (!pa->enabled)
-        return !pb->enabled;
+    for (uint64_t i = 0; i < end; i++)
+        out[i] = (ps_photon_source){PS_SOURCE_NONE, 0, UINT32_MAX, false};
     if (!pb->enabled)
-        return false;
-    count_strata(pa, total);
-    count_strata(pb, total);
-    const stratum *sa = &pa->strata[stratum_of(pa, i)], *sb = &pb->strata[stratum_of(pb, i)];
-    *light = sa->light;
-    if (sa->light != sb->light || sa->target != sb->target || sa->has_caustic_cone != sb->has_caustic_cone)
-        return false;
-    if (sa->has_caustic_cone && memcmp(&sa->caustic_cone, &sb->caustic_cone, sizeof sa->caustic_cone) != 0)
-        return false;
-    double xa = pa->scale[sa - pa->strata], xb = pb->scale[sb - pb->strata];
-    return memcmp(&xa, &xb, sizeof xa) == 0 && memcmp(pa->rotation, pb->rotation, sizeof pa->rotation) == 0;
+        return PS_OK;
+    if (!count_strata(pb, total, b->opt.records) || (pa->enabled && !count_strata(pa, total, a->opt.records)))
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning %llu photons", path,
+                            (unsigned long long)total);
+    /* b's stratum kb is a's match[kb] when both sample the same way. */
+    size_t *match = malloc(pb->count * sizeof *match);
+    uint64_t *start = pa->enabled ? calloc(pa->count + 1, sizeof *start) : NULL;
+    uint64_t *byrank = pa->enabled ? malloc((end ? end : 1) * sizeof *byrank) : NULL;
+    uint64_t *rank = calloc(pb->count + (pa->enabled ? pa->count : 0), sizeof *rank);
+    if (!match || !rank || (pa->enabled && (!start || !byrank))) {
+        free(match), free(start), free(byrank), free(rank);
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory matching %llu photons", path,
+                            (unsigned long long)end);
+    }
+    for (size_t kb = 0; kb < pb->count; kb++) {
+        match[kb] = SIZE_MAX;
+        const stratum *sb = &pb->strata[kb];
+        if (!pa->enabled || (sb->light < light_count && resampled[sb->light]))
+            continue;
+        for (size_t ka = 0; ka < pa->count; ka++)
+            if (same_sampling(&pa->strata[ka], sb))
+                match[kb] = ka;
+    }
+    /* end <= total: the kept sequences cover it. */
+#define STRATUM(p, i) ((p)->seq ? (size_t)(p)->seq[i] : stratum_of(p, i))
+    if (pa->enabled) {
+        /* a's indices below end, by stratum and rank. */
+        for (uint64_t i = 0; i < end; i++)
+            start[STRATUM(pa, i) + 1]++;
+        for (size_t ka = 0; ka < pa->count; ka++)
+            start[ka + 1] += start[ka];
+        uint64_t *fill = rank + pb->count;
+        for (uint64_t i = 0; i < end; i++) {
+            size_t ka = STRATUM(pa, i);
+            byrank[start[ka] + fill[ka]++] = i;
+        }
+    }
+    for (uint64_t i = 0; i < end; i++) {
+        size_t kb = STRATUM(pb, i);
+        uint64_t j = rank[kb]++;
+        out[i].stratum = (uint32_t)kb;
+        out[i].rank = j;
+        size_t ka = match[kb];
+        if (ka != SIZE_MAX && j < start[ka + 1] - start[ka]) {
+            out[i].from = byrank[start[ka] + j];
+            /* The same light power and count: the stored bytes are already
+             * those of b's trace (the same T, dither and product). */
+            out[i].repower = memcmp(&pa->strata[ka].power, &pb->strata[kb].power, sizeof(ps_rgb)) != 0 ||
+                             memcmp(&pa->scale[ka], &pb->scale[kb], sizeof(double)) != 0;
+        }
+    }
+#undef STRATUM
+    free(match), free(start), free(byrank), free(rank);
+    return PS_OK;
 }
 
-static bool same_stratum(const map_plan *pa, size_t ka, const map_plan *pb, size_t kb)
+void ps_tracer_repower(ps_tracer *t, ps_map_kind kind, const ps_photon_source *src, const ps_path_thr *thr,
+                       size_t n, ps_photon *ph)
 {
-    const stratum *sa = &pa->strata[ka], *sb = &pb->strata[kb];
-    if (sa->light != sb->light || sa->target != sb->target || sa->has_caustic_cone != sb->has_caustic_cone)
-        return false;
-    if (sa->has_caustic_cone && memcmp(&sa->caustic_cone, &sb->caustic_cone, sizeof sa->caustic_cone) != 0)
-        return false;
-    return memcmp(&pa->scale[ka], &pb->scale[kb], sizeof pa->scale[ka]) == 0;
-}
-
-ps_source_match ps_tracer_match_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total)
-{
-    map_plan *pa = &a->plans[kind], *pb = &b->plans[kind];
-    if (!pa->enabled || !pb->enabled || memcmp(pa->rotation, pb->rotation, sizeof pa->rotation) != 0)
-        return PS_SOURCES_NONE;
-    count_strata(pa, total);
-    count_strata(pb, total);
-    bool same = pa->count == pb->count;
-    for (size_t k = 0; same && k < pa->count; k++)
-        same = pa->strata[k].cdf == pb->strata[k].cdf && same_stratum(pa, k, pb, k);
-    if (same)
-        return PS_SOURCES_SAME;
-    for (size_t ka = 0; ka < pa->count; ka++)
-        for (size_t kb = 0; kb < pb->count; kb++)
-            if (same_stratum(pa, ka, pb, kb))
-                return PS_SOURCES_SOME;
-    return PS_SOURCES_NONE;
+    const map_plan *p = &t->plans[kind];
+    const stratum *st = &p->strata[src->stratum];
+    for (size_t s = 0; s < n; s++)
+        ps_rgbe_encode(stored_power(&thr[s], st->power, p->scale[src->stratum]),
+                       photon_dither(st->dither_key, src->rank, (unsigned)s), ph[s].rgbe);
 }
 
 uint32_t ps_tracer_photon_light(ps_tracer *t, ps_map_kind kind, uint64_t i, uint64_t total)
 {
     map_plan *p = &t->plans[kind];
-    if (!p->enabled)
+    if (!p->enabled || !count_strata(p, total, t->opt.records))
         return UINT32_MAX;
-    count_strata(p, total);
     return p->strata[stratum_of(p, i)].light;
 }
 

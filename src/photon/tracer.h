@@ -2,16 +2,27 @@
  * lights, follows them through the scene and fills the caustic and global maps.
  *
  * Photon i of a map is a pure function of (scene, seed, map, i) (thesis 4.1.3):
- * which light (and caustic cone) emits it, where and in which direction come from the
- * Halton sequence at index i, Cranley-Patterson rotated by the seed; every
- * later choice comes from a PCG stream made from (seed, map, i). Tracing runs
+ * which light (and caustic cone: its stratum) emits it comes from the Halton
+ * sequence at index i, Cranley-Patterson rotated by the seed. Where and in
+ * which direction come from the Halton point at its rank j among the indices
+ * of its stratum, rotated by the stratum's identity (light, target) and the
+ * seed; every later choice from a PCG stream made from (seed, map, stratum
+ * identity, j). So photon (stratum, j) does not change when another
+ * stratum's share changes, only where it falls in the map (issue 18). Its
+ * power is its light-independent throughput T, rounded to float, times the
+ * light's power over the stratum's photon count, multiplied in last, and
+ * rounded to RGBE with a dither from (stratum, j): a power edit is an exact
+ * rescale (ps_tracer_repower). Tracing runs
  * on worker threads in fixed chunks whose results are joined in index order,
  * so the photon array is byte-identical for any thread count or batching.
  *
  * Departure from the thesis: it seeds a pseudo-random generator with the
- * photon number; we also use the quasi-random Halton point at that number for
- * emission (Keller's quasi-Monte Carlo photon map), which keeps the same
- * determinism and makes the maps visibly smoother for the same photon count. */
+ * photon number; we also use a quasi-random Halton point for emission
+ * (Keller's quasi-Monte Carlo photon map), which keeps the same determinism
+ * and makes the maps visibly smoother for the same photon count. Departure
+ * from Keller: one Halton sequence per stratum, at the photon's rank in it,
+ * not one for the whole map at the photon's index (so that an edit of one
+ * stratum's share leaves the others' photons as they were; docs/repair.md). */
 #ifndef PS_PHOTON_TRACER_H
 #define PS_PHOTON_TRACER_H
 
@@ -135,23 +146,42 @@ bool ps_tracer_records(const ps_tracer *t);
 /* The quantisation the tracer records paths with. */
 ps_path_quant ps_tracer_path_quant(const ps_tracer *t);
 
-/* Whether photon i of map `kind` leaves tracer a's lights exactly as tracer
- * b's (both planned for `total` photons): the same light, caustic cone,
- * first-hit target and normalisation, bit for bit. *light: its light under
- * a (UINT32_MAX when a's map is off). Whether that light itself changed is
- * the caller's to know. */
-bool ps_tracer_same_source(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t i, uint64_t total,
-                           uint32_t *light);
-/* The same question for all photons of a map at once: every photon leaves
- * the same way (the plans are equal: then only its light is to be checked),
- * none does (no stratum of a is one of b's), or some (ask each photon). */
-typedef enum ps_source_match { PS_SOURCES_NONE, PS_SOURCES_SOME, PS_SOURCES_SAME } ps_source_match;
-ps_source_match ps_tracer_match_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total);
+/* After an edit: which photon of tracer a's map each photon of tracer b's is
+ * (both planned for `total` photons). Photon i of a map is the rank-th
+ * photon of its stratum (light, caustic cone); b's photon (stratum, rank) is
+ * a's photon of the same rank in the stratum of the same light and target
+ * when that stratum samples the same way (the same caustic cone, the light not
+ * in `resampled`: moved, turned, its spot angle or mesh changed; its power may
+ * differ) and a emitted it below `end`: then `from` is its index in a's map,
+ * else PS_SOURCE_NONE. out[i] for i < end. PS_ERR_NOMEM when out of memory
+ * for the tables (end indices). */
+#define PS_SOURCE_NONE UINT64_MAX
+typedef struct ps_photon_source {
+    uint64_t from;    /* a's index, or PS_SOURCE_NONE */
+    uint64_t rank;    /* its rank in b's stratum */
+    uint32_t stratum; /* b's stratum */
+    bool repower;     /* its power differs in b (the light's power or the
+                       * stratum's count changed): ps_tracer_repower */
+} ps_photon_source;
+ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total, uint64_t end,
+                                   const bool *resampled, size_t light_count, ps_photon_source *out,
+                                   ps_error *err);
+/* The n photons a path of source src (from ps_tracer_photon_sources on t as
+ * b) stored, with throughputs thr (its path record's), given t's power: their
+ * RGBE set exactly as t's trace sets it (the light's power and 1 / the
+ * stratum's count, multiplied in last). */
+void ps_tracer_repower(ps_tracer *t, ps_map_kind kind, const ps_photon_source *src, const ps_path_thr *thr,
+                       size_t n, ps_photon *ph);
 /* The light photon i of map kind leaves (UINT32_MAX when the map is off). */
 uint32_t ps_tracer_photon_light(ps_tracer *t, ps_map_kind kind, uint64_t i, uint64_t total);
 
 /* How many of photons [0, total) light l emits for map kind (all its caustic cones
  * together): the tracer shares photons between lights in proportion to flux. */
 uint64_t ps_tracer_light_photons(ps_tracer *t, ps_map_kind kind, uint32_t light, uint64_t total);
+
+/* How many of photons [0, total) the stratum of light `light` and caustic
+ * target `target` (an object index; -1: the global map's, or caustic photons
+ * without cones) has: 0 when there is none. */
+uint64_t ps_tracer_stratum_photons(ps_tracer *t, ps_map_kind kind, uint32_t light, int64_t target, uint64_t total);
 
 #endif

@@ -419,6 +419,14 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
         ps_photon_map_free(&out);
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory reordering %zu photons", m->count);
     }
+    /* The throughputs go with the photons (path_record.h). */
+    ps_path_thr *thr = malloc((m->count ? m->count : 1) * sizeof *thr);
+    if (!thr) {
+        free(marks);
+        ps_photon_map_free(&out);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory reordering %zu photons", m->count);
+    }
+    const ps_path_thr *old_thr = f->paths[k].thr;
     size_t nmarks = 0;
     uint64_t r = 0, boundary = round_end(f, k, 0, 0);
     size_t kept = 0, re = f->kept_end[k];
@@ -430,6 +438,7 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
             memcpy(out.photons + out.count, m->photons + *from, n * sizeof *m->photons);
             memcpy(out.materials + out.count, m->materials + *from, n * sizeof *m->materials);
             memcpy(out.objects + out.count, m->objects + *from, n * sizeof *m->objects);
+            memcpy(thr + out.count, old_thr + *from, n * sizeof *thr);
             out.count += n;
             *from += n;
         }
@@ -448,7 +457,12 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
     memcpy(out.photons + out.count, m->photons + re, rest * sizeof *m->photons);
     memcpy(out.materials + out.count, m->materials + re, rest * sizeof *m->materials);
     memcpy(out.objects + out.count, m->objects + re, rest * sizeof *m->objects);
+    memcpy(thr + out.count, old_thr + re, rest * sizeof *thr);
     out.count += rest;
+    free(f->paths[k].thr);
+    f->paths[k].thr = thr;
+    f->paths[k].tcap = m->count ? m->count : 1;
+    f->paths[k].tcount = m->count;
     out.counters = m->counters;
     pthread_mutex_lock(&f->lock);
     ps_photon_map_free(m);
@@ -487,7 +501,134 @@ bool ps_feed_repairable(const ps_feed *f)
     return true;
 }
 
-ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep, void *ctx, ps_feed **out,
+/* Map k of the repaired feed f from the old one's (in index order, with
+ * complete records): photon i of the edited scene takes the photons and
+ * record of the old index its source names, when keep() lets it, with their
+ * power set anew; the others' indices go to the pending list. */
+static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repair_fns *fns, ps_error *err)
+{
+    ps_photon_map *om = &old->maps[k];
+    ps_path_store *op = &old->paths[k];
+    uint64_t end = old->next[k];
+    f->next[k] = end;
+    f->repair_end[k] = end;
+    if (!f->active[k] || end == 0)
+        return PS_OK;
+    if (op->tcount != om->count || op->count != end)
+        return ps_error_set(err, PS_ERR_NOMEM, "the %s map's path records are incomplete", ps_map_name((ps_map_kind)k));
+    ps_photon_source *src = malloc(end * sizeof *src);
+    size_t *off = malloc((end + 1) * sizeof *off);
+    if (!src || !off) {
+        free(src), free(off);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
+    }
+    ps_status st = fns->sources(fns->ctx, (ps_map_kind)k, end, src, err);
+    /* Every kept photon at its own index (the plans share every count: an
+     * object moved, a power edit of a lone light): compact in place, as
+     * the map's kept photons only move down. Else gather into new arrays. */
+    bool in_place = true;
+    for (uint64_t i = 0; i < end && in_place; i++)
+        in_place = src[i].from == PS_SOURCE_NONE || src[i].from == i;
+    ps_photon_map *m = &f->maps[k];
+    ps_path_store *np = &f->paths[k];
+    size_t room = om->count ? om->count : 1;
+    if (st == PS_OK && in_place) {
+        *m = *om, *np = *op;
+        ps_photon_map_init(om, (ps_map_kind)k), ps_path_store_init(op);
+        om = m, op = np;
+    } else if (st == PS_OK && (!ps_photon_map_reserve_exact(m, room) || !ps_path_store_reserve(np, end) ||
+                               !PS_RESERVE(np->thr, np->tcap, room))) {
+        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
+    }
+    ps_path_rec *orec = op->rec;
+    off[0] = 0;
+    for (uint64_t i = 0; i < end; i++)
+        off[i + 1] = off[i] + ((orec[i].flags & REC_PENDING) ? 0 : orec[i].stored);
+    size_t at = 0, cap = 0, to = 0;
+    uint64_t every = batch_of(f, k);
+    for (uint64_t i = 0; i < end && st == PS_OK; i++) {
+        uint64_t o = src[i].from;
+        ps_path_rec *r = &np->rec[i];
+        if (o < end && !(orec[o].flags & REC_PENDING) && fns->keep(fns->ctx, (ps_map_kind)k, o, op, &orec[o])) {
+            size_t n = orec[o].stored;
+            /* In place, source and destination may overlap (to <= off[o]). */
+            if (n == 1) { /* most paths: plain copies, no calls */
+                m->photons[to] = om->photons[off[o]];
+                m->materials[to] = om->materials[off[o]];
+                m->objects[to] = om->objects[off[o]];
+                np->thr[to] = op->thr[off[o]];
+            } else if (!in_place || to != off[o]) {
+                memmove(m->photons + to, om->photons + off[o], n * sizeof *m->photons);
+                memmove(m->materials + to, om->materials + off[o], n * sizeof *m->materials);
+                memmove(m->objects + to, om->objects + off[o], n * sizeof *m->objects);
+                memmove(np->thr + to, op->thr + off[o], n * sizeof *np->thr);
+            }
+            /* The same path, maybe of a light with another power, maybe one of
+             * more or fewer photons of its stratum: its power set anew, as
+             * the edited scene's trace sets it. */
+            if (src[i].repower)
+                ps_tracer_repower(f->tracer, (ps_map_kind)k, &src[i], np->thr + to, n, m->photons + to);
+            if (r != &orec[o])
+                *r = orec[o];
+            r->flags = 0;
+            to += n;
+        } else if (!PS_RESERVE(f->pending[k], cap, at + 1)) {
+            st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %zu photons", at);
+        } else {
+            memset(r, 0, sizeof *r);
+            r->flags = REC_PENDING;
+            f->pending[k][at++] = i;
+        }
+        /* A mark every batch of indices: the kept photons of indices below
+         * i + 1 stand for all of them, so a refresh that draws only its
+         * budget draws a prefix of the kept ones, scaled right. */
+        if ((i + 1) % every == 0 && i + 1 < end) {
+            if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1)) {
+                st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
+                break;
+            }
+            ps_feed_mark mk = {to, i + 1};
+            f->marks[k][f->mark_count[k]++] = mk;
+        }
+    }
+    free(src), free(off);
+    if (st != PS_OK)
+        return st;
+    np->count = end;
+    np->tcount = to;
+    m->count = to;
+    /* The kept records point into the old pool: take it whole; the pool is
+     * rewritten once half of it is garbage, so it stays within twice what
+     * the records use (the soak's memory stays flat over hundreds of edits). */
+    if (!in_place) {
+        np->vert = op->vert, np->vcount = op->vcount, np->vcap = op->vcap;
+        op->vert = NULL, op->vcount = op->vcap = 0;
+    }
+    if (!compact_paths(np))
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for path records");
+    if (!in_place) {
+        ps_photon_map_free(om);
+        ps_path_store_free(op);
+    }
+    f->pending_count[k] = at;
+    f->kept_end[k] = to;
+    f->repairing[k] = at > 0;
+    /* Counters: every index below `end` counts as emitted (the pending
+     * ones are on their way); what the paths did is counted anew. */
+    memset(&m->counters, 0, sizeof m->counters);
+    m->counters.emitted = end;
+    m->counters.stored = to;
+    f->repair.kept[k] = end - at;
+    f->repair.retraced[k] = at;
+    f->repair.kept_photons[k] = to;
+    if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1))
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
+    ps_feed_mark mk = {to, end};
+    f->marks[k][f->mark_count[k]++] = mk;
+    return PS_OK;
+}
+
+ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair_fns *fns, ps_feed **out,
                                 ps_error *err)
 {
     *out = NULL;
@@ -501,83 +642,8 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep
     f->max_stored = old->max_stored;
     f->round = old->round;
     f->seconds = old->seconds;
-    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
-        ps_photon_map *om = &old->maps[k], *m = &f->maps[k];
-        ps_path_store *op = &old->paths[k];
-        uint64_t end = old->next[k];
-        f->next[k] = end;
-        f->repair_end[k] = end;
-        if (!f->active[k] || end == 0)
-            continue;
-        /* Take the old map and records whole, then keep in place. */
-        *m = *om;
-        ps_photon_map_init(om, (ps_map_kind)k);
-        f->paths[k] = *op;
-        ps_path_store_init(op);
-        ps_path_rec *rec = f->paths[k].rec;
-        /* Keep in place: the kept photons move down over the others (both
-         * in index order), the others' indices go to the pending list. */
-        size_t at = 0, cap = 0, from = 0, to = 0;
-        uint64_t every = batch_of(f, k);
-        for (uint64_t i = 0; i < end && st == PS_OK; i++) {
-            bool pending = (rec[i].flags & REC_PENDING) != 0;
-            size_t n = pending ? 0 : rec[i].stored;
-            if (!pending && keep(ctx, (ps_map_kind)k, i, &f->paths[k], &rec[i])) {
-                if (to != from) {
-                    memmove(m->photons + to, m->photons + from, n * sizeof *m->photons);
-                    memmove(m->materials + to, m->materials + from, n * sizeof *m->materials);
-                    memmove(m->objects + to, m->objects + from, n * sizeof *m->objects);
-                }
-                to += n;
-            } else if (!PS_RESERVE(f->pending[k], cap, at + 1)) {
-                st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %zu photons", at);
-            } else {
-                rec[i].flags = REC_PENDING;
-                rec[i].vertices = 0; /* its path is to be retraced: the old one is garbage */
-                rec[i].stored = 0;
-                f->pending[k][at++] = i;
-            }
-            from += n;
-            /* A mark every batch of indices: the kept photons of indices
-             * below i + 1 stand for all of them, so a refresh that draws only
-             * its budget draws a prefix of the kept ones, scaled right. */
-            if ((i + 1) % every == 0 && i + 1 < end) {
-                if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1)) {
-                    st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
-                    break;
-                }
-                ps_feed_mark mk = {to, i + 1};
-                f->marks[k][f->mark_count[k]++] = mk;
-            }
-        }
-        if (st != PS_OK)
-            break;
-        /* Retraced paths append their vertices; the pool is rewritten once
-         * half of it is garbage, so it stays within twice what the records
-         * use (the soak's memory stays flat over hundreds of edits). */
-        if (!compact_paths(&f->paths[k])) {
-            st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for path records");
-            break;
-        }
-        f->pending_count[k] = at;
-        m->count = to;
-        f->kept_end[k] = to;
-        f->repairing[k] = at > 0;
-        /* Counters: every index below `end` counts as emitted (the pending
-         * ones are on their way); what the paths did is counted anew. */
-        memset(&m->counters, 0, sizeof m->counters);
-        m->counters.emitted = end;
-        m->counters.stored = to;
-        f->repair.kept[k] = end - at;
-        f->repair.retraced[k] = at;
-        f->repair.kept_photons[k] = to;
-        if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1)) {
-            st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
-            break;
-        }
-        ps_feed_mark mk = {to, end};
-        f->marks[k][f->mark_count[k]++] = mk;
-    }
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
+        st = repair_map(f, old, k, fns, err);
     if (st != PS_OK) {
         ps_feed_destroy(f);
         return st;

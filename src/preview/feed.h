@@ -87,8 +87,9 @@ bool ps_feed_active(const ps_feed *f, ps_map_kind k);
 /* ---- selective repair (issue 18) ------------------------------------------------
  * With the tracer's path records (ps_tracer_options.records) a feed can go on
  * after an edit from what it has: ps_feed_create_repair takes a stopped
- * feed's maps and records, keeps every photon index that keep() says the
- * edit cannot have changed, and retraces the others first (PS_FEED_BATCH at
+ * feed's maps and records, keeps every photon the edit cannot have changed
+ * (put at its index under the edited scene's plan, its power set anew),
+ * and retraces the others first (PS_FEED_BATCH at
  * a time, in index order), before tracing on from where the old feed was.
  * Until then a map is in repair order (kept, then retraced, then new
  * photons), each batch still a mark whose emitted count is the whole range
@@ -96,16 +97,25 @@ bool ps_feed_active(const ps_feed *f, ps_map_kind k);
  * ends the map is put back in index order, equal photon for photon to a
  * fresh trace of the edited scene, and the generation counts up. */
 
-/* Whether photon index i of map k, with record rec (in paths), is kept. */
-typedef bool (*ps_feed_keep_fn)(void *ctx, ps_map_kind k, uint64_t i, const ps_path_store *paths,
-                                const ps_path_rec *rec);
+/* What a repair asks its caller (repair.c): */
+typedef struct ps_feed_repair_fns {
+    void *ctx;
+    /* Which old photon each of map k's indices [0, end) is under the edited
+     * scene's tracer (ps_tracer_photon_sources). */
+    ps_status (*sources)(void *ctx, ps_map_kind k, uint64_t end, ps_photon_source *out, ps_error *err);
+    /* Whether old photon index i of map k, with record rec (in paths), is
+     * clear of the edit. */
+    bool (*keep)(void *ctx, ps_map_kind k, uint64_t i, const ps_path_store *paths, const ps_path_rec *rec);
+} ps_feed_repair_fns;
 /* Whether a stopped feed can be repaired: its records are complete, it did
  * not fail or end at the store limit. */
 bool ps_feed_repairable(const ps_feed *f);
 /* The new feed, on tracer t (the edited scene's), from old (stopped and
- * repairable; left empty, to be destroyed). On an error old's maps may be
- * lost: start a new feed from photon 0. */
-ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, ps_feed_keep_fn keep, void *ctx, ps_feed **out,
+ * repairable; left empty, to be destroyed): photon i of the edited scene is
+ * the old photon its source names when keep() says so (its power set anew,
+ * ps_tracer_repower), else retraced. On an error old's maps may be lost:
+ * start a new feed from photon 0. */
+ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair_fns *fns, ps_feed **out,
                                 ps_error *err);
 /* What the repair that made f did, per map: photon indices kept and to
  * retrace, and the stored photons kept. */

@@ -50,30 +50,40 @@ ps_aabb ps_repair_record_box(const ps_scene *scene)
 typedef struct keep_ctx {
     ps_tracer *old_tracer, *new_tracer;
     uint64_t cap[PS_MAP_COUNT];
-    bool *light_changed;
+    bool *resampled; /* lights whose emission changed other than by power */
     size_t light_count;
     ps_aabb *moved; /* old and new box of each moved object */
     size_t moved_count;
     ps_path_quant quant;
-    ps_source_match match[PS_MAP_COUNT];
 } keep_ctx;
+
+static ps_status sources(void *arg, ps_map_kind k, uint64_t end, ps_photon_source *out, ps_error *err)
+{
+    keep_ctx *c = arg;
+    return ps_tracer_photon_sources(c->old_tracer, c->new_tracer, k, c->cap[k], end, c->resampled, c->light_count,
+                                    out, err);
+}
 
 static bool keep(void *arg, ps_map_kind k, uint64_t i, const ps_path_store *paths, const ps_path_rec *rec)
 {
+    (void)k, (void)i;
     keep_ctx *c = arg;
-    uint32_t light;
-    if (c->match[k] == PS_SOURCES_NONE)
-        return false;
-    if (c->match[k] == PS_SOURCES_SAME)
-        light = ps_tracer_photon_light(c->old_tracer, k, i, c->cap[k]);
-    else if (!ps_tracer_same_source(c->old_tracer, c->new_tracer, k, i, c->cap[k], &light))
-        return false;
-    if (light < c->light_count && c->light_changed[light])
-        return false;
     for (size_t m = 0; m < c->moved_count; m++)
         if (ps_path_meets(paths, rec, &c->quant, c->moved[m]))
             return false;
     return true;
+}
+
+/* Whether light a emits as b does but for its power: the same kind, place,
+ * aim, shape and table (its power and the radiance that follows from it may
+ * differ). */
+static bool same_emission(const ps_light *a, const ps_light *b)
+{
+    ps_light x = *a, y = *b;
+    x.power = y.power = (ps_rgb){0.0, 0.0, 0.0};
+    x.radiance = y.radiance = (ps_rgb){0.0, 0.0, 0.0};
+    x.line = y.line = 0;
+    return memcmp(&x, &y, sizeof x) == 0;
 }
 
 static bool inside(ps_aabb b, ps_aabb box, double margin)
@@ -102,12 +112,11 @@ ps_status ps_repair_feed(ps_feed *old, ps_tracer *old_tracer, ps_tracer *new_tra
         if (ps_tracer_map_enabled(old_tracer, (ps_map_kind)k) != ps_tracer_map_enabled(new_tracer, (ps_map_kind)k))
             return PS_OK;
         c.cap[k] = ps_feed_cap(old, (ps_map_kind)k);
-        c.match[k] = ps_tracer_match_sources(old_tracer, new_tracer, (ps_map_kind)k, c.cap[k]);
     }
-    c.light_changed = calloc(nl ? nl : 1, sizeof *c.light_changed);
+    c.resampled = calloc(nl ? nl : 1, sizeof *c.resampled);
     c.moved = malloc(2 * (no ? no : 1) * sizeof *c.moved);
-    if (!c.light_changed || !c.moved) {
-        free(c.light_changed);
+    if (!c.resampled || !c.moved) {
+        free(c.resampled);
         free(c.moved);
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for a repair", ps_scene_path(scene));
     }
@@ -123,17 +132,18 @@ ps_status ps_repair_feed(ps_feed *old, ps_tracer *old_tracer, ps_tracer *new_tra
         /* A mesh light's faces move with its object: its emission changes. */
         for (size_t l = 0; l < nl; l++)
             if (L[l].type == PS_LIGHT_MESH && L[l].object == o)
-                c.light_changed[l] = true;
+                c.resampled[l] = true;
     }
     for (size_t l = 0; l < nl; l++)
-        if (memcmp(&L[l], &was->lights[l], sizeof L[l]) != 0)
-            c.light_changed[l] = true;
+        if (!same_emission(&L[l], &was->lights[l]))
+            c.resampled[l] = true;
     ps_status st = PS_OK;
     if (fits) {
-        st = ps_feed_create_repair(new_tracer, old, keep, &c, out, err);
+        ps_feed_repair_fns fns = {&c, sources, keep};
+        st = ps_feed_create_repair(new_tracer, old, &fns, out, err);
         *repaired = st == PS_OK;
     }
-    free(c.light_changed);
+    free(c.resampled);
     free(c.moved);
     return st;
 }

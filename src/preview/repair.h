@@ -2,21 +2,20 @@
  * edit cannot have changed (issue 18): the session's hook between the old
  * feed and the new one (feed.h, selective repair).
  *
- * Photon i of a map is kept, exactly, when
- *  - it leaves the same light the same way under the old and the new plan
- *    (ps_tracer_same_source: light, caustic cone, first-hit target and the
- *    normalisation 1 / photons of its stratum, bit for bit),
- *  - that light did not change (its ps_light, bit for bit; a mesh light also
- *    changes when its object moves), and
- *  - no segment of its path meets the bounds of a moved object, at the old
- *    or the new place (path_record.h).
- * So: moving object O keeps every path clear of O's boxes; moving a light,
- * changing its power or a spot's angle retraces that light's photons; an
- * edit that changes any stratum's share (another caustic cone, another
- * light's flux) changes every photon count of that map, hence every photon's
- * power, and the whole map is retraced (a rescale is not bit-identical: the
- * tracer multiplies the power along the path in an order a rescale cannot
- * reproduce, and RGBE rounds it with a dither). The repair falls back to a
+ * Photon i of the edited scene's map is photon (stratum, j) of its plan
+ * (tracer.h). It keeps the old photon (stratum, j), exactly, when
+ *  - the old plan has that stratum (the same light and target) sampling the
+ *    same way (the same caustic cone; the light not moved, turned, its spot
+ *    angle or mesh changed: its power and colour may differ) and emitted its
+ *    photon j below the old end (ps_tracer_photon_sources), and
+ *  - no segment of that photon's path meets the bounds of a moved object, at
+ *    the old or the new place (path_record.h).
+ * Its power is then set anew from its recorded throughput
+ * (ps_tracer_repower), bit for bit what a fresh trace stores. So: a power or
+ * colour edit keeps every photon (with several lights only the strata whose
+ * counts grew trace more); moving object O keeps every path clear of O's
+ * boxes, and the other objects' caustic cones' photons; moving a light or a
+ * spot's angle keeps the other lights' photons. The repair falls back to a
  * restart when the scene's ray offset changed, a moved box left the record
  * box, or the maps the scene needs changed. */
 #ifndef PS_PREVIEW_REPAIR_H

@@ -1,0 +1,199 @@
+/* test_tracer_strata.c: per-stratum photon streams (tracer.h, issue 18).
+ * Photon (stratum, j) is the same path whatever the other strata's shares:
+ * after a power edit of one of two lights every photon's path is one of the
+ * unedited scene's, at another index, and its bytes are that photon's with
+ * its power set anew (ps_tracer_repower): equal, all 20 bytes. */
+#include "test.h"
+#include "rig.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "photon/tracer.h"
+
+#define N_CAUSTIC 6000
+#define N_GLOBAL 3000
+
+static const char *scene_text(char *buf, size_t size, const char *spot_power)
+{
+    snprintf(buf, size,
+             "camera eye 0 1 3.4 target 0 1 0 up 0 1 0 fov 40\n"
+             "material white diffuse albedo 0.75 0.75 0.75\n"
+             "material red diffuse albedo 0.75 0.25 0.25\n"
+             "material glass dielectric ior 1.5\n"
+             "material mirror mirror reflectance 1 1 1\n"
+             "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
+             "quad corner -1 2 -1 edge1 2 0 0 edge2 0 0 2 material white\n"
+             "quad corner -1 0 -1 edge1 2 0 0 edge2 0 2 0 material white\n"
+             "quad corner -1 0 -1 edge1 0 2 0 edge2 0 0 2 material red\n"
+             "quad corner 1 0 -1 edge1 0 0 2 edge2 0 2 0 material white\n"
+             "sphere center 0.35 0.4 0.2 radius 0.4 material glass\n"
+             "sphere center -0.45 0.35 -0.4 radius 0.35 material mirror\n"
+             "light point position 0 1.9 0 power 100 100 100\n"
+             "light spot position 0.5 1.9 0.3 direction 0 -1 0 angle 40 power %s\n",
+             spot_power);
+    return buf;
+}
+
+typedef struct traced {
+    ps_photon_map map;
+    ps_path_store paths;
+    size_t *off; /* off[i]: index i's first photon in map */
+} traced;
+
+static traced trace(rig *r, ps_map_kind k, uint64_t n)
+{
+    traced t;
+    ps_photon_map_init(&t.map, k);
+    ps_path_store_init(&t.paths);
+    ps_traced *tr;
+    ps_error err;
+    assert_int_equal(ps_tracer_trace_range(r->tracer, k, 0, n, n, 0, &tr, &err), PS_OK);
+    assert_int_equal(ps_traced_join_paths(tr, &t.paths, NULL, &err), PS_OK);
+    assert_int_equal(ps_traced_join(tr, &t.map, &err), PS_OK);
+    ps_traced_destroy(tr);
+    assert_int_equal(t.paths.count, n);
+    assert_int_equal(t.paths.tcount, t.map.count);
+    t.off = malloc((n + 1) * sizeof *t.off);
+    t.off[0] = 0;
+    for (uint64_t i = 0; i < n; i++)
+        t.off[i + 1] = t.off[i] + t.paths.rec[i].stored;
+    assert_int_equal(t.off[n], t.map.count);
+    return t;
+}
+
+static void traced_free(traced *t)
+{
+    ps_photon_map_free(&t->map);
+    ps_path_store_free(&t->paths);
+    free(t->off);
+}
+
+/* frac: the fraction of n expected to match from the shares (0: not known
+ * in closed form). */
+static void one_map(rig *a, rig *b, ps_map_kind k, uint64_t n, double frac)
+{
+    traced ta = trace(a, k, n), tb = trace(b, k, n);
+    ps_photon_source *src = malloc(n * sizeof *src);
+    bool resampled[2] = {false, false};
+    ps_error err;
+    assert_int_equal(ps_tracer_photon_sources(a->tracer, b->tracer, k, n, n, resampled, 2, src, &err), PS_OK);
+    /* The expected number of matches: per stratum, the fewer of its two counts. */
+    uint64_t expect = 0;
+    for (uint32_t l = 0; l < 2; l++)
+        for (int64_t target = -1; target < 7; target++) {
+            uint64_t na = ps_tracer_stratum_photons(a->tracer, k, l, target, n);
+            uint64_t nb = ps_tracer_stratum_photons(b->tracer, k, l, target, n);
+            expect += na < nb ? na : nb;
+        }
+    uint64_t matched = 0, moved = 0, photons = 0;
+    for (uint64_t i = 0; i < n; i++) {
+        if (src[i].from == PS_SOURCE_NONE)
+            continue;
+        matched++;
+        moved += src[i].from != i;
+        uint64_t o = src[i].from;
+        size_t na = ta.paths.rec[o].stored, nb = tb.paths.rec[i].stored;
+        assert_int_equal(na, nb);
+        assert_int_equal(ta.paths.rec[o].vertices, tb.paths.rec[i].vertices);
+        /* The same path: every photon the same but for its power. */
+        ps_photon *pa = malloc((na ? na : 1) * sizeof *pa);
+        memcpy(pa, ta.map.photons + ta.off[o], na * sizeof *pa);
+        ps_tracer_repower(b->tracer, k, &src[i], ta.paths.thr + ta.off[o], na, pa);
+        assert_memory_equal(pa, tb.map.photons + tb.off[i], na * sizeof *pa);
+        assert_memory_equal(ta.paths.thr + ta.off[o], tb.paths.thr + tb.off[i], na * sizeof(ps_path_thr));
+        assert_memory_equal(ta.map.materials + ta.off[o], tb.map.materials + tb.off[i], na * sizeof(uint16_t));
+        assert_memory_equal(ta.map.objects + ta.off[o], tb.map.objects + tb.off[i], na * sizeof(uint32_t));
+        photons += na;
+        free(pa);
+    }
+    fprintf(stderr, "%s: %llu of %llu photon paths are the unedited scene's (%llu at another index), %llu photons\n",
+            ps_map_name(k), (unsigned long long)matched, (unsigned long long)n, (unsigned long long)moved,
+            (unsigned long long)photons);
+    assert_int_equal(matched, expect);
+    /* All but the counts' growth: a low-discrepancy share is within a few
+     * photons of n times the share, for every n. */
+    if (frac > 0.0)
+        assert_true(fabs((double)expect - frac * (double)n) <= 4.0);
+    assert_true(expect > n / 2);
+    assert_true(moved > 0);           /* the shares did change */
+    assert_true(photons > 0);
+    free(src);
+    traced_free(&ta);
+    traced_free(&tb);
+}
+
+/* The spot twice as bright: both lights' shares change, no path does. */
+static void paths_survive_a_share_change(void **state)
+{
+    (void)state;
+    char ta[2048], tb[2048];
+    ps_tracer_options o = ps_tracer_default_options();
+    o.seed = 5;
+    o.threads = 2;
+    o.records = true;
+    rig a = rig_make(scene_text(ta, sizeof ta, "60 50 40"), "", &o, PS_ACCEL_AUTO);
+    ps_aabb box = ps_scene_bounds(a.scene);
+    box.lo = ps_v3_sub(box.lo, ps_v3(2, 2, 2));
+    box.hi = ps_v3_add(box.hi, ps_v3(2, 2, 2));
+    rig_free(&a);
+    o.record_box = box;
+    a = rig_make(scene_text(ta, sizeof ta, "60 50 40"), "", &o, PS_ACCEL_AUTO);
+    rig b = rig_make(scene_text(tb, sizeof tb, "120 100 80"), "", &o, PS_ACCEL_AUTO);
+    assert_true(ps_tracer_light_photons(a.tracer, PS_MAP_GLOBAL, 0, N_GLOBAL) !=
+                ps_tracer_light_photons(b.tracer, PS_MAP_GLOBAL, 0, N_GLOBAL));
+    /* Global: the point's share 300 / 450 = 2/3 becomes 1/2, the spot's
+     * 1/3 becomes 1/2: 1/2 + 1/3 of the photons keep their paths. */
+    one_map(&a, &b, PS_MAP_GLOBAL, N_GLOBAL, 5.0 / 6.0);
+    one_map(&a, &b, PS_MAP_CAUSTIC, N_CAUSTIC, 0.0);
+    rig_free(&a);
+    rig_free(&b);
+}
+
+/* Each stratum's count over a prefix follows its share for every prefix
+ * (the strata still interleave along the index), and the ranks the tracer
+ * gives are 0.. in index order: photon sources of a tracer with itself name
+ * every index itself. */
+static void ranks_are_in_index_order(void **state)
+{
+    (void)state;
+    char t[2048];
+    ps_tracer_options o = ps_tracer_default_options();
+    o.seed = 9;
+    o.threads = 1;
+    rig a = rig_make(scene_text(t, sizeof t, "60 50 40"), "", &o, PS_ACCEL_AUTO);
+    const uint64_t n = 5000;
+    ps_photon_source *src = malloc(n * sizeof *src);
+    bool resampled[2] = {false, false};
+    ps_error err;
+    assert_int_equal(ps_tracer_photon_sources(a.tracer, a.tracer, PS_MAP_CAUSTIC, n, n, resampled, 2, src, &err),
+                     PS_OK);
+    uint64_t next[16] = {0};
+    for (uint64_t i = 0; i < n; i++) {
+        assert_int_equal(src[i].from, i);
+        assert_true(src[i].stratum < 16);
+        assert_int_equal(src[i].rank, next[src[i].stratum]++);
+    }
+    /* The spot resampled (moved): its strata match nothing, the point's all. */
+    resampled[1] = true;
+    assert_int_equal(ps_tracer_photon_sources(a.tracer, a.tracer, PS_MAP_CAUSTIC, n, n, resampled, 2, src, &err),
+                     PS_OK);
+    uint64_t none = 0;
+    for (uint64_t i = 0; i < n; i++)
+        none += src[i].from == PS_SOURCE_NONE;
+    uint64_t spot = ps_tracer_light_photons(a.tracer, PS_MAP_CAUSTIC, 1, n);
+    assert_true(spot > 0);
+    assert_int_equal(none, spot);
+    free(src);
+    rig_free(&a);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(paths_survive_a_share_change),
+        cmocka_unit_test(ranks_are_in_index_order),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
