@@ -49,7 +49,7 @@ static inline render_rig render_rig_make(const char *text, uint64_t caustic, uin
         assert_int_equal(ps_tracer_create(r.world, &o, &r.full_tracer, &err), PS_OK);
         assert_int_equal(ps_tracer_trace(r.full_tracer, PS_MAP_GLOBAL, 0, global, global, &r.full, &err), PS_OK);
         assert_int_equal(ps_kdtree_build(r.full.photons, r.full.count, &r.full_tree, &err), PS_OK);
-        assert_int_equal(ps_irradiance_precompute(r.full_tree, est, 4, 2, &r.irr, &err), PS_OK);
+        assert_int_equal(ps_irradiance_precompute(r.full_tree, est, 4, 2, NULL, &r.irr, &err), PS_OK);
     }
     return r;
 }

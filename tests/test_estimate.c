@@ -422,7 +422,7 @@ static ps_kdtree *precompute(const ps_kdtree *map, const ps_estimate_options *o,
 {
     ps_kdtree *irr = NULL;
     ps_error err;
-    if (ps_irradiance_precompute(map, o, stride, threads, &irr, &err) != PS_OK)
+    if (ps_irradiance_precompute(map, o, stride, threads, NULL, &irr, &err) != PS_OK)
         fail_msg("precompute: %s", err.msg);
     assert_non_null(irr);
     return irr;
@@ -490,6 +490,13 @@ static void precomputed_irradiance(void **state)
     assert_int_equal(ps_kdtree_count(irr0), 0);
     ps_kdtree_destroy(irr0);
     ps_kdtree_destroy(empty);
+    /* A raised cancel flag stops it: interrupted, no tree. */
+    ps_cancel_flag raised = 15;
+    ps_kdtree *none = NULL;
+    ps_error err;
+    assert_int_equal(ps_irradiance_precompute(map, &o, 1, 2, &raised, &none, &err), PS_ERR_INTERRUPTED);
+    assert_null(none);
+    assert_non_null(strstr(err.msg, "interrupted"));
     ps_kdtree_destroy(map);
     free(ph);
 }

@@ -310,8 +310,8 @@ static ps_status render_image(const ref_options *o, const ps_scene *scene, ref_r
         if (st == PS_OK)
             st = ps_kdtree_build(r->full.photons, r->full.count, &r->full_tree, err);
         if (st == PS_OK)
-            st = ps_irradiance_precompute(r->full_tree, &ro.global, REF_IRRADIANCE_STRIDE, ro.threads,
-                                                 &r->irradiance, err);
+            st = ps_irradiance_precompute(r->full_tree, &ro.global, REF_IRRADIANCE_STRIDE, ro.threads, o->cancel,
+                                          &r->irradiance, err);
         maps.full = r->full_tree;
         maps.irradiance = r->irradiance;
         rs->rays += r->full.counters.rays;

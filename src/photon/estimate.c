@@ -126,6 +126,8 @@ typedef struct irr_job {
     size_t next; /* next chunk, under lock */
     pthread_mutex_t lock;
     bool nomem;
+    const ps_cancel_flag *cancel;
+    bool cancelled; /* under lock */
 } irr_job;
 
 static void *irr_worker(void *arg)
@@ -139,8 +141,11 @@ static void *irr_worker(void *arg)
         job->next += IRR_CHUNK;
         if (!scratch)
             job->nomem = true;
+        if (ps_cancelled(job->cancel))
+            job->cancelled = true;
+        bool stop = !scratch || job->cancelled || first >= job->samples;
         pthread_mutex_unlock(&job->lock);
-        if (!scratch || first >= job->samples)
+        if (stop)
             break;
         size_t last = first + IRR_CHUNK < job->samples ? first + IRR_CHUNK : job->samples;
         for (size_t s = first; s < last; s++) {
@@ -159,13 +164,13 @@ static void *irr_worker(void *arg)
 }
 
 ps_status ps_irradiance_precompute(const ps_kdtree *map, const ps_estimate_options *o, size_t stride, int threads,
-                                   ps_kdtree **out, ps_error *err)
+                                   const ps_cancel_flag *cancel, ps_kdtree **out, ps_error *err)
 {
     *out = NULL;
     if (stride < 1)
         stride = 1;
     irr_job job = {map, o, stride, (ps_kdtree_count(map) + stride - 1) / stride, NULL, 0,
-                   PTHREAD_MUTEX_INITIALIZER, false};
+                   PTHREAD_MUTEX_INITIALIZER, false, cancel, false};
     job.out = malloc((job.samples ? job.samples : 1) * sizeof *job.out);
     if (!job.out)
         return ps_error_set(err, PS_ERR_NOMEM, "irradiance: out of memory for %zu samples", job.samples);
@@ -179,8 +184,9 @@ ps_status ps_irradiance_precompute(const ps_kdtree *map, const ps_estimate_optio
     for (int i = 0; i < started; i++)
         pthread_join(tid[i], NULL);
     pthread_mutex_destroy(&job.lock);
-    ps_status st = job.nomem ? ps_error_set(err, PS_ERR_NOMEM, "irradiance: out of memory")
-                             : ps_kdtree_build(job.out, job.samples, out, err);
+    ps_status st = job.nomem       ? ps_error_set(err, PS_ERR_NOMEM, "irradiance: out of memory")
+                   : job.cancelled ? ps_error_set(err, PS_ERR_INTERRUPTED, "interrupted while precomputing irradiance")
+                                   : ps_kdtree_build(job.out, job.samples, out, err);
     free(job.out);
     return st;
 }

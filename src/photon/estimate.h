@@ -12,6 +12,7 @@
 
 #include <stddef.h>
 
+#include "core/cancel.h"
 #include "core/status.h"
 #include "core/vec.h"
 #include "photon/kdtree.h"
@@ -58,9 +59,12 @@ ps_rgb ps_photon_radiance(const ps_kdtree *map, const ps_material *m, ps_vec3 p,
 /* Christensen's precomputation: the irradiance at every stride-th photon of
  * map (stride >= 1), as a new tree whose photons carry E in place of power
  * (same position and normal). Computed on `threads` threads; the result does
- * not depend on their number. */
+ * not depend on their number. cancel (NULL: none) stops it between chunks
+ * with PS_ERR_INTERRUPTED and nothing made: at the reference's final quality
+ * it takes seconds, and mpirun kills ranks that do not stop within about a
+ * second of its SIGTERM. */
 ps_status ps_irradiance_precompute(const ps_kdtree *map, const ps_estimate_options *o, size_t stride, int threads,
-                                   ps_kdtree **out, ps_error *err);
+                                   const ps_cancel_flag *cancel, ps_kdtree **out, ps_error *err);
 
 /* The precomputed irradiance nearest to p within radius whose normal faces
  * the same way as n (cosine above PS_IRRADIANCE_MIN_COS); false when none. */
