@@ -996,7 +996,9 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     int started = 0;
     /* The irradiance cache first, when asked for and the indirect term is
      * wanted, directly or through mirrors and glass. It is the same for
-     * every such component, so that they still add up to `all`. */
+     * every such component, so that they still add up to `all` (`specular`
+     * needs it also where it only tells a glossy surface's lobe whether the
+     * diffuse rays before it were gathered: indirect_light). */
     bool indirect = o->component == PS_COMPONENT_ALL || o->component == PS_COMPONENT_INDIRECT ||
                     o->component == PS_COMPONENT_SPECULAR;
     st = PS_OK;
