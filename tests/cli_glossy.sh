@@ -5,8 +5,9 @@
 #  - The floor made purely glossy (albedo 0, specular 0.5): what the specular
 #    layer adds there (all four layers less direct,caustic: the global
 #    splats carry no lobe while the layer shows, so the difference is the
-#    layer) against photosplat-ref --component indirect, which on a surface
-#    without albedo is the glossy gather alone: the mean within 3 %.
+#    layer) against photosplat-ref --component specular, which on a glossy
+#    surface seen directly is the lobe's gather (the floor has no albedo, so
+#    --component indirect there is 0): the mean within 3 %.
 #  - The design room itself, all layers against the whole reference on the
 #    floor: the mean within 10 %, relMSE under 0.08 (0.215 before the lobes
 #    were the layer's and GL's capped highlight was normalised for its own
@@ -30,13 +31,13 @@ expect_success "floor mask" "$tools/tool_material_mask" "$room" $size floor "$cl
 pixels=$(echo "$cli_out" | field pixels)
 if awk_true "${pixels:-0} > 3000"; then ok; else bad "floor mask: $pixels pixels"; fi
 
-expect_success "pure glossy: reference indirect" ref "$pure" --component indirect --hdr "$cli_tmp/ref_ind.pfm"
+expect_success "pure glossy: reference specular" ref "$pure" --component specular --hdr "$cli_tmp/ref_spec.pfm"
 expect_success "pure glossy: all layers" snap "$pure" --hdr "$cli_tmp/all.pfm"
 expect_success "pure glossy: direct,caustic" snap "$pure" --layers direct,caustic --hdr "$cli_tmp/dc.pfm"
-all=$(mean_on_floor "$cli_tmp/all.pfm" "$cli_tmp/ref_ind.pfm" | field mean_a)
-dc=$(mean_on_floor "$cli_tmp/dc.pfm" "$cli_tmp/ref_ind.pfm" | field mean_a)
-want=$(mean_on_floor "$cli_tmp/dc.pfm" "$cli_tmp/ref_ind.pfm" | field mean_b)
-echo "pure glossy floor: the specular layer $(awk "BEGIN { print $all - $dc }") against the reference's indirect $want"
+all=$(mean_on_floor "$cli_tmp/all.pfm" "$cli_tmp/ref_spec.pfm" | field mean_a)
+dc=$(mean_on_floor "$cli_tmp/dc.pfm" "$cli_tmp/ref_spec.pfm" | field mean_a)
+want=$(mean_on_floor "$cli_tmp/dc.pfm" "$cli_tmp/ref_spec.pfm" | field mean_b)
+echo "pure glossy floor: the specular layer $(awk "BEGIN { print $all - $dc }") against the reference's specular $want"
 if awk_true "$want > 0.05 && ($all - $dc) / $want > 0.97 && ($all - $dc) / $want < 1.03"; then ok; else
     bad "pure glossy floor: the layer $all - $dc against $want"
 fi

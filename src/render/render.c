@@ -467,21 +467,46 @@ static ps_status cache_build(render_job *job, worker *wk, int threads, ps_error 
  * for albedo / pi, whose estimate is pi f_d L = albedo L, and rays in the
  * Phong lobe for the glossy term, whose estimate is f_s L cos / pdf =
  * specular (e + 2) / (e + 1) cos(theta) L. Both are stratified in their
- * first dimension. */
+ * first dimension. Without gathering, the global map's estimate with the
+ * BRDF, or with one of its terms.
+ *
+ * `diffuse` and `glossy` select the terms: at a glossy surface seen directly
+ * the lobe's part is the `specular` component, the diffuse part `indirect`
+ * (render.h). Both together are computed exactly as one sum, so `all` is
+ * the same bytes as before the split. The lobe's rays take their numbers
+ * from rng after the diffuse rays: where the diffuse term is not wanted but
+ * gathers (no cache record reaches), its rays are still traced, only to
+ * leave rng where it would be (how many numbers a gather ray takes depends
+ * on the glass it meets), so the components of one sample add up to the
+ * whole exactly. */
 static ps_rgb indirect_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec3 wo, const ps_material *m,
-                             ps_rng *rng)
+                             ps_rng *rng, bool diffuse, bool glossy)
 {
     const render_job *job = wk->job;
     int g = job->o->gather;
-    if (g == 0)
-        return job->maps->global ? ps_photon_radiance(job->maps->global, m, sp->p, n, wo, &job->o->global, wk->scratch)
-                                 : ps_rgb_gray(0.0);
+    bool has_lobe = m->type == PS_MAT_GLOSSY && !ps_rgb_is_black(m->specular);
+    glossy = glossy && has_lobe;
+    if (!diffuse && !glossy)
+        return ps_rgb_gray(0.0);
+    if (g == 0) {
+        if (!job->maps->global)
+            return ps_rgb_gray(0.0);
+        ps_material part = *m;
+        if (!glossy) { /* albedo / pi alone: the irradiance estimate times it */
+            part.type = PS_MAT_DIFFUSE;
+        } else if (!diffuse) {
+            part.albedo = ps_rgb_gray(0.0);
+        }
+        return ps_photon_radiance(job->maps->global, diffuse && glossy ? m : &part, sp->p, n, wo, &job->o->global,
+                                  wk->scratch);
+    }
     if (!job->maps->irradiance || !job->maps->full)
         return ps_rgb_gray(0.0);
     ps_rgb sum = ps_rgb_gray(0.0);
     ps_rgb cached;
     if (!ps_rgb_is_black(m->albedo) && job->irr && ps_irrcache_lookup(job->irr, sp->p, n, &cached, NULL)) {
-        sum = ps_rgb_scale(ps_rgb_mul(m->albedo, cached), PS_INV_PI);
+        if (diffuse)
+            sum = ps_rgb_scale(ps_rgb_mul(m->albedo, cached), PS_INV_PI);
     } else if (!ps_rgb_is_black(m->albedo)) {
         ps_rgb acc = ps_rgb_gray(0.0);
         for (int k = 0; k < g; k++) {
@@ -491,9 +516,10 @@ static ps_rgb indirect_light(worker *wk, const ps_surface *sp, ps_vec3 n, ps_vec
                 continue; /* an interpolated normal pointed it into the surface */
             acc = ps_rgb_add(acc, gather_ray(wk, ps_world_spawn(job->world, sp, dir), rng, NULL));
         }
-        sum = ps_rgb_mul(m->albedo, ps_rgb_scale(acc, 1.0 / g));
+        if (diffuse)
+            sum = ps_rgb_mul(m->albedo, ps_rgb_scale(acc, 1.0 / g));
     }
-    if (m->type == PS_MAT_GLOSSY && !ps_rgb_is_black(m->specular)) {
+    if (glossy) {
         ps_vec3 mirror = ps_reflect(ps_v3_neg(wo), n);
         ps_rgb acc = ps_rgb_gray(0.0);
         for (int k = 0; k < g; k++) {
@@ -601,7 +627,7 @@ static ps_rgb illuminance_at(worker *wk, ps_ray r, uint64_t key)
         sum = ps_rgb_add(sum, ps_photon_irradiance(job->maps->caustic, sp.p, n, &job->o->caustic, wk->scratch));
     if (wants(want, PS_COMPONENT_INDIRECT)) {
         ps_rng rng = ps_rng_make(key, KEY_GATHER, 0);
-        sum = ps_rgb_add(sum, ps_rgb_scale(indirect_light(wk, &sp, n, wo, &white, &rng), PS_PI));
+        sum = ps_rgb_add(sum, ps_rgb_scale(indirect_light(wk, &sp, n, wo, &white, &rng, true, false), PS_PI));
     }
     return sum;
 }
@@ -664,7 +690,10 @@ static ps_rgb radiance(worker *wk, ps_ray r, int depth, bool through, uint64_t k
     }
 
     /* A diffuse or glossy surface: the terms of the split equation. Through
-     * mirrors and glass they all count as `specular`. */
+     * mirrors and glass they all count as `specular`; seen directly, so does
+     * the glossy lobe's reflection of the other surfaces (the preview's
+     * specular layer draws it; the lobe's caustic and direct light stay
+     * in those terms, as the preview keeps them). */
     ps_rgb sum = ps_rgb_gray(0.0);
     ps_component as_direct = through ? PS_COMPONENT_SPECULAR : PS_COMPONENT_DIRECT;
     ps_component as_caustic = through ? PS_COMPONENT_SPECULAR : PS_COMPONENT_CAUSTIC;
@@ -677,9 +706,10 @@ static ps_rgb radiance(worker *wk, ps_ray r, int depth, bool through, uint64_t k
     }
     if (wants(want, as_caustic) && job->maps->caustic)
         sum = ps_rgb_add(sum, ps_photon_radiance(job->maps->caustic, m, sp.p, n, wo, &job->o->caustic, wk->scratch));
-    if (wants(want, as_indirect)) {
+    bool diffuse = wants(want, as_indirect), lobe = through ? diffuse : wants(want, PS_COMPONENT_SPECULAR);
+    if (diffuse || lobe) {
         ps_rng rng = ps_rng_make(key, KEY_GATHER, 0);
-        sum = ps_rgb_add(sum, indirect_light(wk, &sp, n, wo, m, &rng));
+        sum = ps_rgb_add(sum, indirect_light(wk, &sp, n, wo, m, &rng, diffuse, lobe));
     }
     return sum;
 }
@@ -966,7 +996,9 @@ ps_status ps_render(const ps_world *w, const ps_light_sampler *ls, const ps_rend
     int started = 0;
     /* The irradiance cache first, when asked for and the indirect term is
      * wanted, directly or through mirrors and glass. It is the same for
-     * every such component, so that they still add up to `all`. */
+     * every such component, so that they still add up to `all` (`specular`
+     * needs it also where it only tells a glossy surface's lobe whether the
+     * diffuse rays before it were gathered: indirect_light). */
     bool indirect = o->component == PS_COMPONENT_ALL || o->component == PS_COMPONENT_INDIRECT ||
                     o->component == PS_COMPONENT_SPECULAR;
     st = PS_OK;

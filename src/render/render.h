@@ -5,9 +5,11 @@
  * split as in the thesis: direct light (shadow rays to every light; point and
  * spot exact, area lights sampled), caustics (the caustic map's radiance
  * estimate), and indirect diffuse light (final gathering on precomputed
- * irradiance, Christensen 1999, or the global map's estimate directly). Eye
- * rays that meet mirrors and glass first are followed (Fresnel) and all they
- * then see is the `specular` term. The four terms partition the image:
+ * irradiance, Christensen 1999, or the global map's estimate directly), its
+ * diffuse part. Eye rays that meet mirrors and glass first are followed
+ * (Fresnel) and all they then see is the `specular` term, and so is a glossy
+ * surface's lobe reflecting the other surfaces (the preview's specular layer
+ * draws it from the cube maps). The four terms partition the image:
  * all = direct + caustic + indirect + specular. An irradiance cache with
  * gradients (irrcache.h) serves the diffuse indirect light wherever a path
  * meets a diffuse surface, and a pixel filter (Mitchell, Gaussian or box)
@@ -30,8 +32,13 @@ typedef enum ps_component {
     PS_COMPONENT_ALL,
     PS_COMPONENT_DIRECT,   /* lights seen by the first diffuse/glossy surface (and emitters seen directly) */
     PS_COMPONENT_CAUSTIC,  /* light through mirrors and glass onto that surface */
-    PS_COMPONENT_INDIRECT, /* light from other diffuse surfaces onto it */
-    PS_COMPONENT_SPECULAR, /* everything seen through mirrors and glass */
+    PS_COMPONENT_INDIRECT, /* light from other surfaces reflected by its diffuse part */
+    /* Everything seen through mirrors and glass, and, at a glossy surface
+     * seen directly, its lobe's reflection of the other surfaces (the
+     * Phong-lobe gather, or the global photons' glossy BRDF): what the
+     * preview's specular layer shows. The lobe's caustic stays `caustic`,
+     * its highlights of the lights `direct`. */
+    PS_COMPONENT_SPECULAR,
     PS_COMPONENT_COUNT
 } ps_component;
 
