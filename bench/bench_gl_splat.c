@@ -16,8 +16,11 @@
  *          depth test without writes, kernel texture, polygon offset, point
  *          sprite state): the GL cost alone, the baseline.
  * ours/bare is the issue's figure (target >= 0.8: the CPU work must not be the
- * bottleneck); draw/bare checks that our GL call adds nothing to the bare
- * one. The pixels of `ours` and `bare` are compared byte for byte, so the
+ * bottleneck), judged as the median over the rounds of each round's own
+ * bare / ours: ours and bare take turns within a round, so a round's ratio
+ * sees the same load on both, where the best of each may come from
+ * different moments; best/best is printed beside it. draw/bare checks that
+ * our GL call adds nothing to the bare one. The pixels of `ours` and `bare` are compared byte for byte, so the
  * baseline is known to draw the very same picture.
  *
  * The photons: one caustic map traced until it holds at least 10^6 photons
@@ -54,7 +57,10 @@
 #define TRACE_MARGIN 1.05
 #define REPS_SMALL 7 /* repetitions at 10^5 photons */
 #define REPS_LARGE 3 /* at 10^6 */
-#define MAX_REPS 7
+/* Points at 10^6, the issue's figure: a frame takes a tenth of a second, so
+ * many rounds cost little and steady the median against the machine's load. */
+#define REPS_POINTS_LARGE 15
+#define MAX_REPS 15
 /* gl_render.c's SPLAT_OFFSET (private there): triangle splats pulled forward. */
 #define BARE_SPLAT_OFFSET -1.0f
 /* snap's defaults: point side in pixels, exposure. */
@@ -81,6 +87,8 @@ typedef struct row {
     ps_splat_mode mode;
     size_t photons, splats;
     double best[4], median[4]; /* seconds a frame: build, ours, draw, bare */
+    double pair_median; /* the median over the rounds of bare / ours, both timed in the same round */
+    double pair_lo, pair_hi; /* their least and greatest */
     int reps;
     bool same_pixels;
 } row;
@@ -435,6 +443,12 @@ static int measure(bench_gl *g, const ps_photon_map *m, size_t n, ps_splat_mode 
         t[3][r] = tb;
     }
     out->splats = b.splats;
+    double pair[MAX_REPS];
+    for (int r = 0; r < reps; r++)
+        pair[r] = t[3][r] / t[1][r];
+    out->pair_median = median(pair, reps); /* sorted by it */
+    out->pair_lo = pair[0];
+    out->pair_hi = pair[reps - 1];
     for (int k = 0; k < 4; k++) {
         out->best[k] = t[k][0];
         for (int r = 1; r < reps; r++)
@@ -539,8 +553,9 @@ int main(void)
     }
     for (int c = 0; c < 2; c++)
         for (int md = 0; md < PS_SPLAT_MODE_COUNT; md++) {
-            if (measure(&g, &map, counts[c], (ps_splat_mode)md, def->caustic_radius,
-                        c == 0 ? REPS_SMALL : REPS_LARGE, c == 0, pixels, &rows[nrows], &err) != 0) {
+            int reps = c == 0 ? REPS_SMALL : md == PS_SPLAT_POINTS ? REPS_POINTS_LARGE : REPS_LARGE;
+            if (measure(&g, &map, counts[c], (ps_splat_mode)md, def->caustic_radius, reps, c == 0, pixels,
+                        &rows[nrows], &err) != 0) {
                 fail("splats", &err);
                 free(pixels);
                 ps_photon_map_free(&map);
@@ -559,23 +574,30 @@ int main(void)
     printf("each frame: ps_gl_begin_frame (direct off, untimed), then: build = ps_splat_build; ours = build + "
            "ps_gl_draw_splats + glFinish;\n  draw = the ps_gl_draw_splats + glFinish part of ours; bare = "
            "glDrawArrays + glFinish of the same arrays in the same GL state;\n  rates: splats drawn per second, "
-           "best of the reps; ours/bare also as the median's ratio\n\n");
+           "best of the reps;\n  ours/bare: the median over the reps of each rep's bare / ours (the "
+           "goal's figure), and best / best\n\n");
     printf("| mode | photons | splats | reps | build Msplat/s | ours Msplat/s | draw Msplat/s | bare Msplat/s | "
-           "ours/bare | ours/bare median | draw/bare | build ms | draw ms | bare ms | same pixels |\n");
+           "ours/bare (median of reps) | ours/bare (best/best) | draw/bare | build ms | draw ms | bare ms | same pixels |\n");
     printf("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n");
     bool all_same = true, all_met = true;
     for (int i = 0; i < nrows; i++) {
         const row *r = &rows[i];
-        double s = (double)r->splats * 1e-6, ratio = r->best[3] / r->best[1];
+        double s = (double)r->splats * 1e-6, ratio = r->pair_median;
         printf("| %s | %zu | %zu | %d | %.2f | %.2f | %.2f | %.2f | %.2f%s | %.2f | %.2f | %.1f | %.1f | %.1f | %s |\n",
                ps_splat_mode_name(r->mode), r->photons, r->splats, r->reps, s / r->best[0], s / r->best[1],
-               s / r->best[2], s / r->best[3], ratio, ratio >= 0.8 ? "" : " (<0.8)", r->median[3] / r->median[1],
+               s / r->best[2], s / r->best[3], ratio, ratio >= 0.8 ? "" : " (<0.8)", r->best[3] / r->best[1],
                r->best[3] / r->best[2], 1e3 * r->best[0], 1e3 * r->best[2], 1e3 * r->best[3],
                r->same_pixels ? "yes" : "NO");
         all_same = all_same && r->same_pixels;
         all_met = all_met && ratio >= 0.8;
     }
-    printf("target ours/bare >= 0.8: %s\n", all_met ? "met in every row" : "NOT met in every row");
+    printf("target ours/bare (median of reps) >= 0.8: %s\n", all_met ? "met in every row" : "NOT met in every row");
+    for (int i = 0; i < nrows; i++)
+        if (rows[i].mode == PS_SPLAT_POINTS && rows[i].photons == counts[1])
+            printf("the issue's goal, points at 10^6: ours/bare %.3f, the median of %d reps (each rep's bare / ours; "
+                   "reps' range %.3f-%.3f): %s\n",
+                   rows[i].pair_median, rows[i].reps, rows[i].pair_lo, rows[i].pair_hi,
+                   rows[i].pair_median >= 0.8 ? "met" : "MISSED");
 
     double total = 0.0;
     for (int s = 0; s < STAGE_COUNT; s++)
@@ -592,13 +614,13 @@ int main(void)
            1e3 * warm[0], 1e3 * warm[1], 1e3 * warm[2]);
 
     printf("csv,mode,photons,splats,build_splats_per_s,ours_splats_per_s,draw_splats_per_s,bare_splats_per_s,"
-           "ours_over_bare,ours_over_bare_median,draw_over_bare,same_pixels\n");
+           "ours_over_bare_median_of_reps,ours_over_bare_best,draw_over_bare,same_pixels\n");
     for (int i = 0; i < nrows; i++) {
         const row *r = &rows[i];
         double s = (double)r->splats;
         printf("csv,%s,%zu,%zu,%.0f,%.0f,%.0f,%.0f,%.3f,%.3f,%.3f,%d\n", ps_splat_mode_name(r->mode), r->photons,
-               r->splats, s / r->best[0], s / r->best[1], s / r->best[2], s / r->best[3], r->best[3] / r->best[1],
-               r->median[3] / r->median[1], r->best[3] / r->best[2], r->same_pixels ? 1 : 0);
+               r->splats, s / r->best[0], s / r->best[1], s / r->best[2], s / r->best[3], r->pair_median,
+               r->best[3] / r->best[1], r->best[3] / r->best[2], r->same_pixels ? 1 : 0);
     }
     printf("csv,stage,ms\n");
     for (int s = 0; s < STAGE_COUNT; s++)
