@@ -495,6 +495,118 @@ static int trace_caustics(bench_gl *g, size_t want, ps_photon_map *m, double *se
     return 0;
 }
 
+/* ---- what limits the triangle splats' raster rate -------------------------------- */
+
+/* The bare draw of 10^6 triangle splats with one thing of the GL state taken
+ * away or the splats resized, each against the full state in the same run:
+ * whatever speeds up when taken away is what the rate pays for. Triangles
+ * are disjoint, one a splat, so strips or fans have nothing to share. */
+enum {
+    RASTER_FULL,       /* as ours: kernel texture, additive blend, depth test */
+    RASTER_NO_TEXTURE, /* the texture off (a flat triangle) */
+    RASTER_NO_BLEND,   /* blending off (each fragment overwrites) */
+    RASTER_NO_DEPTH,   /* the depth test off */
+    RASTER_QUARTER,    /* radius r / 4: a sixteenth of the fragments, the same triangles */
+    RASTER_DOUBLE,     /* radius 2 r: four times the fragments */
+    RASTER_VARIANTS
+};
+static const char *const raster_names[RASTER_VARIANTS] = {
+    "full state (texture, blend, depth)", "no texture", "no blending", "no depth test", "radius r/4", "radius 2r",
+};
+#define RASTER_REPS 3
+
+/* Seconds of glDrawArrays + glFinish of b's triangles in variant v; the
+ * fragments drawn in *fragments (an occlusion query). */
+static double raster_draw(const bench_gl *g, const ps_splat_batch *b, int v, uint64_t *fragments)
+{
+    glDisable(GL_LIGHTING);
+    if (v == RASTER_NO_DEPTH)
+        glDisable(GL_DEPTH_TEST);
+    else
+        glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    if (v == RASTER_NO_BLEND)
+        glDisable(GL_BLEND);
+    else
+        glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE);
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glEnableClientState(GL_COLOR_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, b->positions);
+    glColorPointer(4, GL_FLOAT, 0, b->colors);
+    if (v != RASTER_NO_TEXTURE) {
+        glEnable(GL_TEXTURE_2D);
+        glBindTexture(GL_TEXTURE_2D, g->kernel_tex);
+        glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+        glEnableClientState(GL_TEXTURE_COORD_ARRAY);
+        glTexCoordPointer(2, GL_FLOAT, 0, b->texcoords);
+    }
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(BARE_SPLAT_OFFSET, BARE_SPLAT_OFFSET);
+    GLuint q = 0;
+    glGenQueries(1, &q);
+    double t0 = bench_now();
+    glBeginQuery(GL_SAMPLES_PASSED, q);
+    glDrawArrays(GL_TRIANGLES, 0, (GLsizei)b->vertex_count);
+    glEndQuery(GL_SAMPLES_PASSED);
+    glFinish();
+    double t = bench_now() - t0;
+    GLuint n = 0; /* 32 bits: 10^6 triangles of a few hundred pixels fit */
+    glGetQueryObjectuiv(q, GL_QUERY_RESULT, &n);
+    glDeleteQueries(1, &q);
+    *fragments = (uint64_t)n;
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisableClientState(GL_TEXTURE_COORD_ARRAY);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glDisable(GL_TEXTURE_2D);
+    glDisableClientState(GL_COLOR_ARRAY);
+    glDisableClientState(GL_VERTEX_ARRAY);
+    glDisable(GL_BLEND);
+    glEnable(GL_DEPTH_TEST);
+    return t;
+}
+
+typedef struct raster_row {
+    double seconds;     /* best of RASTER_REPS */
+    uint64_t fragments; /* drawn, from the query */
+    size_t triangles;
+} raster_row;
+
+/* Each variant RASTER_REPS times, the variants taking turns round by round
+ * (the machine's load falls on all alike). */
+static int raster_limits(bench_gl *g, const ps_photon_map *m, size_t n, double r, raster_row out[RASTER_VARIANTS],
+                         ps_error *err)
+{
+    ps_splat_batch b[3]; /* r, r / 4, 2 r */
+    const double radii[3] = {r, 0.25 * r, 2.0 * r};
+    int rc = -1;
+    for (int i = 0; i < 3; i++)
+        ps_splat_batch_init(&b[i]);
+    double scale = EXPOSURE * (double)m->count / (double)n;
+    for (int i = 0; i < 3; i++)
+        if (build(g, m, n, PS_SPLAT_TRIANGLES, radii[i], scale, &b[i], err) != PS_OK)
+            goto done;
+    for (int v = 0; v < RASTER_VARIANTS; v++)
+        out[v].seconds = HUGE_VAL;
+    for (int rep = -1; rep < RASTER_REPS; rep++) /* -1: the warm-up (llvmpipe compiles each state once) */
+        for (int v = 0; v < RASTER_VARIANTS; v++) {
+            const ps_splat_batch *bb = &b[v == RASTER_QUARTER ? 1 : v == RASTER_DOUBLE ? 2 : 0];
+            fresh_frame(g);
+            uint64_t frags = 0;
+            double t = raster_draw(g, bb, v, &frags);
+            if (rep >= 0 && t < out[v].seconds)
+                out[v].seconds = t;
+            out[v].fragments = frags;
+            out[v].triangles = bb->splats;
+        }
+    rc = 0;
+done:
+    for (int i = 0; i < 3; i++)
+        ps_splat_batch_free(&b[i]);
+    return rc;
+}
+
 static void bench_gl_free(bench_gl *g)
 {
     if (g->kernel_tex)
@@ -564,6 +676,12 @@ int main(void)
             nrows++;
         }
     free(pixels);
+    raster_row raster[RASTER_VARIANTS];
+    if (raster_limits(&g, &map, counts[1], def->caustic_radius, raster, &err) != 0) {
+        fail("raster limits", &err);
+        ps_photon_map_free(&map);
+        goto out;
+    }
 
     /* Step 4: the report. */
     const char *renderer = (const char *)glGetString(GL_RENDERER);
@@ -599,6 +717,18 @@ int main(void)
                    rows[i].pair_median, rows[i].reps, rows[i].pair_lo, rows[i].pair_hi,
                    rows[i].pair_median >= 0.8 ? "met" : "MISSED");
 
+    printf("\nwhat limits the triangle splats (bare glDrawArrays + glFinish of 10^6 caustic photons' triangles, "
+           "best of %d, the variants taking turns; fragments from an occlusion query)\n",
+           RASTER_REPS);
+    printf("| variant | triangles | Mtri/s | fragments / triangle | Mfragments/s | time vs full state |\n"
+           "| --- | ---: | ---: | ---: | ---: | ---: |\n");
+    for (int v = 0; v < RASTER_VARIANTS; v++) {
+        const raster_row *x = &raster[v];
+        printf("| %s | %zu | %.2f | %.1f | %.1f | %.2f |\n", raster_names[v], x->triangles,
+               1e-6 * (double)x->triangles / x->seconds, (double)x->fragments / (double)x->triangles,
+               1e-6 * (double)x->fragments / x->seconds, x->seconds / raster[RASTER_FULL].seconds);
+    }
+
     double total = 0.0;
     for (int s = 0; s < STAGE_COUNT; s++)
         total += stage[s];
@@ -622,6 +752,10 @@ int main(void)
                r->splats, s / r->best[0], s / r->best[1], s / r->best[2], s / r->best[3], r->pair_median,
                r->best[3] / r->best[1], r->best[3] / r->best[2], r->same_pixels ? 1 : 0);
     }
+    printf("csv,raster_variant,triangles,seconds,fragments\n");
+    for (int v = 0; v < RASTER_VARIANTS; v++)
+        printf("csv,%s,%zu,%.4f,%llu\n", raster_names[v], raster[v].triangles, raster[v].seconds,
+               (unsigned long long)raster[v].fragments);
     printf("csv,stage,ms\n");
     for (int s = 0; s < STAGE_COUNT; s++)
         printf("csv,%s,%.2f\n", stage_names[s], 1e3 * stage[s]);

@@ -565,7 +565,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
             size_t nm;
             const ps_feed_mark *mk = ps_feed_marks(s->feed, (ps_map_kind)k, &nm);
             double arrived = nm ? (double)mk[nm - 1].emitted : (double)emitted;
-            s->splat_radius[k] *= fmin(PS_RADIUS_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
+            s->splat_radius[k] *= fmin(PS_SESSION_MOVING_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
         }
         p.radius = s->splat_radius[k];
         p.kernel_mean = s->kernel.mean;
@@ -598,7 +598,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
      * in the next ones (the default scene's two spheres: 10^4, 12 ms). */
     out->specular = (s->set.layers & PS_LAYER_SPECULAR) && !s->illuminance && ps_specular_range_count(s->spec) > 0;
     if (out->specular)
-        ps_specular_update(s->spec, s->world, cam->eye, inc ? PS_SESSION_SPECULAR_VERTICES : 0);
+        ps_specular_update(s->spec, s->world, cam->eye,
+                           !inc ? 0 : s->moving ? PS_SESSION_SPECULAR_VERTICES_MOVING : PS_SESSION_SPECULAR_VERTICES);
     out->direct_exposure = inc ? 1.0 : exposure(s);
     out->direct_gain = inc ? exposure(s) : 1.0;
     out->splat = s->set.splat;
