@@ -419,6 +419,36 @@ static void moving_camera_level_of_detail(void **state)
     ps_scene_destroy(scene);
 }
 
+/* The level of detail's growth is held at PS_SESSION_MOVING_GROWTH_MAX: one
+ * batch of nine that arrived asks for sqrt(9) = 3 r and gets 2 r (a grown
+ * splat's pixels set a moving frame's time), still scaled by N / n; the
+ * specular layer's vertices while moving are a share of the still ones. */
+static void moving_growth_held(void **state)
+{
+    (void)state;
+    assert_true(PS_SESSION_MOVING_GROWTH_MAX < 3.0 && PS_SESSION_MOVING_GROWTH_MAX >= 1.0);
+    assert_true(PS_SESSION_SPECULAR_VERTICES_MOVING < PS_SESSION_SPECULAR_VERTICES);
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = 9 * PS_FEED_BATCH;
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    ps_session_drawn(s, 100.0); /* the budget at its floor: a batch a refresh */
+    wait_ended(s);
+    cam.eye.x += 0.05;
+    refresh(s, &cam, &f);
+    assert_true(f.moving);
+    assert_int_equal(f.emitted[PS_MAP_CAUSTIC], PS_FEED_BATCH);
+    assert_near(f.map[PS_MAP_CAUSTIC].radius, PS_SESSION_MOVING_GROWTH_MAX * set.radius[PS_MAP_CAUSTIC], 1e-12);
+    assert_near(f.map[PS_MAP_CAUSTIC].gain, EXPOSURE * 9.0, 1e-12);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 /* Progressive area lights: the first refresh with one virtual light an area
  * light, then 2 x 2, then all 16, each change said (lights_changed); an
  * edit starts over at one; without the setting, 16 from the start. */
@@ -469,6 +499,7 @@ int main(void)
         cmocka_unit_test(radius_follows_the_schedule),
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(moving_camera_level_of_detail),
+        cmocka_unit_test(moving_growth_held),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
