@@ -66,6 +66,12 @@
  * splat's pixels, not the count, set a moving frame's time (llvmpipe fills a
  * few hundred million a second): 2 r draws a quarter of 4 r's. */
 #define PS_SESSION_MOVING_GROWTH_MAX 2.0
+/* Once the camera stops, until the view is drawn in full again, a refresh
+ * draws this much more than the budget (0.8 of tau at the default share of
+ * 0.5 instead of half of it): the picture the user waits for comes back
+ * sooner, at a refresh that takes most of tau. Moving refreshes teach the
+ * budget nothing (their time is the level of detail's). */
+#define PS_SESSION_CATCH_UP_GAIN 1.6
 /* The specular layer's eye paths an incremental refresh traces at most
  * (distinct vertices of mirrors and glass; preview/specular.h). */
 #define PS_SESSION_SPECULAR_VERTICES 32768
