@@ -208,8 +208,10 @@ static double to_steps(double x, double L)
  * 0, for the diffusion's carry: adding and taking away 1.5 * 2^52 leaves no
  * bits below the units (x86-64's base instruction set has no rounding
  * instruction, and the integer conversions to_steps makes are the slowest
- * link of the carry's chain). Past QUANTISE_MAX_STEPS the count is kept as
- * it is, as to_steps keeps it; a NaN gives 0, as to_steps does. */
+ * link of the carry's chain). It needs the IEEE arithmetic the build asks
+ * for: -ffast-math would fold the two away. Past QUANTISE_MAX_STEPS the
+ * count is kept as it is, as to_steps keeps it; a NaN gives 0, as to_steps
+ * does. */
 #define ROUND_MAGIC 6755399441055744.0 /* 1.5 * 2^52 */
 static double round_steps(double steps)
 {
