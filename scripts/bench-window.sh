@@ -4,7 +4,8 @@
 # still, orbiting every 0.05 s while tracing, and orbiting once the maps are
 # full: "orbit-full", the frame rate over every stored photon; the fps figure
 # is smoothed over the last few frames), and the time from a light move to the
-# first refreshed frame. Each run is made twice, the picture composited and
+# first refreshed frame; the camera's level of detail (frames while moving,
+# and the full picture's return after the stop). Each run is made twice, the picture composited and
 # encoded by GL (the window's default) and, as the baseline measured in the
 # same run, read back and encoded on the CPU (--composite cpu): the last
 # column says what the GL side saves a refresh; then the still view with the
@@ -59,6 +60,28 @@ for n in 100000 1000000; do
             "$(stat_of fps "$c")"
     done
 done
+echo
+# The camera's level of detail over the full maps (10^6 + 2.5 10^5 photons,
+# GL composite): orbiting a step every 0.05 s for 2.95 s (60 steps), then
+# still until every photon is drawn again. The window's own figures: the
+# frames drawn while moving (at most one a step: 20 fps), their mean time,
+# and the time from the last moving frame to the refresh that has drawn
+# every photon again (the goal: within one tau).
+echo "| photons (caustic + global) | moving frames (60 steps) | fps while moving | mean moving frame ms | full picture after the stop s | tau s |"
+echo "| ---: | ---: | ---: | ---: | ---: | ---: |"
+{
+    echo "0 wait done"
+    for t in $(seq 0.05 0.05 3); do echo "$t orbit 2 0"; done
+    echo "3.05 wait done"
+    echo "3.05 quit"
+} >"$tmp/orbit-stop.txt"
+xvfb-run -a -s "-screen 0 1024x768x24" bin/photosplat "$scene" --size 512x512 --exposure 0.3 --overlay off \
+    --caustic-photons 1000000 --global-photons 250000 --script "$tmp/orbit-stop.txt" --stats "$tmp/orbit-stop.json" >/dev/null
+f=$tmp/orbit-stop.json
+mf=$(stat_of moving_frame_seconds_mean "$f")
+printf '| 1000000 + 250000 | %s | %.1f | %s | %.3f | %s |\n' "$(stat_of moving_frames "$f")" \
+    "$(awk -v n="$(stat_of moving_frames "$f")" 'BEGIN { printf "%.1f", n / 2.95 }')" "$(ms "$mf")" \
+    "$(stat_of full_after_stop_seconds "$f")" "$(stat_of tau "$f")"
 echo
 # The specular layer's cost (issue 15): the same still view with it on and
 # off, in the same run; its cube faces are drawn within a share of tau.

@@ -4,6 +4,7 @@
  * edit restarts, and what a left-out layer skips. */
 #include "test.h"
 
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -419,6 +420,123 @@ static void moving_camera_level_of_detail(void **state)
     ps_scene_destroy(scene);
 }
 
+/* The level of detail's growth is held at PS_SESSION_MOVING_GROWTH_MAX: one
+ * batch of nine that arrived asks for sqrt(9) = 3 r and gets 2 r (a grown
+ * splat's pixels set a moving frame's time), still scaled by N / n; the
+ * specular layer's vertices while moving are a share of the still ones. */
+static void moving_growth_held(void **state)
+{
+    (void)state;
+    assert_true(PS_SESSION_MOVING_GROWTH_MAX < 3.0 && PS_SESSION_MOVING_GROWTH_MAX >= 1.0);
+    assert_true(PS_SESSION_SPECULAR_VERTICES_MOVING < PS_SESSION_SPECULAR_VERTICES);
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = 9 * PS_FEED_BATCH;
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    ps_session_drawn(s, 100.0); /* the budget at its floor: a batch a refresh */
+    wait_ended(s);
+    cam.eye.x += 0.05;
+    refresh(s, &cam, &f);
+    assert_true(f.moving);
+    assert_int_equal(f.emitted[PS_MAP_CAUSTIC], PS_FEED_BATCH);
+    assert_near(f.map[PS_MAP_CAUSTIC].radius, PS_SESSION_MOVING_GROWTH_MAX * set.radius[PS_MAP_CAUSTIC], 1e-12);
+    assert_near(f.map[PS_MAP_CAUSTIC].gain, EXPOSURE * 9.0, 1e-12);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* A splat as bytes: its vertices' positions and its colour (the same on each
+ * vertex), for comparing splat sets whatever their order. */
+enum { SPLAT_RECORD_FLOATS = 3 * 3 + 4 };
+typedef struct splat_records {
+    float *v;
+    size_t n, cap;
+} splat_records;
+
+static void records_add(splat_records *r, const ps_splat_batch *b)
+{
+    size_t per = b->splats ? b->vertex_count / b->splats : 1;
+    assert_true(per >= 1 && per <= 3);
+    for (size_t i = 0; i < b->splats; i++) {
+        if (r->n == r->cap) {
+            r->cap = r->cap ? 2 * r->cap : 4096;
+            r->v = realloc(r->v, r->cap * SPLAT_RECORD_FLOATS * sizeof *r->v);
+            assert_non_null(r->v);
+        }
+        float *out = r->v + r->n++ * SPLAT_RECORD_FLOATS;
+        memset(out, 0, SPLAT_RECORD_FLOATS * sizeof *out);
+        memcpy(out, b->positions + 3 * per * i, 3 * per * sizeof *out);
+        memcpy(out + 9, b->colors + 4 * per * i, 4 * sizeof *out);
+    }
+}
+
+static int cmp_record(const void *a, const void *b) { return memcmp(a, b, SPLAT_RECORD_FLOATS * sizeof(float)); }
+
+/* After a camera move, the view starts over when the camera stops and is
+ * drawn over several refreshes (a batch each here: the budget at its floor),
+ * each showing what it has with the gain N / n; once settled, the refreshes
+ * have splatted exactly the splats one whole refresh of every photon gives
+ * for that view, byte for byte (exposure 1, so both scale by 1). */
+static void after_the_stop_converges_to_the_whole_view(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.exposure = 1.0;
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    refresh(s, &cam, &f);
+    ps_session_drawn(s, 100.0);
+    wait_ended(s);
+    cam.eye.x += 0.05;
+    refresh(s, &cam, &f);
+    assert_true(f.moving);
+    ps_session_drawn(s, 100.0);
+    splat_records got = {0}, want = {0};
+    int refreshes = 0;
+    for (int i = 0; i < 1000 && !ps_session_settled(s); i++) {
+        refresh(s, &cam, &f);
+        assert_false(f.moving);
+        assert_true(f.new_view == (i == 0));
+        for (int k = 0; k < PS_MAP_COUNT; k++) {
+            records_add(&got, f.map[k].batch);
+            if (f.emitted[k] > 0) /* the partial sum's gain: N / n of what it shows */
+                assert_near(f.map[k].gain, (double)set.caps[k] / (double)f.emitted[k], 1e-12);
+        }
+        ps_session_drawn(s, 100.0);
+        refreshes++;
+    }
+    assert_true(ps_session_settled(s));
+    assert_true(refreshes > 2); /* spread over refreshes, not one */
+    assert_int_equal(ps_session_stop(s, &err), PS_OK);
+    ps_session_destroy(s);
+
+    set = settings(scene, false);
+    set.float_buffer = true;
+    set.exposure = 1.0;
+    s = open_session(scene, &set);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    refresh(s, &cam, &f);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        records_add(&want, f.map[k].batch);
+    ps_session_destroy(s);
+    assert_int_equal(got.n, want.n);
+    qsort(got.v, got.n, SPLAT_RECORD_FLOATS * sizeof(float), cmp_record);
+    qsort(want.v, want.n, SPLAT_RECORD_FLOATS * sizeof(float), cmp_record);
+    assert_memory_equal(got.v, want.v, got.n * SPLAT_RECORD_FLOATS * sizeof(float));
+    free(got.v);
+    free(want.v);
+    ps_scene_destroy(scene);
+}
+
 /* Progressive area lights: the first refresh with one virtual light an area
  * light, then 2 x 2, then all 16, each change said (lights_changed); an
  * edit starts over at one; without the setting, 16 from the start. */
@@ -469,6 +587,8 @@ int main(void)
         cmocka_unit_test(radius_follows_the_schedule),
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(moving_camera_level_of_detail),
+        cmocka_unit_test(moving_growth_held),
+        cmocka_unit_test(after_the_stop_converges_to_the_whole_view),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

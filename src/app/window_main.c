@@ -176,6 +176,11 @@ typedef struct app {
     double edit_time, edit_latency_max, edit_latency_sum;
     uint64_t edit_latency_count;
     bool awaiting_edit_frame;
+    /* The camera's level of detail: frames drawn while it moved, their time,
+     * and how long after the last one every photon was back in the picture. */
+    uint64_t moving_frames;
+    double moving_seconds, moving_end, full_after_stop;
+    bool full_pending;
     /* Illuminance in false colour (key F): the last refresh's lux, a pixel
      * each (row 0 the top), the cursor that reads it, and the 8-bit picture. */
     bool false_color;
@@ -506,6 +511,15 @@ static ps_status refresh(app *a, ps_error *err)
             a->edit_latency_max = latency;
     }
     a->awaiting_edit_frame = false;
+    if (a->frame.moving) {
+        a->moving_frames++;
+        a->moving_seconds += t1 - t0;
+        a->moving_end = t1;
+        a->full_pending = true;
+    } else if (a->full_pending && ps_session_settled(a->session)) {
+        a->full_after_stop = t1 - a->moving_end;
+        a->full_pending = false;
+    }
     return PS_OK;
 }
 
@@ -1098,6 +1112,9 @@ static ps_status write_stats(app *a, ps_error *err)
     ps_stats_add(&rs, "edit_to_frame_seconds_mean",
                  a->edit_latency_count ? a->edit_latency_sum / (double)a->edit_latency_count : 0.0);
     ps_stats_add(&rs, "tau", set ? set->tau : a->o.p.tau);
+    ps_stats_add(&rs, "moving_frames", (double)a->moving_frames);
+    ps_stats_add(&rs, "moving_frame_seconds_mean", a->moving_frames ? a->moving_seconds / (double)a->moving_frames : 0.0);
+    ps_stats_add(&rs, "full_after_stop_seconds", a->full_after_stop);
     ps_stats_add(&rs, "composite_seconds_mean", a->show_count ? a->show_sum / (double)a->show_count : 0.0);
     ps_stats_add(&rs, "counter_stopped", a->session && ps_session_counter_stopped(a->session, NULL) ? 1.0 : 0.0);
     ps_stats_add(&rs, "caustic_cap", set ? (double)set->caps[PS_MAP_CAUSTIC] : 0.0);

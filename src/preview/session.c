@@ -38,6 +38,7 @@ struct ps_session {
     double round_off;
     bool have_cam, view_dirty;
     bool moving;           /* the last refresh had a new camera: a level of detail */
+    bool catch_up;         /* still after a move, the view not yet drawn in full */
     ps_camera_frame cam;
     bool edited, geometry_edited;
     uint64_t edits;
@@ -367,8 +368,10 @@ static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t fr
                             uint64_t *emitted);
 static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emitted, uint64_t *emitted)
 {
-    return prefix_within(s, k, from, from_emitted, s->moving ? s->budget * PS_SESSION_MOVING_SHARE : s->budget,
-                         emitted);
+    double budget = s->moving     ? s->budget * PS_SESSION_MOVING_SHARE
+                    : s->catch_up ? s->budget * PS_SESSION_CATCH_UP_GAIN
+                                  : s->budget;
+    return prefix_within(s, k, from, from_emitted, budget, emitted);
 }
 
 static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t from_emitted, double budget,
@@ -494,6 +497,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     } else if (s->moving) {
         /* Still again: the view starts over at full detail. */
         s->moving = false;
+        s->catch_up = true;
         s->view_dirty = true;
     }
     out->moving = s->moving;
@@ -580,7 +584,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
             size_t nm;
             const ps_feed_mark *mk = ps_feed_marks(s->feed, (ps_map_kind)k, &nm);
             double arrived = nm ? (double)mk[nm - 1].emitted : (double)emitted;
-            s->splat_radius[k] *= fmin(PS_RADIUS_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
+            s->splat_radius[k] *= fmin(PS_SESSION_MOVING_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
         }
         p.radius = s->splat_radius[k];
         p.kernel_mean = s->kernel.mean;
@@ -599,6 +603,12 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         lost += b->lost;
         out->splats += b->splats;
     }
+    if (s->catch_up) { /* the view is whole again once every stored photon is drawn */
+        bool whole = true;
+        for (int k = 0; k < PS_MAP_COUNT; k++)
+            whole = whole && s->drawn[k] >= maps[k].count;
+        s->catch_up = !whole && !s->moving;
+    }
     ps_feed_unlock(s->feed);
     s->round_off = wanted > 0.0 ? lost / wanted : 0.0;
     s->last_splats = out->splats;
@@ -613,7 +623,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
      * in the next ones (the default scene's two spheres: 10^4, 12 ms). */
     out->specular = (s->set.layers & PS_LAYER_SPECULAR) && !s->illuminance && ps_specular_range_count(s->spec) > 0;
     if (out->specular)
-        ps_specular_update(s->spec, s->world, cam->eye, inc ? PS_SESSION_SPECULAR_VERTICES : 0);
+        ps_specular_update(s->spec, s->world, cam->eye,
+                           !inc ? 0 : s->moving ? PS_SESSION_SPECULAR_VERTICES_MOVING : PS_SESSION_SPECULAR_VERTICES);
     out->direct_exposure = inc ? 1.0 : exposure(s);
     out->direct_gain = inc ? exposure(s) : 1.0;
     out->splat = s->set.splat;
@@ -652,7 +663,9 @@ static bool has_area_lights(const ps_session *s)
 
 void ps_session_drawn(ps_session *s, double draw_seconds)
 {
-    if (incremental(s) && s->last_splats > 0) {
+    /* A moving refresh's time is the level of detail's (grown splats, a new
+     * direct layer): it would understate the rate the still view draws at. */
+    if (incremental(s) && s->last_splats > 0 && !s->moving) {
         double rate = (double)s->last_splats / fmax(s->last_build + draw_seconds, 1e-6);
         s->budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * s->set.splat_share / PS_MAP_COUNT);
     }

@@ -60,9 +60,25 @@
  * most PS_RADIUS_GROWTH_MAX) so that the fewer photons still cover; the
  * first refresh with the camera still starts the view over in full. */
 #define PS_SESSION_MOVING_SHARE 0.25
+/* ... and the level of detail's radius grows at most this much (not
+ * PS_RADIUS_GROWTH_MAX): the share is at least one batch (PS_FEED_BATCH), so
+ * over a million photons the cover asked for is sqrt(60) r, and a grown
+ * splat's pixels, not the count, set a moving frame's time (llvmpipe fills a
+ * few hundred million a second): 2 r draws a quarter of 4 r's. */
+#define PS_SESSION_MOVING_GROWTH_MAX 2.0
+/* Once the camera stops, until the view is drawn in full again, a refresh
+ * draws this much more than the budget (0.8 of tau at the default share of
+ * 0.5 instead of half of it): the picture the user waits for comes back
+ * sooner, at a refresh that takes most of tau. Moving refreshes teach the
+ * budget nothing (their time is the level of detail's). */
+#define PS_SESSION_CATCH_UP_GAIN 1.6
 /* The specular layer's eye paths an incremental refresh traces at most
  * (distinct vertices of mirrors and glass; preview/specular.h). */
 #define PS_SESSION_SPECULAR_VERTICES 32768
+/* ... and while the camera moves (the level of detail): the vertices not
+ * traced again keep their last eye's lookups, and the next refreshes trace
+ * the rest (the default scene's 10^4 in 12 ms were a fifth of a moving frame). */
+#define PS_SESSION_SPECULAR_VERTICES_MOVING 2048
 
 typedef struct ps_session_settings {
     /* The photons. */

@@ -5,6 +5,9 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "core/array.h"
 #include "photon/tracer.h"
@@ -101,6 +104,7 @@ void ps_splat_batch_free(ps_splat_batch *b)
     free(b->group);
     free(b->order);
     free(b->order_tmp);
+    free(b->normals);
     memset(b, 0, sizeof *b);
 }
 
@@ -200,6 +204,28 @@ static double to_steps(double x, double L)
     return (double)(int64_t)(steps + 0.5) / L;
 }
 
+/* A step count rounded to the nearest whole number (ties to even), at least
+ * 0, for the diffusion's carry: adding and taking away 1.5 * 2^52 leaves no
+ * bits below the units (x86-64's base instruction set has no rounding
+ * instruction, and the integer conversions to_steps makes are the slowest
+ * link of the carry's chain). It needs the IEEE arithmetic the build asks
+ * for: -ffast-math would fold the two away. Past QUANTISE_MAX_STEPS the
+ * count is kept as it is, as to_steps keeps it; a NaN gives 0, as to_steps
+ * does. */
+#define ROUND_MAGIC 6755399441055744.0 /* 1.5 * 2^52 */
+static double round_steps(double steps)
+{
+    if (steps >= QUANTISE_MAX_STEPS)
+        return steps;
+    double q = (steps + ROUND_MAGIC) - ROUND_MAGIC;
+    /* Faint photons round to 0 at random, so a branch here mispredicts:
+     * SSE2's max (unordered, it gives the 0: a NaN gives 0). */
+#if defined(__SSE2__)
+    return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(q), _mm_setzero_pd()));
+#else
+    return q > 0.0 ? q : 0.0;
+#endif
+}
 
 /* Where a splat's centre falls on the screen, as a Z-order (Morton) key of
  * its pixel: interleaved bits of x and y, so that splats near each other on
@@ -358,7 +384,7 @@ static void diffuse_region(void *ctx, size_t g)
         t = swap;
     }
     ps_splat_batch *b = d->b;
-    double carry[3] = {b->carry[g][0], b->carry[g][1], b->carry[g][2]}, L = d->p->levels;
+    double c0 = b->carry[g][0], c1 = b->carry[g][1], c2 = b->carry[g][2], L = d->p->levels, inv_L = 1.0 / L;
     size_t per = d->per, v0 = d->v0;
     for (size_t i = 0; i < n; i++) {
         /* The colours are read in screen order, scattered over the array:
@@ -368,16 +394,25 @@ static void diffuse_region(void *ctx, size_t g)
             PS_PREFETCH_WRITE(&b->colors[4 * (v0 + (size_t)(a[i + SORT_PREFETCH] & 0xffffffffu) * per)]);
         size_t v = v0 + (size_t)(a[i] & 0xffffffffu) * per;
         float *rgba = &b->colors[4 * v];
-        for (int ch = 0; ch < 3; ch++) { /* the round-off carried into the next splat, per channel */
-            double want = rgba[ch] + carry[ch];
-            double q = to_steps(want, L);
-            carry[ch] = want - q;
-            rgba[ch] = (float)q;
-        }
+        /* The round-off carried into the next splat, per channel. The carry
+         * is the loop's dependency chain, so only adds and multiplies lie on
+         * it (the step count rounded by round_steps), the division that
+         * turns the count into a colour off it; the channels are written
+         * out so that the carries stay in registers. */
+        double s0 = (rgba[0] + c0) * L, s1 = (rgba[1] + c1) * L, s2 = (rgba[2] + c2) * L;
+        double q0 = round_steps(s0), q1 = round_steps(s1), q2 = round_steps(s2);
+        c0 = (s0 - q0) * inv_L;
+        c1 = (s1 - q1) * inv_L;
+        c2 = (s2 - q2) * inv_L;
+        rgba[0] = (float)(q0 / L);
+        rgba[1] = (float)(q1 / L);
+        rgba[2] = (float)(q2 / L);
         for (size_t k = 1; k < per; k++)
             memcpy(&b->colors[4 * (v + k)], rgba, 4 * sizeof *rgba);
     }
-    memcpy(b->carry[g], carry, sizeof carry);
+    b->carry[g][0] = c0;
+    b->carry[g][1] = c1;
+    b->carry[g][2] = c2;
 }
 
 /* The order is a stable sort of the splats by their keys (the splat's place
@@ -450,6 +485,10 @@ static double count_round_off(build_range *R, double L, double c)
     return c;
 }
 
+/* The photon's normal code: bits 0-13 of normal_flags (photon.h). */
+#define NORMAL_CODE_BITS 14
+#define NORMAL_CODE_MASK ((1u << NORMAL_CODE_BITS) - 1u)
+
 static void build_splats_of(build_range *R)
 {
     const ps_splat_params *p = R->p;
@@ -469,9 +508,13 @@ static void build_splats_of(build_range *R)
     int region_bits = key_bits < REGION_BITS ? key_bits : REGION_BITS;
     /* World size of one pixel at unit depth along the view axis. */
     double pixel = 2.0 * cam->tan_half_fov / cam->height;
+    const ps_vec3 *normals = b->normals;
+    /* The projection to pixels (diffusion's screen order). */
+    double half_w = 0.5 * cam->width, half_h = 0.5 * cam->height;
+    double to_px = half_w / (cam->tan_half_fov * cam->aspect), to_py = half_h / cam->tan_half_fov;
     for (size_t i = R->first; i < R->end; i++) {
         const ps_photon *ph = &R->photons[i];
-        ps_vec3 pos = ps_photon_position(ph), n = ps_photon_normal(ph);
+        ps_vec3 pos = ps_photon_position(ph), n = normals[ph->normal_flags & NORMAL_CODE_MASK];
         ps_vec3 to_eye = ps_v3_sub(cam->eye, pos);
         double dist = ps_v3_len(to_eye);
         if (!(dist > 0.0))
@@ -497,9 +540,11 @@ static void build_splats_of(build_range *R)
              * subtends side^2 pixel^2 cos^3(a) at angle a off the axis; at
              * distance dist = depth / cos(a) that is side^2 pixel^2 depth^2
              * cos(a) across the ray, and 1 / cos_v more along the surface. */
+            /* One division, not three: they were a chain of the point's
+             * latency. */
             double side = p->point_size * pixel * depth;
-            double area = side * side * (depth / dist) / (cos_v > PS_SPLAT_MIN_COS ? cos_v : PS_SPLAT_MIN_COS);
-            c = ps_rgb_scale(c, 1.0 / area);
+            double cos_held = cos_v > PS_SPLAT_MIN_COS ? cos_v : PS_SPLAT_MIN_COS;
+            c = ps_rgb_scale(c, cos_held * dist / (side * side * depth));
         } else {
             c = ps_rgb_scale(c, disc);
             /* A sprite faces the eye: its disc covers 1 / cos more pixels than
@@ -525,8 +570,15 @@ static void build_splats_of(build_range *R)
             rgba[2] = (float)count_round_off(R, L, c.b);
         } else if (diffuse) {
             /* Rounded below, in screen order; the exact colour till then. */
-            double px = 0.0, py = 0.0;
-            (void)ps_camera_project(cam, centre, &px, &py);
+            /* ps_camera_project's pixel, with one division (it showed in
+             * the build's profile); off the eye's front, the corner. */
+            ps_vec3 e = ps_v3_sub(centre, cam->eye);
+            double z = ps_v3_dot(e, cam->forward), px = 0.0, py = 0.0;
+            if (z > 0.0) {
+                double inv_z = 1.0 / z;
+                px = half_w + to_px * ps_v3_dot(e, cam->right) * inv_z;
+                py = half_h - to_py * ps_v3_dot(e, cam->up) * inv_z;
+            }
             uint32_t key = z_order(px, py, zside);
             b->order[sp - first_splat] = (uint64_t)key << 32; /* the place: when compacted */
             R->regions[key >> (key_bits - region_bits)]++;
@@ -564,6 +616,26 @@ static void build_splats_of(build_range *R)
 
 static void build_range_job(void *ctx, size_t k) { build_splats_of(&((build_range *)ctx)[k]); }
 
+/* The photon's normal is an octahedral code (NORMAL_CODE_BITS): decoded once for every code into the batch, so
+ * that a splat looks its normal up instead of decoding it (two divisions, a
+ * square root: a sixth of a point splat's build). The table is
+ * ps_photon_normal's own results, so the splats are the same bits. */
+static bool decode_normals(ps_splat_batch *b)
+{
+    if (b->normals)
+        return true;
+    b->normals = malloc(((size_t)1 << NORMAL_CODE_BITS) * sizeof *b->normals);
+    if (!b->normals)
+        return false;
+    ps_photon ph;
+    memset(&ph, 0, sizeof ph);
+    for (uint32_t code = 0; code <= NORMAL_CODE_MASK; code++) {
+        ph.normal_flags = (uint16_t)code;
+        b->normals[code] = ps_photon_normal(&ph);
+    }
+    return true;
+}
+
 ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
                          ps_splat_batch *b, ps_error *err)
 {
@@ -572,7 +644,7 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
         !PS_RESERVE(b->positions, b->cap_pos, 3 * (b->vertex_count + per * count)) ||
         !PS_RESERVE(b->colors, b->cap_col, 4 * (b->vertex_count + per * count)) ||
         (per == 3 && !PS_RESERVE(b->texcoords, b->cap_tex, 2 * (b->vertex_count + per * count))) ||
-        (p->objects && !PS_RESERVE(b->group, b->cap_group, b->splats + count)))
+        (p->objects && !PS_RESERVE(b->group, b->cap_group, b->splats + count)) || (count && !decode_normals(b)))
         return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
     size_t first_splat = b->splats;
     bool diffuse = p->levels > 0 && p->precision == PS_PRECISION_DIFFUSION;

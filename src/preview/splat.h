@@ -153,6 +153,7 @@ typedef struct ps_splat_batch {
     size_t cap_group;
     uint64_t *order, *order_tmp; /* scratch: the diffusion's screen order (splat.c) */
     size_t cap_order, cap_order_tmp;
+    ps_vec3 *normals;    /* scratch: every photon normal code decoded, made once (splat.c) */
     double carry[PS_SPLAT_DIFFUSION_REGIONS][3]; /* diffusion: each tile's round-off not yet added */
     double wanted, lost; /* counter: colour asked for, and what rounding took (summed over channels) */
 } ps_splat_batch;
