@@ -104,7 +104,10 @@ awk_true "$rmse < 2.0 / 255" && ok || bad "maps: the window and photosplat-snap 
 # Illuminance in false colour (key F; a script's set false-color): a picture of
 # its own (the lux in it are test_gl_illuminance's), and off again the normal
 # picture comes back, the photons kept.
+# wait done first: on a loaded machine (ASan) the picture was still refining
+# at 1.2 s, so "off again" differed from "before" by what came in between.
 cat >"$cli_tmp/fc.txt" <<SCRIPT
+0.1 wait done
 1.2 screenshot $cli_tmp/fc-before.png
 1.3 set false-color on
 1.6 screenshot $cli_tmp/fc-on.png
