@@ -47,6 +47,8 @@ struct ps_gl_specular {
     bool layer_valid;
     float *scaled; /* weights times exposure */
     size_t scaled_cap;
+    float *xy; /* the per-pixel points' window coordinates */
+    size_t xy_cap;
 };
 
 ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err)
@@ -80,6 +82,7 @@ void ps_gl_specular_destroy(ps_gl_specular *g)
         glDeleteFramebuffers(1, &g->layer_fbo);
     ps_splat_batch_free(&g->batch);
     free(g->scaled);
+    free(g->xy);
     free(g);
 }
 
@@ -348,9 +351,100 @@ static void draw_terms(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, doub
     glDepthMask(GL_TRUE);
 }
 
+/* The per-pixel points (specular.h), each a one-pixel GL point at its
+ * pixel's centre with its lookup as the texture coordinate and its weight
+ * times exposure as the colour, added; no depth test: the CPU's eye rays
+ * found what each pixel sees first. */
+static void draw_points(ps_gl_specular *g, ps_gl_renderer *r, const ps_specular_points *p, double exposure)
+{
+    if (p->count == 0 || g->cube_count == 0)
+        return;
+    if (g->xy_cap < 2 * p->count) {
+        float *xy = realloc(g->xy, 2 * p->count * sizeof *xy);
+        if (!xy)
+            return;
+        g->xy = xy;
+        g->xy_cap = 2 * p->count;
+    }
+    /* Window coordinates: GL's rows count from the bottom. */
+    for (size_t i = 0; i < p->count; i++) {
+        g->xy[2 * i] = p->xy[2 * i] + 0.5f;
+        g->xy[2 * i + 1] = (float)r->height - p->xy[2 * i + 1] - 0.5f;
+    }
+    const float *w = p->weights;
+    if (exposure != 1.0) {
+        if (g->scaled_cap < 3 * p->count) {
+            float *q = realloc(g->scaled, 3 * p->count * sizeof *q);
+            if (!q)
+                return;
+            g->scaled = q;
+            g->scaled_cap = 3 * p->count;
+        }
+        for (size_t i = 0; i < 3 * p->count; i++)
+            g->scaled[i] = (float)(p->weights[i] * exposure);
+        w = g->scaled;
+    }
+    glMatrixMode(GL_PROJECTION);
+    glLoadIdentity();
+    glOrtho(0.0, r->width, 0.0, r->height, -1.0, 1.0);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadIdentity();
+    glDisable(GL_LIGHTING);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    glPointSize(1.0f);
+    glActiveTexture(GL_TEXTURE0);
+    glEnable(GL_TEXTURE_CUBE_MAP);
+    glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glEnableClientState(GL_COLOR_ARRAY);
+    glEnableClientState(GL_TEXTURE_COORD_ARRAY);
+    glVertexPointer(2, GL_FLOAT, 0, g->xy);
+    glColorPointer(3, GL_FLOAT, 0, w);
+    glTexCoordPointer(3, GL_FLOAT, 0, p->dirs);
+    /* Runs of one cube. */
+    for (size_t i = 0; i < p->count;) {
+        size_t j = i + 1;
+        while (j < p->count && p->cube[j] == p->cube[i])
+            j++;
+        glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[p->cube[i]]);
+        glDrawArrays(GL_POINTS, (GLint)i, (GLsizei)(j - i));
+        i = j;
+    }
+    glDisableClientState(GL_TEXTURE_COORD_ARRAY);
+    glDisableClientState(GL_COLOR_ARRAY);
+    glDisableClientState(GL_VERTEX_ARRAY);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    glDisable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+    glDisable(GL_TEXTURE_CUBE_MAP);
+    glDisable(GL_BLEND);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(r->proj);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(r->view);
+}
+
+/* The layer at full detail: the per-pixel points once the current camera
+ * frame is traced whole, else the per-vertex lookups. */
+static void draw_full(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure)
+{
+    ps_specular_points p = ps_specular_pixel_points(ps_session_specular(s));
+    if (p.ready)
+        draw_points(g, r, &p, exposure);
+    else
+        draw_terms(g, r, s, exposure, PS_SPECULAR_TERMS);
+}
+
 void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure)
 {
-    draw_terms(g, r, s, exposure, PS_SPECULAR_TERMS);
+    draw_full(g, r, s, exposure);
 }
 
 ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_renderer *r, ps_session *s,
@@ -391,8 +485,13 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
         glClear(GL_COLOR_BUFFER_BIT); /* colour only: the depth is the view's prepass */
         /* A moving camera's level of detail: the heaviest lookup only (one
          * pass instead of PS_SPECULAR_TERMS); all again once it stops. */
-        if (g->faces_rendered > 0 || g->frozen) /* black cubes draw black: the first picture saves them */
-            draw_terms(g, r, s, f->direct_exposure, f->moving ? 1 : PS_SPECULAR_TERMS);
+        if (g->faces_rendered == 0 && !g->frozen) {
+            /* black cubes draw black: the first picture saves them */
+        } else if (f->moving) {
+            draw_terms(g, r, s, f->direct_exposure, 1);
+        } else {
+            draw_full(g, r, s, f->direct_exposure);
+        }
         glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
         g->cubes_changed = false;
         g->layer_valid = true;

@@ -38,6 +38,7 @@
 #include "core/vec.h"
 #include "photon/world.h"
 #include "preview/mesh.h"
+#include "scene/camera.h"
 #include "scene/scene.h"
 
 /* Lookups a vertex: each one a drawing pass of the object. */
@@ -90,6 +91,42 @@ void ps_specular_invalidate(ps_specular *sp);
  * centre, and an rgb weight (0 where a vertex has fewer paths). */
 const float *ps_specular_dirs(const ps_specular *sp, int k);
 const float *ps_specular_weights(const ps_specular *sp, int k);
+
+/* ---- per-pixel eye paths ------------------------------------------------------ */
+
+/* The lookups above are interpolated over the mesh's triangles, which bends
+ * what refraction through a curved glass shows and what a sphere's mirror
+ * shows past a reflected edge, and leaves a silhouette's pixels all or
+ * nothing where the reference averages 16 samples. Once the camera holds
+ * still, each pixel that an object of the layer may cover (its vertices'
+ * bounding box projected, PIXEL_MARGIN pixels wider) is traced on the CPU
+ * instead, PS_SPECULAR_PIXEL_SAMPLES^2 stratified eye rays a pixel through
+ * the exact surfaces, each path ending as above; every kept path of every
+ * sample is one point of the layer: its pixel, its lookup direction and its
+ * weight over the samples a pixel (a box filter; the reference's Mitchell
+ * filter is wider by a pixel). src/gl draws those points instead of the
+ * objects once a camera frame is traced whole. */
+#define PS_SPECULAR_PIXEL_SAMPLES 2
+/* Eye rays a refresh in incremental sessions (the window): the default
+ * scene's spheres at 512^2 take about 2.5 10^5. */
+#define PS_SPECULAR_PIXEL_RAYS 65536
+
+/* Traces at most max_rays eye rays (0: all) of camera frame cam's pixels;
+ * a new frame (or ps_specular_invalidate) starts over. Returns the rays
+ * left for this frame (0: done, and the points below are this frame's). */
+size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const ps_camera_frame *cam,
+                                 size_t max_rays);
+/* The points of the current camera frame, once traced whole: their count,
+ * else 0 and *ready false (draw the per-vertex lookups then). xy: pixel
+ * (column, row from the top); dirs: lookup direction from cube[i]'s centre;
+ * weights: rgb, already divided by the samples a pixel. */
+typedef struct ps_specular_points {
+    bool ready;
+    size_t count;
+    const float *xy, *dirs, *weights;
+    const int *cube;
+} ps_specular_points;
+ps_specular_points ps_specular_pixel_points(const ps_specular *sp);
 
 /* ---- for tests --------------------------------------------------------------- */
 
