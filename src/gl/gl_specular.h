@@ -30,7 +30,7 @@
 #define PS_GL_SPECULAR_FACES_PER_REFRESH 1
 /* Past the first round, faces take at most this share of tau on average. */
 #define PS_GL_SPECULAR_TIME_SHARE 0.15
-#define PS_GL_SPECULAR_ENV_PHOTONS 8192
+#define PS_GL_SPECULAR_ENV_PHOTONS 65536
 /* Once every photon has arrived, the last round is drawn over this many
  * refreshes, budget or not. */
 #define PS_GL_SPECULAR_SETTLE_REFRESHES 4
