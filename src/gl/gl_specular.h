@@ -9,17 +9,22 @@
  * photons so far, at most PS_GL_SPECULAR_ENV_PHOTONS a map, a prefix with
  * the level of detail's grown radius), every mirror and glass object left
  * out (the lookups trace through them on the CPU), at exposure 1: radiance.
- * Faces are refreshed round-robin while photons arrive, as
- * PS_GL_SPECULAR_TIME_SHARE of tau allows (a face every few refreshes, the
- * first one at the first refresh after a new view, never in one: the first
+ * Faces are refreshed round-robin while photons arrive: the first round
+ * after a change over PS_GL_SPECULAR_FIRST_REFRESHES refreshes from the
+ * first after the new view, then as PS_GL_SPECULAR_TIME_SHARE of tau allows
+ * (a face every few refreshes; never in a new view's refresh: the first
  * picture, the first after an edit and a moving camera's come as fast as
  * without the layer), the last round once they all arrived
  * over a few refreshes whatever the budget, all at once for a single frame and a snapshot's last
  * picture; the objects are redrawn when a cube is whole again. They are kept
  * while only the camera moves; a new layer set, an edit or new GL lights
- * start a new round. The objects are then drawn PS_SPECULAR_TERMS times,
- * each pass one lookup direction (texture coordinates into the object's
- * cube) modulated by its weight (vertex colours), added together. */
+ * start a new round. Once the camera holds still and its per-pixel paths
+ * are traced (preview/specular.h), each path is drawn as a one-pixel point
+ * looking its cube up, times its weight, added; before that (a moving
+ * camera, or paths still being traced) the objects are drawn
+ * PS_SPECULAR_TERMS times, each pass one lookup direction (texture
+ * coordinates into the object's cube) modulated by its weight (vertex
+ * colours), added together. */
 #ifndef PS_GL_GL_SPECULAR_H
 #define PS_GL_GL_SPECULAR_H
 
@@ -51,7 +56,9 @@ void ps_gl_specular_destroy(ps_gl_specular *g); /* accepts NULL */
 ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
                                  int faces, ps_error *err);
 /* The specular objects' lookups times exposure added into the bound
- * framebuffer over the renderer's current view (its depth already there). */
+ * framebuffer over the renderer's current view (its depth already there):
+ * the per-pixel points when traced for the session's camera, else the
+ * per-vertex lookups. */
 void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure);
 /* The layered path (the window, snap --time in float): the specular layer
  * as a texture of l's size sharing l's depth, redrawn when the cubes, the

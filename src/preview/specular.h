@@ -22,8 +22,9 @@
  * that no energy is lost (a furnace stays at 1).
  *
  * Departures, said where they show (docs/preview.md): the cube map shows P
- * only if nothing diffuse lies between the centre and P; lookups are
- * interpolated over the mesh's triangles (Gouraud); area lights are seen in
+ * only if nothing diffuse lies between the centre and P; the per-vertex
+ * lookups are interpolated over the mesh's triangles (Gouraud), which is why
+ * a still camera gets per-pixel paths instead (below); area lights are seen in
  * the cube map as the direct layer draws them, point and spot lights not at
  * all (as in photosplat-ref). Glossy lobes are not part of this layer (as in
  * photosplat-ref's `specular` component, which is what mirrors and glass
