@@ -160,7 +160,9 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
     ps_status st = PS_OK;
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
         double radius;
-        st = ps_session_env_splats(s, (ps_map_kind)k, &cam, PS_GL_SPECULAR_ENV_PHOTONS, &g->batch, &radius, err);
+        st = ps_session_env_splats(s, (ps_map_kind)k, &cam,
+                                   k == PS_MAP_CAUSTIC ? PS_GL_SPECULAR_ENV_CAUSTIC : PS_GL_SPECULAR_ENV_GLOBAL,
+                                   &g->batch, &radius, err);
         if (st == PS_OK)
             ps_gl_draw_splats(r, &g->batch, PS_SPLAT_TRIANGLES, radius, 1.0);
     }

@@ -6,7 +6,7 @@
  * A cube map is six faces of PS_GL_SPECULAR_CUBE_SIZE^2 RGBA16F texels,
  * rendered as the view is (the depth prepass, the direct layer with its
  * shadow maps, the area lights, then the caustic and global splats of the
- * photons so far, at most PS_GL_SPECULAR_ENV_PHOTONS a map, a prefix with
+ * photons so far, at most PS_GL_SPECULAR_ENV_CAUSTIC and _GLOBAL, a prefix with
  * the level of detail's grown radius), every mirror and glass object left
  * out (the lookups trace through them on the CPU), at exposure 1: radiance.
  * Faces are refreshed round-robin while photons arrive: the first round
@@ -35,7 +35,12 @@
 #define PS_GL_SPECULAR_FACES_PER_REFRESH 1
 /* Past the first round, faces take at most this share of tau on average. */
 #define PS_GL_SPECULAR_TIME_SHARE 0.15
-#define PS_GL_SPECULAR_ENV_PHOTONS 65536
+/* Photons a cube face splats from each map. The caustic's are small and
+ * cheap to fill, and fewer grow their radius toward the global one (8 192
+ * blurred the ring's caustic into its shadow); the global splats' fill is
+ * most of what a face costs. */
+#define PS_GL_SPECULAR_ENV_CAUSTIC 65536
+#define PS_GL_SPECULAR_ENV_GLOBAL 16384
 /* Once every photon has arrived, the last round is drawn over this many
  * refreshes, budget or not. */
 #define PS_GL_SPECULAR_SETTLE_REFRESHES 4
