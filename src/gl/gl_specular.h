@@ -47,7 +47,7 @@
 /* The first round after a change (the first picture, an edit, new layers or
  * lights) is drawn over this many refreshes, budget or not, from the first
  * refresh after the new view's. */
-#define PS_GL_SPECULAR_FIRST_REFRESHES 2
+#define PS_GL_SPECULAR_FIRST_REFRESHES 4
 
 typedef struct ps_gl_specular ps_gl_specular;
 
