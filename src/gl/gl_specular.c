@@ -284,6 +284,10 @@ bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s)
         return true;
     if (g->cube_count != cubes || g->layers != layers || g->edits != ps_session_edits(s) || g->cubes_changed)
         return false;
+    /* The still camera's per-pixel paths traced (and so drawn: they mark the
+     * layer changed), not the per-vertex lookups shown until then. */
+    if (!ps_specular_pixel_points(ps_session_specular(s)).ready)
+        return false;
     ps_session_counts counts;
     ps_session_get_counts(s, &counts);
     int total = 6 * cubes;

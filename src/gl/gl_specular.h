@@ -76,9 +76,10 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
  * layer read alone). */
 void ps_gl_specular_set_gain(ps_gl_specular *g, ps_gl_layers *l, double gain);
 
-/* Whether the cube maps show every photon and the objects were redrawn
- * from them (or the layer is not shown): nothing left to refresh. A
- * script's `wait done` waits for it too. */
+/* Whether the cube maps show every photon, the still camera's per-pixel
+ * paths are traced and the objects were redrawn from them (or the layer is
+ * not shown): nothing left to refresh. A script's `wait done` waits for it
+ * too. */
 bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s);
 
 /* For tests: every face of every cube filled with radiance `value` (a
