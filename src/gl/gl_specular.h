@@ -48,6 +48,9 @@
  * lights) is drawn over this many refreshes, budget or not, from the first
  * refresh after the new view's. */
 #define PS_GL_SPECULAR_FIRST_REFRESHES 4
+/* That first round draws shadows only up to this many GL lights (an area
+ * light's virtual lights make faces dear): the later rounds draw them all. */
+#define PS_GL_SPECULAR_QUICK_SHADOW_LIGHTS 4
 
 typedef struct ps_gl_specular ps_gl_specular;
 
