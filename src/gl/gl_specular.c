@@ -49,7 +49,10 @@ struct ps_gl_specular {
     size_t scaled_cap;
     float *xy; /* the per-pixel points' window coordinates */
     size_t xy_cap;
+    int first_refreshes; /* the first round over this many refreshes; 0: budgeted */
 };
+
+void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes) { g->first_refreshes = refreshes > 0 ? refreshes : 0; }
 
 ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err)
 {
@@ -222,10 +225,10 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
      * of tau had saved up for it), and the objects stayed black that long
      * (relMSE 0.145 against the reference's specular term at 2 s, 0.021 once
      * drawn, in the default scene). */
-    bool first_round = g->since_change < total;
+    bool first_round = g->first_refreshes > 0 && g->since_change < total;
     int n = faces <= 0 || faces > total ? total
             : settled ? (total + PS_GL_SPECULAR_SETTLE_REFRESHES - 1) / PS_GL_SPECULAR_SETTLE_REFRESHES
-            : first_round ? (total + PS_GL_SPECULAR_FIRST_REFRESHES - 1) / PS_GL_SPECULAR_FIRST_REFRESHES
+            : first_round ? (total + g->first_refreshes - 1) / g->first_refreshes
                           : faces;
     /* A new view (the first picture, the first after an edit, a moving
      * camera) comes as soon as without the layer: its faces wait. */

@@ -9,9 +9,10 @@
  * photons so far, at most PS_GL_SPECULAR_ENV_CAUSTIC and _GLOBAL, a prefix with
  * the level of detail's grown radius), every mirror and glass object left
  * out (the lookups trace through them on the CPU), at exposure 1: radiance.
- * Faces are refreshed round-robin while photons arrive: the first round
- * after a change over PS_GL_SPECULAR_FIRST_REFRESHES refreshes from the
- * first after the new view, then as PS_GL_SPECULAR_TIME_SHARE of tau allows
+ * Faces are refreshed round-robin while photons arrive: in snap the first
+ * round after a change over PS_GL_SPECULAR_FIRST_REFRESHES refreshes from
+ * the first after the new view, then (the window: always) as
+ * PS_GL_SPECULAR_TIME_SHARE of tau allows
  * (a face every few refreshes; never in a new view's refresh: the first
  * picture, the first after an edit and a moving camera's come as fast as
  * without the layer), the last round once they all arrived
@@ -44,9 +45,12 @@
 /* Once every photon has arrived, the last round is drawn over this many
  * refreshes, budget or not. */
 #define PS_GL_SPECULAR_SETTLE_REFRESHES 4
-/* The first round after a change (the first picture, an edit, new layers or
- * lights) is drawn over this many refreshes, budget or not, from the first
- * refresh after the new view's. */
+/* With ps_gl_specular_set_first_round (photosplat-snap --time, whose
+ * checkpoints are what photosplat-bench measures): the first round after a
+ * change (the first picture, an edit, new layers or lights) is drawn over
+ * this many refreshes, budget or not, from the first refresh after the new
+ * view's. The window keeps the budget (its frame rate; 3 faces a refresh
+ * made the sanitizer build's window miss its scripted frames). */
 #define PS_GL_SPECULAR_FIRST_REFRESHES 4
 /* That first round draws shadows only up to this many GL lights (an area
  * light's virtual lights make faces dear): the later rounds draw them all. */
@@ -57,6 +61,10 @@ typedef struct ps_gl_specular ps_gl_specular;
 /* cube_size 0: PS_GL_SPECULAR_CUBE_SIZE. Needs a current context. */
 ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err);
 void ps_gl_specular_destroy(ps_gl_specular *g); /* accepts NULL */
+
+/* The first round of faces after a change over `refreshes` refreshes
+ * whatever the budget (0, the default: within the budget, as later rounds). */
+void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes);
 
 /* Before drawing refresh f of session s: up to `faces` cube faces rendered
  * (0: every face of every cube), when f shows the specular layer. Leaves the

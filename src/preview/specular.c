@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/clock.h"
 #include "scene/bsdf.h"
 
 /* A path that meets nothing is looked up this many scene diagonals away
@@ -634,8 +635,11 @@ static bool trace_pixel(ps_specular *sp, path_ctx *c, const ps_camera_frame *cam
     return true;
 }
 
+/* Pixels traced between looks at the clock. */
+#define PIXELS_PER_CLOCK 64
+
 size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const ps_camera_frame *cam,
-                                 size_t max_rays)
+                                 size_t max_rays, double max_seconds)
 {
     if (sp->range_count == 0 || cam->width <= 0 || cam->height <= 0)
         return 0;
@@ -667,8 +671,12 @@ size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const p
     c.far = scene_far(world);
     c.escape_black = true;
     const size_t per_pixel = (size_t)PS_SPECULAR_PIXEL_SAMPLES * PS_SPECULAR_PIXEL_SAMPLES;
-    size_t rays = 0;
+    size_t rays = 0, traced = 0;
+    double t0 = max_seconds > 0.0 ? ps_now_seconds() : 0.0;
     while (sp->pix_range < sp->range_count && (max_rays == 0 || rays < max_rays)) {
+        if (max_seconds > 0.0 && traced > 0 && traced % PIXELS_PER_CLOCK == 0 &&
+            ps_now_seconds() - t0 >= max_seconds)
+            break;
         const int *r = sp->rect[sp->pix_range];
         size_t w = (size_t)(r[2] - r[0]), count = w * (size_t)(r[3] - r[1]);
         if (sp->pix_next >= count) {
@@ -682,6 +690,7 @@ size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const p
             continue;
         sp->pix_seen[at] = 1;
         rays += per_pixel;
+        traced++;
         if (!trace_pixel(sp, &c, cam, x, y)) {
             sp->pix_have_cam = sp->pix_ready = false; /* out of memory: the per-vertex lookups stay */
             return 0;

@@ -108,17 +108,22 @@ const float *ps_specular_weights(const ps_specular *sp, int k);
  * filter is wider by a pixel). src/gl draws those points instead of the
  * objects once a camera frame is traced whole. */
 #define PS_SPECULAR_PIXEL_SAMPLES 2
-/* Eye rays a refresh in incremental sessions (the window): the default
- * scene's spheres at 512^2 take about 2.7 10^5, 65 536 of them 0.33 s on
- * the loaded 2-core machine, so a still view shows per-pixel paths after
- * some 17 refreshes (the per-vertex lookups until then). */
+/* Eye rays a refresh in incremental sessions (the window), at most, and
+ * the share of tau they may take: the default scene's spheres at 512^2 take
+ * about 2.7 10^5 rays, 65 536 of them 0.33 s on the loaded 2-core machine
+ * (several times that in the sanitizer build), so a still view shows
+ * per-pixel paths after some 17 refreshes or more (the per-vertex lookups
+ * until then). */
 #define PS_SPECULAR_PIXEL_RAYS 16384
+#define PS_SPECULAR_PIXEL_TIME_SHARE 0.5
 
-/* Traces at most max_rays eye rays (0: all) of camera frame cam's pixels;
- * a new frame (or ps_specular_invalidate) starts over. Returns the rays
- * left for this frame (0: done, and the points below are this frame's). */
+/* Traces at most max_rays eye rays (0: all) of camera frame cam's pixels,
+ * stopping once max_seconds have gone by (0: no limit; what is traced does
+ * not depend on where it stops); a new frame (or ps_specular_invalidate)
+ * starts over. Returns the rays left for this frame (0: done, and the
+ * points below are this frame's). */
 size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const ps_camera_frame *cam,
-                                 size_t max_rays);
+                                 size_t max_rays, double max_seconds);
 /* The points of the current camera frame, once traced whole: their count,
  * else 0 and *ready false (draw the per-vertex lookups then). xy: pixel
  * (column, row from the top); dirs: lookup direction from cube[i]'s centre;
