@@ -109,13 +109,15 @@ const float *ps_specular_weights(const ps_specular *sp, int k);
  * objects once a camera frame is traced whole. */
 #define PS_SPECULAR_PIXEL_SAMPLES 2
 /* Eye rays a refresh in incremental sessions (the window), at most, and
- * the share of tau they may take: the default scene's spheres at 512^2 take
+ * the share of tau they may take (a guard: at half of tau the sanitizer
+ * build's window had not traced a 128^2 view's spheres by the picture
+ * cli_window.sh compares with snap's): the default scene's spheres at 512^2 take
  * about 2.7 10^5 rays, 65 536 of them 0.33 s on the loaded 2-core machine
  * (several times that in the sanitizer build), so a still view shows
  * per-pixel paths after some 17 refreshes or more (the per-vertex lookups
  * until then). */
 #define PS_SPECULAR_PIXEL_RAYS 16384
-#define PS_SPECULAR_PIXEL_TIME_SHARE 0.5
+#define PS_SPECULAR_PIXEL_TIME_SHARE 2.0
 
 /* Traces at most max_rays eye rays (0: all) of camera frame cam's pixels,
  * stopping once max_seconds have gone by (0: no limit; what is traced does
