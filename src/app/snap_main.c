@@ -814,6 +814,10 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
         st = ps_gl_layers_create(width, height, true, &s.layers, err);
     if (st == PS_OK)
         st = ps_gl_specular_create(0, &s.spec, err);
+    /* --time: the first round of cube faces soon, for the checkpoints (a
+     * script keeps the window's budget). */
+    if (st == PS_OK && !o->script)
+        ps_gl_specular_set_first_round(s.spec, PS_GL_SPECULAR_FIRST_REFRESHES);
     double t_start = ps_now_seconds(), first_frame = -1.0;
     if (st == PS_OK && o->script) {
         st = run_script(&s, t_start, &first_frame, err);

@@ -6,21 +6,27 @@
  * A cube map is six faces of PS_GL_SPECULAR_CUBE_SIZE^2 RGBA16F texels,
  * rendered as the view is (the depth prepass, the direct layer with its
  * shadow maps, the area lights, then the caustic and global splats of the
- * photons so far, at most PS_GL_SPECULAR_ENV_PHOTONS a map, a prefix with
+ * photons so far, at most PS_GL_SPECULAR_ENV_CAUSTIC and _GLOBAL, a prefix with
  * the level of detail's grown radius), every mirror and glass object left
  * out (the lookups trace through them on the CPU), at exposure 1: radiance.
- * Faces are refreshed round-robin while photons arrive, as
- * PS_GL_SPECULAR_TIME_SHARE of tau allows (a face every few refreshes, the
- * first one at the first refresh after a new view, never in one: the first
+ * Faces are refreshed round-robin while photons arrive: in snap the first
+ * round after a change over PS_GL_SPECULAR_FIRST_REFRESHES refreshes from
+ * the first after the new view, then (the window: always) as
+ * PS_GL_SPECULAR_TIME_SHARE of tau allows
+ * (a face every few refreshes; never in a new view's refresh: the first
  * picture, the first after an edit and a moving camera's come as fast as
  * without the layer), the last round once they all arrived
  * over a few refreshes whatever the budget, all at once for a single frame and a snapshot's last
  * picture; the objects are redrawn when a cube is whole again. They are kept
  * while only the camera moves; a new layer set, an edit or new GL lights
- * start a new round. The objects are then drawn PS_SPECULAR_TERMS times,
- * each pass one lookup direction (texture coordinates into the object's
- * cube) modulated by its weight (vertex colours), added together. Glossy
- * objects look up their cube's blurred level instead (gl_specular_blur.h). */
+ * start a new round. Once the camera holds still and its per-pixel paths
+ * are traced (preview/specular.h), each path is drawn as a one-pixel point
+ * looking its cube up, times its weight, added; before that (a moving
+ * camera, or paths still being traced) the objects are drawn
+ * PS_SPECULAR_TERMS times, each pass one lookup direction (texture
+ * coordinates into the object's cube) modulated by its weight (vertex
+ * colours), added together. Glossy objects always take the per-vertex
+ * passes, looking up their cube's blurred level (gl_specular_blur.h). */
 #ifndef PS_GL_GL_SPECULAR_H
 #define PS_GL_GL_SPECULAR_H
 
@@ -31,10 +37,25 @@
 #define PS_GL_SPECULAR_FACES_PER_REFRESH 1
 /* Past the first round, faces take at most this share of tau on average. */
 #define PS_GL_SPECULAR_TIME_SHARE 0.15
-#define PS_GL_SPECULAR_ENV_PHOTONS 8192
+/* Photons a cube face splats from each map. The caustic's are small and
+ * cheap to fill, and fewer grow their radius toward the global one (8 192
+ * blurred the ring's caustic into its shadow); the global splats' fill is
+ * most of what a face costs. */
+#define PS_GL_SPECULAR_ENV_CAUSTIC 65536
+#define PS_GL_SPECULAR_ENV_GLOBAL 16384
 /* Once every photon has arrived, the last round is drawn over this many
  * refreshes, budget or not. */
 #define PS_GL_SPECULAR_SETTLE_REFRESHES 4
+/* With ps_gl_specular_set_first_round (photosplat-snap --time, whose
+ * checkpoints are what photosplat-bench measures): the first round after a
+ * change (the first picture, an edit, new layers or lights) is drawn over
+ * this many refreshes, budget or not, from the first refresh after the new
+ * view's. The window keeps the budget (its frame rate; 3 faces a refresh
+ * made the sanitizer build's window miss its scripted frames). */
+#define PS_GL_SPECULAR_FIRST_REFRESHES 4
+/* That first round draws shadows only up to this many GL lights (an area
+ * light's virtual lights make faces dear): the later rounds draw them all. */
+#define PS_GL_SPECULAR_QUICK_SHADOW_LIGHTS 4
 
 typedef struct ps_gl_specular ps_gl_specular;
 
@@ -42,13 +63,19 @@ typedef struct ps_gl_specular ps_gl_specular;
 ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err);
 void ps_gl_specular_destroy(ps_gl_specular *g); /* accepts NULL */
 
+/* The first round of faces after a change over `refreshes` refreshes
+ * whatever the budget (0, the default: within the budget, as later rounds). */
+void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes);
+
 /* Before drawing refresh f of session s: up to `faces` cube faces rendered
  * (0: every face of every cube), when f shows the specular layer. Leaves the
  * renderer's view, the viewport and the framebuffer binding as they were. */
 ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
                                  int faces, ps_error *err);
 /* The specular objects' lookups times exposure added into the bound
- * framebuffer over the renderer's current view (its depth already there). */
+ * framebuffer over the renderer's current view (its depth already there):
+ * the per-pixel points when traced for the session's camera, else the
+ * per-vertex lookups. */
 void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure);
 /* The layered path (the window, snap --time in float): the specular layer
  * as a texture of l's size sharing l's depth, redrawn when the cubes, the
@@ -61,9 +88,10 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
  * layer read alone). */
 void ps_gl_specular_set_gain(ps_gl_specular *g, ps_gl_layers *l, double gain);
 
-/* Whether the cube maps show every photon and the objects were redrawn
- * from them (or the layer is not shown): nothing left to refresh. A
- * script's `wait done` waits for it too. */
+/* Whether the cube maps show every photon, the still camera's per-pixel
+ * paths are traced and the objects were redrawn from them (or the layer is
+ * not shown): nothing left to refresh. A script's `wait done` waits for it
+ * too. */
 bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s);
 
 /* For tests: every face of every cube filled with radiance `value` (a

@@ -625,6 +625,10 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     if (out->specular)
         ps_specular_update(s->spec, s->world, cam->eye,
                            !inc ? 0 : s->moving ? PS_SESSION_SPECULAR_VERTICES_MOVING : PS_SESSION_SPECULAR_VERTICES);
+    /* Per-pixel paths once the camera holds still (specular.h). */
+    if (out->specular && !out->moving)
+        ps_specular_update_pixels(s->spec, s->world, cam, inc ? PS_SPECULAR_PIXEL_RAYS : 0,
+                                  inc ? PS_SPECULAR_PIXEL_TIME_SHARE * s->set.tau : 0.0);
     out->direct_exposure = inc ? 1.0 : exposure(s);
     out->direct_gain = inc ? exposure(s) : 1.0;
     out->splat = s->set.splat;

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/clock.h"
 #include "preview/specular_glossy.h"
 #include "scene/bsdf.h"
 
@@ -13,6 +14,47 @@
  * along its last direction: far enough to stand for "at infinity" when
  * interpolated against neighbouring vertices' finite points. */
 #define FAR_DIAGONALS 1000.0
+
+/* Points of the per-pixel layer (specular.h). */
+typedef struct point_set {
+    float *xy, *dirs, *weights;
+    int *cube;
+    size_t count, cap;
+} point_set;
+
+static void point_set_free(point_set *p)
+{
+    free(p->xy), free(p->dirs), free(p->weights), free(p->cube);
+    memset(p, 0, sizeof *p);
+}
+
+static bool point_set_add(point_set *p, float x, float y, ps_vec3 d, ps_rgb w, int cube)
+{
+    if (p->count == p->cap) {
+        size_t cap = p->cap ? 2 * p->cap : 4096;
+        float *xy = realloc(p->xy, 2 * cap * sizeof *xy);
+        if (xy)
+            p->xy = xy;
+        float *dirs = realloc(p->dirs, 3 * cap * sizeof *dirs);
+        if (dirs)
+            p->dirs = dirs;
+        float *weights = realloc(p->weights, 3 * cap * sizeof *weights);
+        if (weights)
+            p->weights = weights;
+        int *cubes = realloc(p->cube, cap * sizeof *cubes);
+        if (cubes)
+            p->cube = cubes;
+        if (!xy || !dirs || !weights || !cubes)
+            return false;
+        p->cap = cap;
+    }
+    size_t i = p->count++;
+    p->xy[2 * i] = x, p->xy[2 * i + 1] = y;
+    p->dirs[3 * i] = (float)d.x, p->dirs[3 * i + 1] = (float)d.y, p->dirs[3 * i + 2] = (float)d.z;
+    p->weights[3 * i] = (float)w.r, p->weights[3 * i + 1] = (float)w.g, p->weights[3 * i + 2] = (float)w.b;
+    p->cube[i] = cube;
+    return true;
+}
 
 struct ps_specular {
     const ps_preview_mesh *mesh;
@@ -35,6 +77,19 @@ struct ps_specular {
     bool have_eye, changed;
     ps_vec3 eye;
     size_t next_unique;
+    /* Per-pixel paths: each listed range's vertex box, the camera frame being
+     * traced, its pixel rectangles and the cursor over them (range, pixel),
+     * the pixels done (ranges' rectangles overlap), the points being built
+     * and those of the last frame traced whole (ready: that frame is the
+     * current one). */
+    ps_aabb *range_box;
+    bool pix_have_cam, pix_ready;
+    ps_camera_frame pix_cam;
+    int (*rect)[4];
+    size_t pix_range, pix_next;
+    unsigned char *pix_seen;
+    size_t pix_seen_cap;
+    point_set pix_build, pix_done;
 };
 
 static const ps_material *range_material(const ps_specular *sp, size_t r)
@@ -179,6 +234,19 @@ ps_status ps_specular_create(const ps_preview_mesh *mesh, const ps_material *mat
     }
     for (int c = 0; c < sp->cube_count; c++)
         sp->centre[c] = ps_aabb_center(box[c]);
+    size_t nr = sp->range_count ? sp->range_count : 1;
+    sp->range_box = malloc(nr * sizeof *sp->range_box);
+    sp->rect = malloc(nr * sizeof *sp->rect);
+    if (!sp->range_box || !sp->rect) {
+        ps_specular_destroy(sp);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the specular layer");
+    }
+    for (size_t i = 0; i < sp->range_count; i++) {
+        const ps_mesh_range *rg = &mesh->ranges[sp->ranges[i].range];
+        sp->range_box[i] = ps_aabb_empty();
+        for (size_t v = 0; v < rg->count; v++)
+            sp->range_box[i] = ps_aabb_point(sp->range_box[i], vertex_pos(mesh, rg->first + v));
+    }
     size_t n = sp->vertex_count ? sp->vertex_count : 1;
     for (int k = 0; k < PS_SPECULAR_TERMS; k++) {
         sp->dirs[k] = calloc(3 * n, sizeof(float));
@@ -210,6 +278,11 @@ void ps_specular_destroy(ps_specular *sp)
     free(sp->first_of);
     free(sp->order);
     free(sp->order_first);
+    free(sp->range_box);
+    free(sp->rect);
+    free(sp->pix_seen);
+    point_set_free(&sp->pix_build);
+    point_set_free(&sp->pix_done);
     free(sp);
 }
 
@@ -231,6 +304,13 @@ typedef struct path_ctx {
     ps_specular_term paths[PS_SPECULAR_MAX_PATHS];
     int count;
     double dropped;
+    /* A path that meets nothing is black, as in photosplat-ref (no
+     * environment), rather than looked up far away along its direction:
+     * from the cube's centre that direction may meet a wall the path itself
+     * passed by (the open front of the default box seen in the mirror sphere
+     * grew by a pixel or two into the floor). Per-pixel paths only: the
+     * per-vertex ones interpolate a lookup toward it. */
+    bool escape_black;
 } path_ctx;
 
 static double weight_of(ps_rgb w) { return fmax(w.r, fmax(w.g, w.b)); }
@@ -288,6 +368,8 @@ static void follow(path_ctx *c, ps_ray r, ps_rgb w, int depth, double length)
     }
     ps_surface sp;
     if (!ps_world_intersect(c->world, r, INFINITY, &sp)) {
+        if (c->escape_black)
+            return;
         add_path(c, ps_v3_scale(r.d, c->far), w);
         return;
     }
@@ -387,6 +469,7 @@ int ps_specular_trace_point(const ps_world *world, const ps_material *materials,
     c.materials = materials;
     c.centre = centre;
     c.far = scene_far(world);
+    c.escape_black = false;
     int k = trace_point(&c, m, eye, p, n, out);
     if (dropped)
         *dropped = c.dropped;
@@ -425,6 +508,7 @@ size_t ps_specular_update(ps_specular *sp, const ps_world *world, ps_vec3 eye, s
     c.world = world;
     c.materials = ps_scene_materials(ps_world_scene(world), &(size_t){0});
     c.far = scene_far(world);
+    c.escape_black = false;
     for (size_t u = sp->next_unique; u < end; u++) {
         size_t k = sp->first_of[u];
         const ps_specular_range *lr = &sp->ranges[range_of(sp, k)];
@@ -465,4 +549,193 @@ void ps_specular_invalidate(ps_specular *sp)
 {
     sp->have_eye = false;
     sp->next_unique = 0;
+    sp->pix_have_cam = false;
+    sp->pix_ready = false;
+}
+
+/* ---- per-pixel paths ----------------------------------------------------------- */
+
+/* A vertex box's projection is widened by this many pixels: the exact
+ * surface bulges past the mesh's chords, and a sample's pixel may lie just
+ * outside the box's projected corners. */
+#define PIXEL_MARGIN 2
+
+static bool same_frame(const ps_camera_frame *a, const ps_camera_frame *b)
+{
+    return same_vec(a->eye, b->eye) && same_vec(a->forward, b->forward) && same_vec(a->right, b->right) &&
+           same_vec(a->up, b->up) && a->tan_half_fov == b->tan_half_fov && a->aspect == b->aspect &&
+           a->width == b->width && a->height == b->height;
+}
+
+/* Range i's pixel rectangle [x0, x1) x [y0, y1): its box's eight corners
+ * projected; the whole image when a corner lies behind the eye. */
+static void range_rect(const ps_aabb *b, const ps_camera_frame *cam, int r[4])
+{
+    double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
+    bool all = false;
+    for (int k = 0; k < 8 && !all; k++) {
+        ps_vec3 p = ps_v3(k & 1 ? b->hi.x : b->lo.x, k & 2 ? b->hi.y : b->lo.y, k & 4 ? b->hi.z : b->lo.z);
+        double x, y;
+        if (!ps_camera_project(cam, p, &x, &y) || !isfinite(x) || !isfinite(y)) {
+            all = true;
+            break;
+        }
+        x0 = fmin(x0, x), x1 = fmax(x1, x), y0 = fmin(y0, y), y1 = fmax(y1, y);
+    }
+    if (all) {
+        r[0] = 0, r[1] = 0, r[2] = cam->width, r[3] = cam->height;
+        return;
+    }
+    double lo[2] = {floor(x0) - PIXEL_MARGIN, floor(y0) - PIXEL_MARGIN};
+    double hi[2] = {ceil(x1) + PIXEL_MARGIN, ceil(y1) + PIXEL_MARGIN};
+    double size[2] = {cam->width, cam->height};
+    for (int a = 0; a < 2; a++) {
+        r[a] = (int)fmin(fmax(lo[a], 0.0), size[a]);
+        r[a + 2] = (int)fmin(fmax(hi[a], 0.0), size[a]);
+        if (r[a + 2] < r[a])
+            r[a + 2] = r[a];
+    }
+}
+
+/* The cube of the listed range of scene object `object`; -1: none. */
+static int cube_of_object(const ps_specular *sp, uint32_t object)
+{
+    for (size_t i = 0; i < sp->range_count; i++)
+        if (sp->mesh->ranges[sp->ranges[i].range].object == object)
+            return sp->ranges[i].cube;
+    return -1;
+}
+
+/* Pixel (x, y)'s samples: each eye ray that meets an object of the layer
+ * first is traced as the vertices' rays are (scatter, follow), from the
+ * exact surface point it meets. */
+static bool trace_pixel(ps_specular *sp, path_ctx *c, const ps_camera_frame *cam, int x, int y)
+{
+    const int n = PS_SPECULAR_PIXEL_SAMPLES;
+    const double share = 1.0 / (n * n);
+    for (int j = 0; j < n; j++) {
+        for (int i = 0; i < n; i++) {
+            ps_ray ray = ps_camera_ray(cam, x + (i + 0.5) / n, y + (j + 0.5) / n);
+            ps_surface hit;
+            if (!ps_world_intersect(c->world, ray, INFINITY, &hit))
+                continue;
+            const ps_material *m = &c->materials[hit.material];
+            int cube = ps_material_is_specular(m) ? cube_of_object(sp, hit.object) : -1;
+            if (cube < 0)
+                continue;
+            c->count = 0;
+            c->dropped = 0.0;
+            c->centre = sp->centre[cube];
+            c->first = hit.t;
+            scatter(c, &hit, m, ray.d, ps_rgb_gray(1.0), 0, hit.t);
+            ps_specular_term t[PS_SPECULAR_TERMS];
+            int k = keep_heaviest(c, t);
+            for (int q = 0; q < k; q++)
+                if (!point_set_add(&sp->pix_build, (float)x, (float)y, t[q].dir, ps_rgb_scale(t[q].weight, share),
+                                   cube))
+                    return false;
+        }
+    }
+    return true;
+}
+
+/* Pixels traced between looks at the clock. */
+#define PIXELS_PER_CLOCK 64
+
+size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const ps_camera_frame *cam,
+                                 size_t max_rays, double max_seconds)
+{
+    if (sp->range_count == 0 || cam->width <= 0 || cam->height <= 0)
+        return 0;
+    size_t pixels = (size_t)cam->width * (size_t)cam->height;
+    if (!sp->pix_have_cam || !same_frame(cam, &sp->pix_cam)) {
+        if (sp->pix_seen_cap < pixels) {
+            unsigned char *seen = realloc(sp->pix_seen, pixels);
+            if (!seen) {
+                sp->pix_have_cam = sp->pix_ready = false;
+                return 0; /* out of memory: the per-vertex lookups stay */
+            }
+            sp->pix_seen = seen;
+            sp->pix_seen_cap = pixels;
+        }
+        memset(sp->pix_seen, 0, pixels);
+        sp->pix_have_cam = true;
+        sp->pix_ready = false;
+        sp->pix_cam = *cam;
+        sp->pix_range = sp->pix_next = 0;
+        sp->pix_build.count = 0;
+        for (size_t i = 0; i < sp->range_count; i++) {
+            range_rect(&sp->range_box[i], cam, sp->rect[i]);
+            /* Glossy ranges keep their per-vertex lobe lookups (the GL draws
+             * them beside the points): no pixel of theirs is traced. */
+            if (ps_glossy_wants(range_material(sp, sp->ranges[i].range)))
+                sp->rect[i][2] = sp->rect[i][0], sp->rect[i][3] = sp->rect[i][1];
+        }
+    }
+    if (sp->pix_range >= sp->range_count)
+        return 0;
+    path_ctx c;
+    c.world = world;
+    c.materials = ps_scene_materials(ps_world_scene(world), &(size_t){0});
+    c.far = scene_far(world);
+    c.escape_black = true;
+    const size_t per_pixel = (size_t)PS_SPECULAR_PIXEL_SAMPLES * PS_SPECULAR_PIXEL_SAMPLES;
+    size_t rays = 0, traced = 0;
+    double t0 = max_seconds > 0.0 ? ps_now_seconds() : 0.0;
+    while (sp->pix_range < sp->range_count && (max_rays == 0 || rays < max_rays)) {
+        if (max_seconds > 0.0 && traced > 0 && traced % PIXELS_PER_CLOCK == 0 &&
+            ps_now_seconds() - t0 >= max_seconds)
+            break;
+        const int *r = sp->rect[sp->pix_range];
+        size_t w = (size_t)(r[2] - r[0]), count = w * (size_t)(r[3] - r[1]);
+        if (sp->pix_next >= count) {
+            sp->pix_range++, sp->pix_next = 0;
+            continue;
+        }
+        int x = r[0] + (int)(sp->pix_next % w), y = r[1] + (int)(sp->pix_next / w);
+        sp->pix_next++;
+        size_t at = (size_t)y * (size_t)cam->width + (size_t)x;
+        if (sp->pix_seen[at])
+            continue;
+        sp->pix_seen[at] = 1;
+        rays += per_pixel;
+        traced++;
+        if (!trace_pixel(sp, &c, cam, x, y)) {
+            sp->pix_have_cam = sp->pix_ready = false; /* out of memory: the per-vertex lookups stay */
+            return 0;
+        }
+    }
+    if (sp->pix_range < sp->range_count) {
+        /* Left: the rest of this rectangle and the whole of the others (an
+         * upper bound; pixels seen in earlier rectangles are skipped). */
+        size_t left = 0;
+        for (size_t i = sp->pix_range; i < sp->range_count; i++) {
+            const int *r = sp->rect[i];
+            left += (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]);
+        }
+        left -= sp->pix_next;
+        return left * per_pixel + (left == 0);
+    }
+    point_set t = sp->pix_done;
+    sp->pix_done = sp->pix_build;
+    sp->pix_build = t;
+    sp->pix_build.count = 0;
+    sp->pix_ready = true;
+    sp->changed = true;
+    return 0;
+}
+
+ps_specular_points ps_specular_pixel_points(const ps_specular *sp)
+{
+    ps_specular_points p;
+    memset(&p, 0, sizeof p);
+    if (!sp->pix_ready)
+        return p;
+    p.ready = true;
+    p.count = sp->pix_done.count;
+    p.xy = sp->pix_done.xy;
+    p.dirs = sp->pix_done.dirs;
+    p.weights = sp->pix_done.weights;
+    p.cube = sp->pix_done.cube;
+    return p;
 }

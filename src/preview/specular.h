@@ -22,8 +22,9 @@
  * that no energy is lost (a furnace stays at 1).
  *
  * Departures, said where they show (docs/preview.md): the cube map shows P
- * only if nothing diffuse lies between the centre and P; lookups are
- * interpolated over the mesh's triangles (Gouraud); area lights are seen in
+ * only if nothing diffuse lies between the centre and P; the per-vertex
+ * lookups are interpolated over the mesh's triangles (Gouraud), which is why
+ * a still camera gets per-pixel paths instead (below); area lights are seen in
  * the cube map as the direct layer draws them, point and spot lights not at
  * all (as in photosplat-ref). Glossy objects are in the set too, each with a
  * cube of its own and one lookup a vertex along its mirror direction into a
@@ -38,6 +39,7 @@
 #include "core/vec.h"
 #include "photon/world.h"
 #include "preview/mesh.h"
+#include "scene/camera.h"
 #include "scene/scene.h"
 
 /* Lookups a vertex: each one a drawing pass of the object. */
@@ -90,6 +92,51 @@ void ps_specular_invalidate(ps_specular *sp);
  * centre, and an rgb weight (0 where a vertex has fewer paths). */
 const float *ps_specular_dirs(const ps_specular *sp, int k);
 const float *ps_specular_weights(const ps_specular *sp, int k);
+
+/* ---- per-pixel eye paths ------------------------------------------------------ */
+
+/* The lookups above are interpolated over the mesh's triangles, which bends
+ * what refraction through a curved glass shows and what a sphere's mirror
+ * shows past a reflected edge, and leaves a silhouette's pixels all or
+ * nothing where the reference averages 16 samples. Once the camera holds
+ * still, each pixel that an object of the layer may cover (its vertices'
+ * bounding box projected, PIXEL_MARGIN pixels wider) is traced on the CPU
+ * instead, PS_SPECULAR_PIXEL_SAMPLES^2 stratified eye rays a pixel through
+ * the exact surfaces, each path ending as above; every kept path of every
+ * sample is one point of the layer: its pixel, its lookup direction and its
+ * weight over the samples a pixel (a box filter; the reference's Mitchell
+ * filter is wider by a pixel). src/gl draws those points instead of the
+ * objects once a camera frame is traced whole. */
+#define PS_SPECULAR_PIXEL_SAMPLES 2
+/* Eye rays a refresh in incremental sessions (the window), at most, and
+ * the share of tau they may take (a guard: at half of tau the sanitizer
+ * build's window had not traced a 128^2 view's spheres by the picture
+ * cli_window.sh compares with snap's): the default scene's spheres at 512^2 take
+ * about 2.7 10^5 rays, 65 536 of them 0.33 s on the loaded 2-core machine
+ * (several times that in the sanitizer build), so a still view shows
+ * per-pixel paths after some 17 refreshes or more (the per-vertex lookups
+ * until then). */
+#define PS_SPECULAR_PIXEL_RAYS 16384
+#define PS_SPECULAR_PIXEL_TIME_SHARE 2.0
+
+/* Traces at most max_rays eye rays (0: all) of camera frame cam's pixels,
+ * stopping once max_seconds have gone by (0: no limit; what is traced does
+ * not depend on where it stops); a new frame (or ps_specular_invalidate)
+ * starts over. Returns the rays left for this frame (0: done, and the
+ * points below are this frame's). */
+size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const ps_camera_frame *cam,
+                                 size_t max_rays, double max_seconds);
+/* The points of the current camera frame, once traced whole: their count,
+ * else 0 and *ready false (draw the per-vertex lookups then). xy: pixel
+ * (column, row from the top); dirs: lookup direction from cube[i]'s centre;
+ * weights: rgb, already divided by the samples a pixel. */
+typedef struct ps_specular_points {
+    bool ready;
+    size_t count;
+    const float *xy, *dirs, *weights;
+    const int *cube;
+} ps_specular_points;
+ps_specular_points ps_specular_pixel_points(const ps_specular *sp);
 
 /* ---- for tests --------------------------------------------------------------- */
 
