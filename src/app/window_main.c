@@ -1172,7 +1172,12 @@ int main(int argc, char **argv)
     ps_status st = ps_check_outputs(&a.o.c, &err);
     for (size_t i = 0; st == PS_OK && a.script && i < ps_script_count(a.script); i++) {
         const ps_script_action *act = ps_script_at(a.script, i);
-        if (act->path)
+        if (act->kind == PS_SCRIPT_SCREENSHOT && ps_script_path_is_radiance(act->path))
+            st = ps_error_at(&err, PS_ERR_PARSE, a.o.script, act->line,
+                             "screenshot %s: the window shows 8-bit codes and writes PNG (linear radiance, .pfm "
+                             "or .exr: photosplat-snap --script)",
+                             act->path);
+        else if (act->path)
             st = ps_check_output_path(act->path, &err);
     }
     if (st == PS_OK)

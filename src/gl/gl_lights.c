@@ -544,6 +544,12 @@ static void disable_texgen(void)
     glDisable(GL_TEXTURE_GEN_Q);
 }
 
+/* A shadowed pass's clip planes: the near plane, then the four sides of the
+ * face's pyramid (GL_CLIP_PLANE2 is the spot's; GL has at least six). */
+#define FACE_CLIP_PLANES 5
+static const GLenum face_clip_planes[FACE_CLIP_PLANES] = {GL_CLIP_PLANE1, GL_CLIP_PLANE0, GL_CLIP_PLANE3,
+                                                          GL_CLIP_PLANE4, GL_CLIP_PLANE5};
+
 void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows)
 {
     glEnable(GL_LIGHTING);
@@ -574,8 +580,8 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows)
         }
         glEnable(GL_TEXTURE_2D);
         glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
-        glEnable(GL_CLIP_PLANE0);
-        glEnable(GL_CLIP_PLANE1);
+        for (int c = 0; c < FACE_CLIP_PLANES; c++)
+            glEnable(face_clip_planes[c]);
         for (int f = 0; f < PS_CUBE_FACES; f++) {
             if (!(v->faces & (1u << f)))
                 continue;
@@ -583,22 +589,33 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows)
             double proj[16], view[16];
             light_face_matrices(r, v, f, proj, view);
             set_shadow_texgen(proj, view, SHADOW_TEXGEN_ULPS * FLOAT_ULP * (r->eye_extent + ps_v3_len(v->pos)));
-            /* Only the half-space in front of the face: behind the light the
-             * projection would fold points back into the map. */
-            GLdouble plane[4] = {axis.x, axis.y, axis.z, -ps_v3_dot(axis, v->pos)};
-            glClipPlane(GL_CLIP_PLANE0, plane);
+            /* Only the face's own pyramid, a little widened: outside its
+             * square the map's border (depth 0) lights nothing, so those
+             * pixels need not be drawn (about a third of the fill of the
+             * half-space in front of the face, which the pyramid lies in:
+             * behind the light the projection would fold points back into
+             * the map). */
+            ps_vec3 fw, rt, up;
+            face_frame(f, &fw, &rt, &up);
+            double k = 1.0 + SHADOW_FACE_SLACK_TEXELS * 2.0 / r->shadow_size;
+            const ps_vec3 sides[4] = {ps_v3_sub(ps_v3_scale(fw, k), rt), ps_v3_add(ps_v3_scale(fw, k), rt),
+                                      ps_v3_sub(ps_v3_scale(fw, k), up), ps_v3_add(ps_v3_scale(fw, k), up)};
+            for (int c = 0; c < 4; c++) {
+                GLdouble side[4] = {sides[c].x, sides[c].y, sides[c].z, -ps_v3_dot(sides[c], v->pos)};
+                glClipPlane(face_clip_planes[1 + c], side);
+            }
             /* Nor what lies nearer than the near plane: outside the face's
              * square its depth would pass the test against the border's 0.
              * Every point this face owns lies beyond (at least nearest /
              * sqrt 3 > PS_SHADOW_NEAR_SHARE * nearest away along the axis). */
-            plane[3] -= v->shadow_near;
-            glClipPlane(GL_CLIP_PLANE1, plane);
+            GLdouble plane[4] = {axis.x, axis.y, axis.z, -ps_v3_dot(axis, v->pos) - v->shadow_near};
+            glClipPlane(face_clip_planes[0], plane);
             glBindTexture(GL_TEXTURE_2D, r->shadow[i][f]);
             ps_gl_draw_mesh(r, true, false);
             r->stats.light_passes++;
         }
-        glDisable(GL_CLIP_PLANE0);
-        glDisable(GL_CLIP_PLANE1);
+        for (int c = 0; c < FACE_CLIP_PLANES; c++)
+            glDisable(face_clip_planes[c]);
         disable_texgen();
         glBindTexture(GL_TEXTURE_2D, 0);
         glDisable(GL_TEXTURE_2D);
