@@ -11,6 +11,7 @@
 
 #include "app/cli.h"
 #include "app/interrupt.h"
+#include "app/latency.h"
 #include "app/options.h"
 #include "app/stats.h"
 #include "core/fileio.h"
@@ -179,12 +180,15 @@ typedef struct snap_run {
      * kept and retraced, per map (repair.h). */
     uint64_t updates, repairs, kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
     double draw_seconds;
+    ps_latency lat;     /* --script: each edit's first refresh, phase by phase (app/latency.h) */
+    bool awaiting_edit; /* the next refresh is the first after an update */
 } snap_run;
 
 /* One refresh: what the session says, drawn into the layers (the new
  * photons) or over the scene into the colour buffer (all of them). */
 static ps_status refresh(snap_run *s, ps_error *err)
 {
+    double t_refresh = ps_now_seconds();
     ps_status st = ps_session_refresh(s->session, &s->cam, &s->frame, err);
     if (st == PS_OK && s->frame.lights_changed) {
         ps_gl_scene gs = ps_gl_scene_of(s->session);
@@ -193,12 +197,24 @@ static ps_status refresh(snap_run *s, ps_error *err)
     if (st != PS_OK)
         return st;
     double t0 = ps_now_seconds();
-    /* A few cube faces a refresh while photons arrive; all of them for a
-     * single frame and for the last picture. */
-    int faces = s->o->time > 0.0 && !s->all_faces ? PS_GL_SPECULAR_FACES_PER_REFRESH : 0;
+    ps_latency_add(&s->lat, PS_LAT_SESSION, t0 - t_refresh);
+    ps_gl_clear_shadow_timing(s->gl);
+    /* A few cube faces a refresh while photons arrive (--time; --script
+     * with float layers, as the window: none in the first refresh after an
+     * edit); all of them for a single frame, for whole refreshes of a
+     * script (each a new view, where faces would wait) and for the last
+     * picture. */
+    int faces = (s->o->time > 0.0 || (s->o->script && s->layers)) && !s->all_faces ? PS_GL_SPECULAR_FACES_PER_REFRESH
+                                                                                   : 0;
     st = ps_gl_specular_refresh(s->spec, s->gl, s->session, &s->frame, faces, err);
     if (st != PS_OK)
         return st;
+    double t_draw = ps_now_seconds();
+    ps_gl_stats gst = ps_gl_get_stats(s->gl);
+    ps_latency_add(&s->lat, PS_LAT_SPECULAR, t_draw - t0 - gst.shadow_seconds_last);
+    ps_latency_add(&s->lat, PS_LAT_SHADOWS, gst.shadow_seconds_last);
+    ps_latency_add_faces(&s->lat, gst.shadow_faces_last);
+    ps_gl_clear_shadow_timing(s->gl);
     if (s->layers) {
         ps_gl_layers_draw(s->layers, s->gl, &s->cam, &s->frame);
         st = ps_gl_specular_layer(s->spec, s->layers, s->gl, s->session, &s->frame, err);
@@ -211,7 +227,14 @@ static ps_status refresh(snap_run *s, ps_error *err)
         if (s->frame.specular)
             ps_gl_specular_draw(s->spec, s->gl, s->session, s->frame.direct_exposure);
     }
-    double spent = ps_now_seconds() - t0;
+    double t1 = ps_now_seconds(), spent = t1 - t0;
+    gst = ps_gl_get_stats(s->gl);
+    ps_latency_add(&s->lat, PS_LAT_SHADOWS, gst.shadow_seconds_last);
+    ps_latency_add_faces(&s->lat, gst.shadow_faces_last);
+    ps_latency_add(&s->lat, PS_LAT_DRAW, t1 - t_draw - gst.shadow_seconds_last);
+    if (s->awaiting_edit)
+        ps_latency_commit(&s->lat, t1);
+    s->awaiting_edit = false;
     s->splats += s->frame.splats;
     s->draw_seconds += spent;
     s->frames++;
@@ -559,27 +582,38 @@ static ps_status script_action(snap_run *s, const ps_script_action *act, bool *w
     ps_status st = PS_OK;
     switch (act->kind) {
     case PS_SCRIPT_SCREENSHOT: {
+        /* The picture as shown: a PNG (times exposure, 8-bit), or where the
+         * path ends in .pfm or .exr its linear radiance (the layers' float
+         * composite with --color-depth float), for comparisons that 8-bit
+         * codes would clip. */
         ps_image img;
         st = read_picture(s, true, every_map, &img, err);
-        if (st == PS_OK)
+        if (st == PS_OK && ps_script_path_is_radiance(act->path)) {
+            to_radiance(s, &img);
+            st = ps_hdr_write(&img, act->path, err);
+        } else if (st == PS_OK)
             st = ps_png_write(&img, act->path, 1.0f, err);
         ps_image_destroy(&img);
         return st;
     }
     case PS_SCRIPT_MOVE_LIGHT:
-        return script_index(s, act, nl, "lights", err) != PS_OK ? err->status
-                                                                : ps_session_move_light(ss, act->index, act->v, err);
     case PS_SCRIPT_MOVE_OBJECT:
-        return script_index(s, act, no, "objects", err) != PS_OK ? err->status
-                                                                 : ps_session_move_object(ss, act->index, act->v, err);
     case PS_SCRIPT_POWER:
-        return script_index(s, act, nl, "lights", err) != PS_OK
-                   ? err->status
-                   : ps_session_set_light_power(ss, act->index, act->power, err);
-    case PS_SCRIPT_ANGLE:
-        return script_index(s, act, nl, "lights", err) != PS_OK
-                   ? err->status
-                   : ps_session_set_spot_angle(ss, act->index, act->number, err);
+    case PS_SCRIPT_ANGLE: {
+        bool object = act->kind == PS_SCRIPT_MOVE_OBJECT;
+        if (script_index(s, act, object ? no : nl, object ? "objects" : "lights", err) != PS_OK)
+            return err->status;
+        /* The edit's clock starts before the call, which holds the tracing
+         * thread between batches (app/latency.h). */
+        double t = ps_now_seconds();
+        ps_latency_begin(&s->lat, t);
+        st = act->kind == PS_SCRIPT_MOVE_LIGHT ? ps_session_move_light(ss, act->index, act->v, err)
+             : object                          ? ps_session_move_object(ss, act->index, act->v, err)
+             : act->kind == PS_SCRIPT_POWER    ? ps_session_set_light_power(ss, act->index, act->power, err)
+                                               : ps_session_set_spot_angle(ss, act->index, act->number, err);
+        ps_latency_add(&s->lat, PS_LAT_HOLD, ps_now_seconds() - t);
+        return st;
+    }
     case PS_SCRIPT_ORBIT: orbit(s, act->yaw, act->pitch); return PS_OK;
     case PS_SCRIPT_WAIT: *wait = true; return PS_OK;
     case PS_SCRIPT_QUIT: *quit = true; return PS_OK;
@@ -617,11 +651,15 @@ static ps_status script_action(snap_run *s, const ps_script_action *act, bool *w
 static ps_status apply_edits(snap_run *s, ps_error *err)
 {
     ps_session_changes ch;
+    double t = ps_now_seconds();
+    ps_latency_begin(&s->lat, t);
     ps_status st = ps_session_update(s->session, &ch, err);
     if (st == PS_OK) {
         ps_gl_scene gs = ps_gl_scene_of(s->session);
         st = ps_gl_renderer_set_scene(s->gl, &gs, err);
     }
+    ps_latency_add(&s->lat, PS_LAT_UPDATE, ps_now_seconds() - t);
+    s->awaiting_edit = true;
     bool repaired;
     uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
     ps_session_repair_counts(s->session, &repaired, kept, retraced);
@@ -661,7 +699,10 @@ static ps_status run_script(snap_run *s, double t_start, double *first_frame, ps
         while (st == PS_OK && !quit && next < count) {
             const ps_script_action *act = ps_script_at(o->script, next);
             if (waiting) {
-                if (ps_session_edited(s->session) || !ps_session_settled(s->session))
+                /* As the window's: with float layers the specular layer's
+                 * last round too (whole refreshes draw every face). */
+                if (ps_session_edited(s->session) || !ps_session_settled(s->session) ||
+                    (s->layers && !ps_gl_specular_done(s->spec, s->session)))
                     break;
                 waiting = false;
                 delay = now - t0 - wait_time;
@@ -692,7 +733,8 @@ static ps_status run_script(snap_run *s, double t_start, double *first_frame, ps
             double at = t0 + delay + ps_script_at(o->script, next)->time;
             due = fmin(due, fmax(at, now));
         }
-        if (ps_session_settled(s->session) && waiting)
+        /* An edit: its update and first refresh at once, as the window's. */
+        if ((ps_session_settled(s->session) && waiting) || ps_session_edited(s->session))
             due = now;
         sleep_until(due);
     }
@@ -700,6 +742,7 @@ static ps_status run_script(snap_run *s, double t_start, double *first_frame, ps
     if (st == PS_OK)
         st = stop;
     ps_session_full_lights(s->session);
+    s->all_faces = true;
     if (st == PS_OK)
         st = refresh(s, err);
     while (st == PS_OK && s->layers && !ps_session_settled(s->session))
@@ -757,6 +800,7 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
         ps_stats_add(&rs, "repair_kept_global", (double)s->kept[PS_MAP_GLOBAL]);
         ps_stats_add(&rs, "repair_retraced_caustic", (double)s->retraced[PS_MAP_CAUSTIC]);
         ps_stats_add(&rs, "repair_retraced_global", (double)s->retraced[PS_MAP_GLOBAL]);
+        ps_latency_stats(&s->lat, &rs);
         printf("script: %llu updates, %llu repaired; photons kept/retraced: caustic %llu/%llu, global %llu/%llu\n",
                (unsigned long long)s->updates, (unsigned long long)s->repairs,
                (unsigned long long)s->kept[PS_MAP_CAUSTIC], (unsigned long long)s->retraced[PS_MAP_CAUSTIC],

@@ -12,7 +12,7 @@
 #include "core/status.h"
 #include "photon/tracer.h"
 
-#define PS_STATS_MAX_EXTRA 32
+#define PS_STATS_MAX_EXTRA 48
 
 typedef struct ps_run_stats {
     uint64_t emitted[PS_MAP_COUNT], stored[PS_MAP_COUNT];

@@ -15,6 +15,7 @@
 
 #include "app/cli.h"
 #include "app/interrupt.h"
+#include "app/latency.h"
 #include "app/options.h"
 #include "app/stats.h"
 #include "app/workfile.h"
@@ -173,14 +174,14 @@ typedef struct app {
     /* Timing and figures. */
     double start_time, t_first_frame, first_frame_seconds, last_refresh, fps, frame_seconds;
     uint64_t frames;
-    double edit_time, edit_latency_max, edit_latency_sum;
-    uint64_t edit_latency_count;
+    double edit_time;
     bool awaiting_edit_frame;
     /* The camera's level of detail: frames drawn while it moved, their time,
      * and how long after the last one every photon was back in the picture. */
     uint64_t moving_frames;
     double moving_seconds, moving_end, full_after_stop;
     bool full_pending;
+    ps_latency lat; /* an edit's first refreshed frame, phase by phase (app/latency.h) */
     /* Illuminance in false colour (key F): the last refresh's lux, a pixel
      * each (row 0 the top), the cursor that reads it, and the 8-bit picture. */
     bool false_color;
@@ -464,18 +465,32 @@ static ps_status refresh(app *a, ps_error *err)
     }
     if (st != PS_OK)
         return st;
+    double t_spec = ps_now_seconds();
+    ps_latency_add(&a->lat, PS_LAT_SESSION, t_spec - t0);
     /* The specular layer's cube faces, as its time budget allows, before
      * the view (gl_specular.h); not counted in the splats' drawing time. */
+    ps_gl_clear_shadow_timing(a->gl);
     st = ps_gl_specular_refresh(a->spec, a->gl, a->session, &a->frame, PS_GL_SPECULAR_FACES_PER_REFRESH, err);
     if (st != PS_OK)
         return st;
     double t_draw = ps_now_seconds();
+    ps_gl_stats gst = ps_gl_get_stats(a->gl);
+    ps_latency_add(&a->lat, PS_LAT_SPECULAR, t_draw - t_spec - gst.shadow_seconds_last);
+    ps_latency_add(&a->lat, PS_LAT_SHADOWS, gst.shadow_seconds_last);
+    ps_latency_add_faces(&a->lat, gst.shadow_faces_last);
+    ps_gl_clear_shadow_timing(a->gl);
     ps_gl_layers_draw(a->layers, a->gl, &cam, &a->frame);
     if (a->frame.splats > 0)
         ps_gl_finish();
     double draw_seconds = ps_now_seconds() - t_draw;
+    gst = ps_gl_get_stats(a->gl);
+    ps_latency_add(&a->lat, PS_LAT_SHADOWS, gst.shadow_seconds_last);
+    ps_latency_add_faces(&a->lat, gst.shadow_faces_last);
+    ps_latency_add(&a->lat, PS_LAT_DRAW, draw_seconds - gst.shadow_seconds_last);
+    double t_layer = ps_now_seconds();
     if ((st = ps_gl_specular_layer(a->spec, a->layers, a->gl, a->session, &a->frame, err)) != PS_OK)
         return st;
+    ps_latency_add(&a->lat, PS_LAT_SHOW, ps_now_seconds() - t_layer);
     double gains[PS_MAP_COUNT];
     for (int k = 0; k < PS_MAP_COUNT; k++)
         gains[k] = a->frame.map[k].gain;
@@ -488,6 +503,7 @@ static ps_status refresh(app *a, ps_error *err)
     else if ((st = ps_gl_layers_show_by_cpu(a->layers, a->frame.direct_gain, gains, err)) != PS_OK)
         return st;
     ps_gl_finish();
+    ps_latency_add(&a->lat, PS_LAT_SHOW, ps_now_seconds() - t_show);
     a->show_sum += ps_now_seconds() - t_show;
     a->show_count++;
     draw_overlay(a);
@@ -504,11 +520,7 @@ static ps_status refresh(app *a, ps_error *err)
         a->t_first_frame = t1;
         a->first_frame_seconds = t1 - a->start_time;
     } else if (a->awaiting_edit_frame) {
-        double latency = t1 - a->edit_time;
-        a->edit_latency_sum += latency;
-        a->edit_latency_count++;
-        if (latency > a->edit_latency_max)
-            a->edit_latency_max = latency;
+        ps_latency_commit(&a->lat, t1);
     }
     a->awaiting_edit_frame = false;
     if (a->frame.moving) {
@@ -594,18 +606,31 @@ static void report(app *a, ps_status st, const ps_error *err)
         say(a, err->msg);
 }
 
+/* An edit's clock starts before its call, which may wait for the tracing
+ * thread's batch in flight (app/latency.h). */
+static double edit_begin(app *a)
+{
+    double t = ps_now_seconds();
+    ps_latency_begin(&a->lat, t);
+    return t;
+}
+
+static void edit_end(app *a, double t) { ps_latency_add(&a->lat, PS_LAT_HOLD, ps_now_seconds() - t); }
+
 /* Moves the selection by d. */
 static void move_selection(app *a, ps_vec3 d)
 {
     ps_error err;
     size_t n;
     ps_status st = PS_OK;
+    double t = edit_begin(a);
     if (a->sel_kind == SEL_LIGHT) {
         const ps_light *L = &ps_scene_lights(ps_session_scene(a->session), &n)[a->sel_index];
         st = ps_session_move_light(a->session, a->sel_index, ps_v3_add(L->position, d), &err);
     } else if (a->sel_kind == SEL_OBJECT) {
         st = ps_session_move_object(a->session, a->sel_index, d, &err);
     }
+    edit_end(a, t);
     report(a, st, &err);
 }
 
@@ -682,7 +707,10 @@ static void scale_power(app *a, double f)
         return;
     const ps_light *L = &ps_scene_lights(ps_session_scene(a->session), &n)[a->sel_index];
     ps_error err;
-    report(a, ps_session_set_light_power(a->session, a->sel_index, ps_rgb_scale(L->power, f), &err), &err);
+    double t = edit_begin(a);
+    ps_status st = ps_session_set_light_power(a->session, a->sel_index, ps_rgb_scale(L->power, f), &err);
+    edit_end(a, t);
+    report(a, st, &err);
 }
 
 static void step_angle(app *a, double d)
@@ -695,7 +723,10 @@ static void step_angle(app *a, double d)
         return;
     ps_error err;
     double want = fmin(90.0, fmax(KEY_ANGLE_STEP, L->angle_deg + d));
-    report(a, ps_session_set_spot_angle(a->session, a->sel_index, want, &err), &err);
+    double t = edit_begin(a);
+    ps_status st = ps_session_set_spot_angle(a->session, a->sel_index, want, &err);
+    edit_end(a, t);
+    report(a, st, &err);
 }
 
 /* ---- settings (keys and scripts) --------------------------------------------------- */
@@ -891,25 +922,39 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
     (void)ps_scene_lights(ps_session_scene(a->session), &nl);
     (void)ps_scene_objects(ps_session_scene(a->session), &no);
     ps_session *s = a->session;
+    ps_status st;
+    double t;
     switch (act->kind) {
     case PS_SCRIPT_SCREENSHOT:
         return screenshot(a, act->path, false, err);
     case PS_SCRIPT_MOVE_LIGHT:
         if (check_index(a, act, "move light", "lights", nl, err) != PS_OK)
             return err->status;
-        return ps_session_move_light(s, act->index, act->v, err);
+        t = edit_begin(a);
+        st = ps_session_move_light(s, act->index, act->v, err);
+        edit_end(a, t);
+        return st;
     case PS_SCRIPT_MOVE_OBJECT:
         if (check_index(a, act, "move object", "objects", no, err) != PS_OK)
             return err->status;
-        return ps_session_move_object(s, act->index, act->v, err);
+        t = edit_begin(a);
+        st = ps_session_move_object(s, act->index, act->v, err);
+        edit_end(a, t);
+        return st;
     case PS_SCRIPT_POWER:
         if (check_index(a, act, "power light", "lights", nl, err) != PS_OK)
             return err->status;
-        return ps_session_set_light_power(s, act->index, act->power, err);
+        t = edit_begin(a);
+        st = ps_session_set_light_power(s, act->index, act->power, err);
+        edit_end(a, t);
+        return st;
     case PS_SCRIPT_ANGLE:
         if (check_index(a, act, "angle light", "lights", nl, err) != PS_OK)
             return err->status;
-        return ps_session_set_spot_angle(s, act->index, act->number, err);
+        t = edit_begin(a);
+        st = ps_session_set_spot_angle(s, act->index, act->number, err);
+        edit_end(a, t);
+        return st;
     case PS_SCRIPT_ORBIT:
         orbit(a, act->yaw, act->pitch);
         return PS_OK;
@@ -922,7 +967,7 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
         return PS_OK;
     case PS_SCRIPT_DUMP_PHOTONS: {
         const ps_photon_map *maps = ps_session_lock_maps(s);
-        ps_status st = ps_write_photon_dump(act->path, maps, err);
+        st = ps_write_photon_dump(act->path, maps, err);
         ps_session_unlock_maps(s);
         return st;
     }
@@ -1046,8 +1091,10 @@ static ps_status session(app *a, ps_error *err)
              * that came since the last refresh (a drag's mouse events) are
              * applied together. The latency counts the repair. */
             a->edit_time = ps_now_seconds();
+            ps_latency_begin(&a->lat, a->edit_time); /* an undo's, a drag's: from here */
             ps_work_before_update(&a->work, ps_session_scene(a->session));
             st = apply_edits(a, err);
+            ps_latency_add(&a->lat, PS_LAT_UPDATE, ps_now_seconds() - a->edit_time);
             if (st == PS_OK)
                 st = ps_work_after_update(&a->work, ps_session_scene(a->session), ps_now_seconds(), err);
             a->awaiting_edit_frame = true;
@@ -1108,9 +1155,7 @@ static ps_status write_stats(app *a, ps_error *err)
     ps_stats_add(&rs, "frame_seconds", a->frame_seconds);
     ps_stats_add(&rs, "first_frame_seconds", a->first_frame_seconds);
     ps_stats_add(&rs, "edits", a->session ? (double)ps_session_edits(a->session) : 0.0);
-    ps_stats_add(&rs, "edit_to_frame_seconds_max", a->edit_latency_max);
-    ps_stats_add(&rs, "edit_to_frame_seconds_mean",
-                 a->edit_latency_count ? a->edit_latency_sum / (double)a->edit_latency_count : 0.0);
+    ps_latency_stats(&a->lat, &rs);
     ps_stats_add(&rs, "tau", set ? set->tau : a->o.p.tau);
     ps_stats_add(&rs, "moving_frames", (double)a->moving_frames);
     ps_stats_add(&rs, "moving_frame_seconds_mean", a->moving_frames ? a->moving_seconds / (double)a->moving_frames : 0.0);
@@ -1148,7 +1193,12 @@ int main(int argc, char **argv)
     ps_status st = ps_check_outputs(&a.o.c, &err);
     for (size_t i = 0; st == PS_OK && a.script && i < ps_script_count(a.script); i++) {
         const ps_script_action *act = ps_script_at(a.script, i);
-        if (act->path)
+        if (act->kind == PS_SCRIPT_SCREENSHOT && ps_script_path_is_radiance(act->path))
+            st = ps_error_at(&err, PS_ERR_PARSE, a.o.script, act->line,
+                             "screenshot %s: the window shows 8-bit codes and writes PNG (linear radiance, .pfm "
+                             "or .exr: photosplat-snap --script)",
+                             act->path);
+        else if (act->path)
             st = ps_check_output_path(act->path, &err);
     }
     if (st == PS_OK)

@@ -15,7 +15,13 @@ struct ps_gl_renderer {
     /* shadow[i][f]: GL light i's depth texture of cube face f (0: none yet). */
     GLuint (*shadow)[PS_CUBE_FACES];
     size_t shadow_lights; /* lights that shadow[] has room for */
-    bool shadows_valid;
+    bool shadows_valid;   /* every lit face of every light is fresh */
+    /* What each light's faces were rendered for, and the depth-only mesh's
+     * objects they saw (gl_lights.c): a new scene keeps the faces no change
+     * can reach, so an edit renders only those. */
+    struct ps_gl_shadow_key *shadow_keys; /* shadow_lights of them */
+    struct ps_gl_object_sig *object_sigs;
+    size_t object_sig_count;
     GLuint fbo, kernel_tex, spot_tex;
     GLuint *profile_tex; /* the IES lights' cube maps, as lights->profiles */
     size_t profile_count;

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/clock.h"
 #include "gl/gl_internal.h"
 
 /* The shadow test's slack for single-precision texgen. GL computes the
@@ -50,18 +51,124 @@ static void face_frame(int f, ps_vec3 *forward, ps_vec3 *right, ps_vec3 *up)
     *up = ps_v3_cross(*right, *forward);
 }
 
+/* A shadow cube's depth range: its near plane, and a far plane beyond the
+ * scene's box as seen from the light. */
+static void face_depth_range(const ps_gl_renderer *r, const ps_preview_light *v, double *znear, double *zfar)
+{
+    double nearest, farthest;
+    ps_gl_box_range(r->in.bounds, v->pos, &nearest, &farthest);
+    *znear = v->shadow_near;
+    *zfar = fmax(farthest * 1.01, 2.0 * *znear);
+}
+
 static void light_face_matrices(const ps_gl_renderer *r, const ps_preview_light *v, int f, double proj[16], double view[16])
 {
     ps_vec3 fw, rt, up;
     face_frame(f, &fw, &rt, &up);
-    double nearest, farthest;
-    ps_gl_box_range(r->in.bounds, v->pos, &nearest, &farthest);
-    double znear = v->shadow_near;
-    ps_gl_mat_perspective(1.0, 1.0, znear, fmax(farthest * 1.01, 2.0 * znear), proj);
+    double znear, zfar;
+    face_depth_range(r, v, &znear, &zfar);
+    ps_gl_mat_perspective(1.0, 1.0, znear, zfar, proj);
     ps_gl_mat_look(v->pos, fw, rt, up, view);
 }
 
-void ps_gl_lights_free(ps_gl_renderer *r)
+/* ---- which faces a new scene must render again --------------------------------
+ *
+ * A face's depths are a function of its matrices (the light's position, near
+ * and far planes: the key) and of the triangles inside its frustum; the
+ * depth test keeps each texel's minimum, whatever the order they are drawn
+ * in. So after a new scene a face stays as it is, texel for texel, when its
+ * key is bit for bit the same and no object that changed (its triangles'
+ * positions, compared by a hash and their box) lies in its frustum at its
+ * old place or its new one. Changing a light's power or colour renders no
+ * face; moving an object renders only the faces that see it; moving a light
+ * renders all of its own. */
+
+typedef struct ps_gl_shadow_key {
+    ps_vec3 pos;
+    double znear, zfar;
+    unsigned fresh; /* faces whose texture holds this key's depths */
+} ps_gl_shadow_key;
+
+/* One object's triangles in the depth-only mesh. */
+typedef struct ps_gl_object_sig {
+    ps_aabb box;
+    size_t vertices; /* 0: the mesh has no triangles of it */
+    uint64_t hash;   /* FNV-1a over its positions' bits, in mesh order */
+} ps_gl_object_sig;
+
+/* A face's frustum is widened by this many shadow texels on each side
+ * before it is tested against a box: a triangle can only write a texel
+ * whose centre it covers, half a texel inside the face's edge, so a texel's
+ * slack is far beyond GL's single-precision clipping error. */
+#define SHADOW_FACE_SLACK_TEXELS 2.0
+
+static uint64_t fnv_bytes(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ b[i]) * 0x100000001b3ull;
+    return h;
+}
+
+/* The signatures of mesh m's objects, *count of them (the largest object
+ * index + 1); NULL with *count 0 when out of memory or empty. */
+static ps_gl_object_sig *object_sigs(const ps_preview_mesh *m, size_t *count)
+{
+    *count = 0;
+    size_t n = 0;
+    for (size_t i = 0; i < m->range_count; i++)
+        if ((size_t)m->ranges[i].object + 1 > n)
+            n = (size_t)m->ranges[i].object + 1;
+    if (n == 0)
+        return NULL;
+    ps_gl_object_sig *sig = calloc(n, sizeof *sig);
+    if (!sig)
+        return NULL;
+    for (size_t o = 0; o < n; o++) {
+        sig[o].box = ps_aabb_empty();
+        sig[o].hash = 0xcbf29ce484222325ull;
+    }
+    for (size_t i = 0; i < m->range_count; i++) {
+        const ps_mesh_range *rg = &m->ranges[i];
+        ps_gl_object_sig *g = &sig[rg->object];
+        const float *p = m->positions + 3 * rg->first;
+        g->hash = fnv_bytes(g->hash, p, 3 * rg->count * sizeof *p);
+        g->vertices += rg->count;
+        for (size_t k = 0; k < rg->count; k++)
+            g->box = ps_aabb_point(g->box, ps_v3(p[3 * k], p[3 * k + 1], p[3 * k + 2]));
+    }
+    *count = n;
+    return sig;
+}
+
+static bool same_sig(const ps_gl_object_sig *a, const ps_gl_object_sig *b)
+{
+    return a->vertices == b->vertices && a->hash == b->hash && memcmp(&a->box, &b->box, sizeof a->box) == 0;
+}
+
+/* Whether box b can meet face f's frustum of a light at pos: false only
+ * when all its corners lie outside one of the four side planes (widened by
+ * `slack`, a tangent), or behind the light. */
+static bool box_meets_face(ps_aabb b, ps_vec3 pos, int f, double slack)
+{
+    ps_vec3 fw, rt, up;
+    face_frame(f, &fw, &rt, &up);
+    double k = 1.0 + slack;
+    ps_vec3 planes[5] = {ps_v3_sub(ps_v3_scale(fw, k), rt), ps_v3_add(ps_v3_scale(fw, k), rt),
+                         ps_v3_sub(ps_v3_scale(fw, k), up), ps_v3_add(ps_v3_scale(fw, k), up), fw};
+    for (int p = 0; p < 5; p++) {
+        bool any_inside = false;
+        for (int c = 0; c < 8 && !any_inside; c++) {
+            ps_vec3 q = ps_v3(c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z);
+            any_inside = ps_v3_dot(planes[p], ps_v3_sub(q, pos)) >= 0.0;
+        }
+        if (!any_inside)
+            return false;
+    }
+    return true;
+}
+
+static void free_shadows(ps_gl_renderer *r)
 {
     for (size_t i = 0; i < r->shadow_lights; i++)
         for (int f = 0; f < PS_CUBE_FACES; f++)
@@ -69,33 +176,110 @@ void ps_gl_lights_free(ps_gl_renderer *r)
                 glDeleteTextures(1, &r->shadow[i][f]);
     free(r->shadow);
     r->shadow = NULL;
+    free(r->shadow_keys);
+    r->shadow_keys = NULL;
     r->shadow_lights = 0;
     r->shadows_valid = false;
+}
+
+static void free_profiles(ps_gl_renderer *r)
+{
     if (r->profile_count)
         glDeleteTextures((GLsizei)r->profile_count, r->profile_tex);
     free(r->profile_tex);
     r->profile_tex = NULL;
     r->profile_count = 0;
+}
+
+void ps_gl_lights_free(ps_gl_renderer *r)
+{
+    free_shadows(r);
+    free(r->object_sigs);
+    r->object_sigs = NULL;
+    r->object_sig_count = 0;
+    free_profiles(r);
     if (r->spot_tex)
         glDeleteTextures(1, &r->spot_tex);
     r->spot_tex = 0;
 }
 
+/* The faces of the kept shadow cubes that stay fresh under the new scene
+ * (r->in), given the old objects' signatures. */
+static void keep_fresh_faces(ps_gl_renderer *r, const ps_gl_object_sig *old, size_t old_count)
+{
+    const ps_preview_lights *L = lights_of(r);
+    const ps_gl_object_sig *now = r->object_sigs;
+    size_t n = old_count > r->object_sig_count ? old_count : r->object_sig_count;
+    double slack = SHADOW_FACE_SLACK_TEXELS * 2.0 / r->shadow_size; /* texels to a tangent: the face spans 2 */
+    for (size_t i = 0; i < r->shadow_lights; i++) {
+        const ps_preview_light *v = &L->lights[i];
+        ps_gl_shadow_key *k = &r->shadow_keys[i];
+        double znear, zfar;
+        face_depth_range(r, v, &znear, &zfar);
+        if (memcmp(&k->pos, &v->pos, sizeof v->pos) != 0 || k->znear != znear || k->zfar != zfar) {
+            k->pos = v->pos;
+            k->znear = znear;
+            k->zfar = zfar;
+            k->fresh = 0;
+            continue;
+        }
+        for (size_t o = 0; o < n && k->fresh; o++) {
+            const ps_gl_object_sig *a = o < old_count ? &old[o] : NULL, *b = o < r->object_sig_count ? &now[o] : NULL;
+            if (a && b && same_sig(a, b))
+                continue;
+            for (int f = 0; f < PS_CUBE_FACES; f++)
+                if ((k->fresh & (1u << f)) && ((a && a->vertices && box_meets_face(a->box, v->pos, f, slack)) ||
+                                               (b && b->vertices && box_meets_face(b->box, v->pos, f, slack))))
+                    k->fresh &= ~(1u << f);
+        }
+    }
+}
+
+static bool all_fresh(const ps_gl_renderer *r)
+{
+    for (size_t i = 0; i < r->shadow_lights; i++) {
+        unsigned faces = lights_of(r)->lights[i].faces;
+        if ((faces & ~r->shadow_keys[i].fresh) != 0)
+            return false;
+    }
+    return true;
+}
+
 ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err)
 {
-    GLuint spot = r->spot_tex;
-    r->spot_tex = 0; /* kept: it does not depend on the lights */
-    ps_gl_lights_free(r);
-    r->spot_tex = spot;
+    free_profiles(r);
     size_t n = lights_of(r)->count;
-    r->stats.virtual_lights = 0;
+    r->stats.virtual_lights = (unsigned)n;
+    ps_gl_object_sig *old = r->object_sigs;
+    size_t old_count = r->object_sig_count;
+    r->object_sigs = object_sigs(r->in.coarse, &r->object_sig_count);
+    /* The same number of GL lights: their textures are kept, and so are the
+     * faces no change can reach. Otherwise (or without the signatures, out
+     * of memory) every face is rendered again. */
+    if (n > 0 && n == r->shadow_lights && old && r->object_sigs) {
+        keep_fresh_faces(r, old, old_count);
+    } else {
+        free_shadows(r);
+        if (n > 0) {
+            r->shadow = calloc(n, sizeof *r->shadow);
+            r->shadow_keys = calloc(n, sizeof *r->shadow_keys);
+            if (!r->shadow || !r->shadow_keys) {
+                free(old);
+                free_shadows(r);
+                return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the shadow maps of %zu GL lights", n);
+            }
+            r->shadow_lights = n;
+            for (size_t i = 0; i < n; i++) {
+                ps_gl_shadow_key *k = &r->shadow_keys[i];
+                k->pos = lights_of(r)->lights[i].pos;
+                face_depth_range(r, &lights_of(r)->lights[i], &k->znear, &k->zfar);
+            }
+        }
+    }
+    free(old);
+    r->shadows_valid = all_fresh(r);
     if (n == 0)
         return PS_OK;
-    r->shadow = calloc(n, sizeof *r->shadow);
-    if (!r->shadow)
-        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the shadow maps of %zu GL lights", n);
-    r->shadow_lights = n;
-    r->stats.virtual_lights = (unsigned)n;
     const ps_preview_lights *L = lights_of(r);
     if (L->profile_count) {
         r->profile_tex = calloc(L->profile_count, sizeof *r->profile_tex);
@@ -120,8 +304,18 @@ ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err)
     return PS_OK;
 }
 
+void ps_gl_clear_shadow_timing(ps_gl_renderer *r)
+{
+    r->stats.shadow_faces_last = 0;
+    r->stats.shadow_seconds_last = 0.0;
+}
+
 void ps_gl_make_shadow_maps(ps_gl_renderer *r)
 {
+    /* Timed between two finishes: GL works behind the calls. */
+    glFinish();
+    double t0 = ps_now_seconds();
+    unsigned faces = 0;
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
@@ -136,8 +330,9 @@ void ps_gl_make_shadow_maps(ps_gl_renderer *r)
     for (size_t i = 0; i < r->shadow_lights; i++) {
         const ps_preview_light *v = &lights_of(r)->lights[i];
         GLuint *shadow = r->shadow[i];
+        ps_gl_shadow_key *key = &r->shadow_keys[i];
         for (int f = 0; f < PS_CUBE_FACES; f++) {
-            if (!(v->faces & (1u << f)))
+            if (!(v->faces & (1u << f)) || (key->fresh & (1u << f)))
                 continue;
             if (!shadow[f]) {
                 glGenTextures(1, &shadow[f]);
@@ -160,7 +355,9 @@ void ps_gl_make_shadow_maps(ps_gl_renderer *r)
             glMatrixMode(GL_MODELVIEW);
             glLoadMatrixd(view);
             ps_gl_draw_mesh(r, false, false);
+            key->fresh |= 1u << f;
             r->stats.shadow_maps++;
+            faces++;
         }
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
@@ -168,6 +365,9 @@ void ps_gl_make_shadow_maps(ps_gl_renderer *r)
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     glBindTexture(GL_TEXTURE_2D, 0);
     r->shadows_valid = true;
+    glFinish();
+    r->stats.shadow_faces_last += faces;
+    r->stats.shadow_seconds_last += ps_now_seconds() - t0;
 }
 
 /* Emissive faces (MTL Ke) as their own radiance, front side only. */
@@ -344,6 +544,12 @@ static void disable_texgen(void)
     glDisable(GL_TEXTURE_GEN_Q);
 }
 
+/* A shadowed pass's clip planes: the near plane, then the four sides of the
+ * face's pyramid (GL_CLIP_PLANE2 is the spot's; GL has at least six). */
+#define FACE_CLIP_PLANES 5
+static const GLenum face_clip_planes[FACE_CLIP_PLANES] = {GL_CLIP_PLANE1, GL_CLIP_PLANE0, GL_CLIP_PLANE3,
+                                                          GL_CLIP_PLANE4, GL_CLIP_PLANE5};
+
 void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows)
 {
     glEnable(GL_LIGHTING);
@@ -374,8 +580,8 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows)
         }
         glEnable(GL_TEXTURE_2D);
         glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
-        glEnable(GL_CLIP_PLANE0);
-        glEnable(GL_CLIP_PLANE1);
+        for (int c = 0; c < FACE_CLIP_PLANES; c++)
+            glEnable(face_clip_planes[c]);
         for (int f = 0; f < PS_CUBE_FACES; f++) {
             if (!(v->faces & (1u << f)))
                 continue;
@@ -383,22 +589,33 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows)
             double proj[16], view[16];
             light_face_matrices(r, v, f, proj, view);
             set_shadow_texgen(proj, view, SHADOW_TEXGEN_ULPS * FLOAT_ULP * (r->eye_extent + ps_v3_len(v->pos)));
-            /* Only the half-space in front of the face: behind the light the
-             * projection would fold points back into the map. */
-            GLdouble plane[4] = {axis.x, axis.y, axis.z, -ps_v3_dot(axis, v->pos)};
-            glClipPlane(GL_CLIP_PLANE0, plane);
+            /* Only the face's own pyramid, a little widened: outside its
+             * square the map's border (depth 0) lights nothing, so those
+             * pixels need not be drawn (about a third of the fill of the
+             * half-space in front of the face, which the pyramid lies in:
+             * behind the light the projection would fold points back into
+             * the map). */
+            ps_vec3 fw, rt, up;
+            face_frame(f, &fw, &rt, &up);
+            double k = 1.0 + SHADOW_FACE_SLACK_TEXELS * 2.0 / r->shadow_size;
+            const ps_vec3 sides[4] = {ps_v3_sub(ps_v3_scale(fw, k), rt), ps_v3_add(ps_v3_scale(fw, k), rt),
+                                      ps_v3_sub(ps_v3_scale(fw, k), up), ps_v3_add(ps_v3_scale(fw, k), up)};
+            for (int c = 0; c < 4; c++) {
+                GLdouble side[4] = {sides[c].x, sides[c].y, sides[c].z, -ps_v3_dot(sides[c], v->pos)};
+                glClipPlane(face_clip_planes[1 + c], side);
+            }
             /* Nor what lies nearer than the near plane: outside the face's
              * square its depth would pass the test against the border's 0.
              * Every point this face owns lies beyond (at least nearest /
              * sqrt 3 > PS_SHADOW_NEAR_SHARE * nearest away along the axis). */
-            plane[3] -= v->shadow_near;
-            glClipPlane(GL_CLIP_PLANE1, plane);
+            GLdouble plane[4] = {axis.x, axis.y, axis.z, -ps_v3_dot(axis, v->pos) - v->shadow_near};
+            glClipPlane(face_clip_planes[0], plane);
             glBindTexture(GL_TEXTURE_2D, r->shadow[i][f]);
             ps_gl_draw_mesh(r, true, false);
             r->stats.light_passes++;
         }
-        glDisable(GL_CLIP_PLANE0);
-        glDisable(GL_CLIP_PLANE1);
+        for (int c = 0; c < FACE_CLIP_PLANES; c++)
+            glDisable(face_clip_planes[c]);
         disable_texgen();
         glBindTexture(GL_TEXTURE_2D, 0);
         glDisable(GL_TEXTURE_2D);

@@ -158,10 +158,16 @@ void ps_gl_show_rgb8(int width, int height, const uint8_t *rgb);
 ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT],
                                  ps_image *out, ps_error *err);
 
-/* What ran: shadow maps made so far and lighting passes in the last frame. */
+/* What ran: shadow maps made so far and lighting passes in the last frame;
+ * the faces the last shadow-map pass rendered (only those whose depths can
+ * have changed, gl_lights.c) and its seconds (0 when no pass ran since the
+ * caller last reset them with ps_gl_clear_shadow_timing). */
 typedef struct ps_gl_stats {
     unsigned shadow_maps, light_passes, virtual_lights;
+    unsigned shadow_faces_last;
+    double shadow_seconds_last;
 } ps_gl_stats;
+void ps_gl_clear_shadow_timing(ps_gl_renderer *r);
 ps_gl_stats ps_gl_get_stats(const ps_gl_renderer *r);
 
 #endif

@@ -4,6 +4,7 @@
 
 #include "preview/illummap.h"
 
+#include <ctype.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -459,4 +460,21 @@ size_t ps_script_count(const ps_script *s) { return s ? s->count : 0; }
 const ps_script_action *ps_script_at(const ps_script *s, size_t i)
 {
     return s && i < s->count ? &s->actions[i] : NULL;
+}
+
+/* Either case, as ps_path_is_exr takes .EXR. */
+static bool ends_with_nocase(const char *s, const char *tail)
+{
+    size_t n = strlen(s), m = strlen(tail);
+    if (n < m)
+        return false;
+    for (size_t i = 0; i < m; i++)
+        if (tolower((unsigned char)s[n - m + i]) != tail[i])
+            return false;
+    return true;
+}
+
+bool ps_script_path_is_radiance(const char *path)
+{
+    return ends_with_nocase(path, ".pfm") || ends_with_nocase(path, ".exr");
 }

@@ -9,7 +9,11 @@
  * allowed. The actions:
  *     screenshot PATH                  PNG of the window as shown; PATH as given
  *                                      (relative to the current directory), no
- *                                      spaces, at most 4095 characters
+ *                                      spaces, at most 4095 characters. In
+ *                                      photosplat-snap --script a PATH ending in
+ *                                      .pfm or .exr writes the picture's linear
+ *                                      radiance instead (the window refuses
+ *                                      those: it shows 8-bit codes)
  *     move light INDEX X Y Z           light INDEX (scene order) to a new position
  *     move object INDEX DX DY DZ       object INDEX (scene order) translated
  *     set splat points|triangles|sprites
@@ -46,6 +50,7 @@
 #ifndef PS_PREVIEW_SCRIPT_H
 #define PS_PREVIEW_SCRIPT_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -121,5 +126,9 @@ size_t ps_script_count(const ps_script *s);
 /* The i-th action in time order; equal times keep file order. NULL when
  * i >= ps_script_count(s). */
 const ps_script_action *ps_script_at(const ps_script *s, size_t i);
+
+/* A screenshot path for linear radiance: its name ends in .pfm or .exr
+ * (either case). */
+bool ps_script_path_is_radiance(const char *path);
 
 #endif

@@ -1,0 +1,204 @@
+/* test_gl_shadow_faces.c: after an edit the renderer renders again only the
+ * shadow-cube faces whose depths can have changed (gl_lights.c), and the
+ * direct layer it then draws is the same, float for float, as a fresh
+ * renderer's of the edited scene. Under OSMesa, float colour buffer.
+ *
+ * The scene: a floor at y = 0, a small square occluder at y = 0.5 and a
+ * point light at y = 1 above it, a smaller square 0.2 above the light (the
+ * nearest geometry, which sets the cube's near plane, stays where it is).
+ * The light's cube has 6 faces; the occluder
+ * lies in the -y face only, so moving it a little renders that face alone;
+ * moving it out to the side (direction (1.5, -0.5) from the light: the +x
+ * face) renders the face it left and the one it entered; a power change
+ * renders none; a moved light all of its own. */
+#include "test.h"
+
+#include <GL/osmesa.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_render.h"
+#include "preview/lights.h"
+#include "preview/mesh.h"
+#include "preview/splat.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+static const char *const scene_text = "camera eye 0 3 0.01 target 0 0 0 up 0 0 -1 fov 70\n"
+                                      "material floor diffuse albedo 0.5 0.5 0.5\n"
+                                      "quad corner -2 0 2 edge1 4 0 0 edge2 0 0 -4 material floor\n"
+                                      "quad corner -0.1 0.5 -0.1 edge1 0.2 0 0 edge2 0 0 0.2 material floor\n"
+                                      "quad corner -0.05 1.2 -0.05 edge1 0.1 0 0 edge2 0 0 0.1 material floor\n"
+                                      "light point position 0 1 0 power 100 100 100\n";
+
+#define W 96
+#define H 96
+
+/* The GL-free inputs of a renderer: built from the scene as the session does. */
+typedef struct inputs {
+    ps_preview_mesh mesh, coarse;
+    ps_preview_lights lights;
+} inputs;
+
+static void inputs_make(const ps_scene *s, inputs *in)
+{
+    ps_error err;
+    memset(in, 0, sizeof *in);
+    ps_mesh_options mo = ps_mesh_default_options(s);
+    assert_int_equal(ps_preview_mesh_build(s, &mo, &in->mesh, &err), PS_OK);
+    mo.max_edge = HUGE_VAL;
+    assert_int_equal(ps_preview_mesh_build(s, &mo, &in->coarse, &err), PS_OK);
+    assert_int_equal(ps_preview_lights_build(s, NULL, &in->coarse, PS_GL_SHADOW_SIZE, PS_PREVIEW_AREA_SIDE,
+                                             &in->lights, &err),
+                     PS_OK);
+}
+
+static void inputs_free(inputs *in)
+{
+    ps_preview_mesh_free(&in->mesh);
+    ps_preview_mesh_free(&in->coarse);
+    ps_preview_lights_free(&in->lights);
+}
+
+static ps_gl_scene gl_scene(const ps_scene *s, const inputs *in)
+{
+    size_t nmat;
+    ps_gl_scene gs = {&in->mesh, &in->coarse, ps_scene_materials(s, &nmat), &in->lights, ps_scene_bounds(s), false, s};
+    return gs;
+}
+
+/* The direct layer with shadows, read back. */
+static ps_image draw(ps_gl_renderer *r, const ps_scene *s)
+{
+    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(s), W, H);
+    ps_gl_begin_frame(r, &cam, 1.0, true);
+    ps_image img;
+    ps_error err;
+    assert_int_equal(ps_gl_read(r, &img, &err), PS_OK);
+    return img;
+}
+
+static bool same_pixels(const ps_image *a, const ps_image *b)
+{
+    return a->width == b->width && a->height == b->height &&
+           memcmp(a->rgb, b->rgb, sizeof(float) * 3 * (size_t)a->width * (size_t)a->height) == 0;
+}
+
+typedef enum edit_kind { MOVE_OCCLUDER_A_LITTLE, MOVE_OCCLUDER_ASIDE, POWER, MOVE_LIGHT } edit_kind;
+
+static void apply(ps_scene *s, edit_kind e)
+{
+    ps_error err;
+    switch (e) {
+    case MOVE_OCCLUDER_A_LITTLE: assert_int_equal(ps_scene_translate_object(s, 1, ps_v3(0.2, 0, 0), &err), PS_OK); break;
+    case MOVE_OCCLUDER_ASIDE: assert_int_equal(ps_scene_translate_object(s, 1, ps_v3(1.5, 0, 0), &err), PS_OK); break;
+    case POWER: assert_int_equal(ps_scene_set_light_power(s, 0, ps_rgb_make(50, 60, 70), &err), PS_OK); break;
+    case MOVE_LIGHT: assert_int_equal(ps_scene_set_light_position(s, 0, ps_v3(0.3, 1, 0.1), &err), PS_OK); break;
+    }
+}
+
+/* One edit: the faces the renderer rendered again, and its picture against
+ * a fresh renderer's of the edited scene. */
+static void edit_renders(edit_kind e, unsigned expect_faces, bool picture_changes)
+{
+    ps_error err;
+    ps_scene *s;
+    if (ps_scene_load_text(scene_text, "inline.scn", "", NULL, &s, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    float *buffer = malloc(sizeof(float) * 4 * W * H);
+    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    assert_non_null(ctx);
+    assert_true(OSMesaMakeCurrent(ctx, buffer, GL_FLOAT, W, H));
+    ps_kernel_texture kernel;
+    assert_int_equal(ps_kernel_texture_make(PS_KERNEL_BOX, PS_KERNEL_TEXTURE_SIZE, &kernel, &err), PS_OK);
+    ps_gl_options go = {true, true, 0};
+
+    inputs before;
+    inputs_make(s, &before);
+    assert_int_equal(before.lights.count, 1);
+    unsigned lit = (unsigned)__builtin_popcount(before.lights.lights[0].faces);
+    assert_int_equal(lit, 6); /* a point light: the whole cube */
+    ps_gl_scene gs = gl_scene(s, &before);
+    ps_gl_renderer *r;
+    assert_int_equal(ps_gl_renderer_create(&gs, &kernel, &go, &r, &err), PS_OK);
+    ps_gl_clear_shadow_timing(r);
+    ps_image old_pic = draw(r, s);
+    assert_int_equal(ps_gl_get_stats(r).shadow_faces_last, 6);
+
+    /* The edit, the inputs made again, the renderer given them. */
+    apply(s, e);
+    inputs after;
+    inputs_make(s, &after);
+    gs = gl_scene(s, &after);
+    assert_int_equal(ps_gl_renderer_set_scene(r, &gs, &err), PS_OK);
+    inputs_free(&before);
+    ps_gl_clear_shadow_timing(r);
+    ps_image new_pic = draw(r, s);
+    unsigned faces = ps_gl_get_stats(r).shadow_faces_last;
+
+    ps_gl_renderer *fresh;
+    assert_int_equal(ps_gl_renderer_create(&gs, &kernel, &go, &fresh, &err), PS_OK);
+    ps_gl_clear_shadow_timing(fresh);
+    ps_image fresh_pic = draw(fresh, s);
+    assert_int_equal(ps_gl_get_stats(fresh).shadow_faces_last, 6);
+
+    bool same = same_pixels(&new_pic, &fresh_pic), changed = !same_pixels(&old_pic, &new_pic);
+    printf("edit %d: %u of 6 shadow faces rendered again; the picture %s a fresh renderer's, %s the one before\n", (int)e,
+           faces, same ? "equals" : "DIFFERS from", changed ? "differs from" : "equals");
+    assert_int_equal(faces, expect_faces);
+    assert_true(same);
+    assert_true(changed == picture_changes);
+    /* Drawn again with nothing changed: no face at all. */
+    ps_gl_clear_shadow_timing(r);
+    ps_image again = draw(r, s);
+    assert_int_equal(ps_gl_get_stats(r).shadow_faces_last, 0);
+    assert_true(same_pixels(&again, &fresh_pic));
+
+    ps_image_destroy(&again);
+    ps_image_destroy(&old_pic);
+    ps_image_destroy(&new_pic);
+    ps_image_destroy(&fresh_pic);
+    ps_gl_renderer_destroy(fresh);
+    ps_gl_renderer_destroy(r);
+    inputs_free(&after);
+    ps_kernel_texture_free(&kernel);
+    OSMesaDestroyContext(ctx);
+    free(buffer);
+    ps_scene_destroy(s);
+}
+
+static void occluder_moved_a_little(void **state)
+{
+    (void)state;
+    edit_renders(MOVE_OCCLUDER_A_LITTLE, 1, true); /* the -y face alone */
+}
+
+static void occluder_moved_aside(void **state)
+{
+    (void)state;
+    edit_renders(MOVE_OCCLUDER_ASIDE, 2, true); /* the -y face it left and the +x face it entered */
+}
+
+static void power_renders_no_face(void **state)
+{
+    (void)state;
+    edit_renders(POWER, 0, true);
+}
+
+static void moved_light_renders_its_cube(void **state)
+{
+    (void)state;
+    edit_renders(MOVE_LIGHT, 6, true);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(occluder_moved_a_little),
+        cmocka_unit_test(occluder_moved_aside),
+        cmocka_unit_test(power_renders_no_face),
+        cmocka_unit_test(moved_light_renders_its_cube),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
