@@ -17,68 +17,7 @@
 #include "preview/specular_glossy.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
-
-typedef struct rig {
-    ps_scene *scene;
-    ps_session *session;
-    OSMesaContext ctx;
-    float *buffer;
-    ps_gl_renderer *gl;
-    ps_gl_specular *spec;
-    ps_camera_frame cam;
-    int w, h;
-} rig;
-
-static void rig_make(rig *r, const char *text, int w, int h)
-{
-    memset(r, 0, sizeof *r);
-    ps_error err;
-    if (ps_scene_load_text(text, "inline.scn", "", NULL, &r->scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    r->w = w, r->h = h;
-    ps_session_settings set = ps_session_default_settings(r->scene);
-    set.caps[0] = set.caps[1] = 0; /* no photons: the direct light and what the lobes show of it */
-    set.float_buffer = true;
-    set.precision = PS_PRECISION_NONE;
-    assert_int_equal(ps_session_create(r->scene, &set, &r->session, &err), PS_OK);
-    assert_int_equal(ps_session_trace_all(r->session, &err), PS_OK);
-    r->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    assert_non_null(r->ctx);
-    r->buffer = malloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
-    assert_true(OSMesaMakeCurrent(r->ctx, r->buffer, GL_FLOAT, w, h));
-    ps_gl_options go = {true, true, 0};
-    ps_gl_scene gs = ps_gl_scene_of(r->session);
-    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(r->session), &go, &r->gl, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_create(0, &r->spec, &err), PS_OK);
-    r->cam = ps_camera_frame_make(ps_scene_camera(r->scene), w, h);
-}
-
-static void rig_free(rig *r)
-{
-    ps_gl_specular_destroy(r->spec);
-    ps_gl_renderer_destroy(r->gl);
-    OSMesaDestroyContext(r->ctx);
-    free(r->buffer);
-    ps_session_destroy(r->session);
-    ps_scene_destroy(r->scene);
-}
-
-/* The specular layer alone (the scene black, still hiding what lies
- * behind), its cube maps and levels rendered whole unless `filled`. */
-static ps_image specular_alone(rig *r, bool filled)
-{
-    ps_error err;
-    ps_session_frame f;
-    assert_int_equal(ps_session_refresh(r->session, &r->cam, &f, &err), PS_OK);
-    assert_true(f.specular);
-    if (!filled)
-        assert_int_equal(ps_gl_specular_refresh(r->spec, r->gl, r->session, &f, 0, &err), PS_OK);
-    ps_gl_begin_frame(r->gl, &r->cam, 1.0, false);
-    ps_gl_specular_draw(r->spec, r->gl, r->session, 1.0);
-    ps_image img;
-    assert_int_equal(ps_gl_read(r->gl, &img, &err), PS_OK);
-    return img;
-}
+#include "specular_rig.h"
 
 /* A glossy sphere in a furnace (every cube texel radiance 1, the level
  * blurred from them): each pixel shows specular (n . v), the energy of the
@@ -96,7 +35,7 @@ static void furnace(double exponent)
              "light point position 0 3 0 power 1 1 1\n",
              FURNACE_SPECULAR, FURNACE_SPECULAR, FURNACE_SPECULAR, exponent);
     rig r;
-    rig_make(&r, text, 96, 96);
+    rig_make(&r, load_text(text), 96, 96);
     ps_gl_specular_fill(r.spec, r.session, 1.0f);
     ps_image img = specular_alone(&r, true);
     const ps_world *w = ps_session_world(r.session);
@@ -206,7 +145,7 @@ static void glossy_floor_shows_the_wall(void **state)
              FLOOR_SPECULAR, FLOOR_SPECULAR, FLOOR_SPECULAR, FLOOR_EXPONENT, WALL_ALBEDO, WALL_ALBEDO, WALL_ALBEDO, LIGHT_X, LIGHT_Y,
              LIGHT_Z, WALL_POWER, WALL_POWER, WALL_POWER);
     rig r;
-    rig_make(&r, text, 128, 128);
+    rig_make(&r, load_text(text), 128, 128);
     ps_image img = specular_alone(&r, false);
     const ps_world *w = ps_session_world(r.session);
     size_t counted = 0;
