@@ -13,11 +13,11 @@
 # figures come from the window's own --stats.
 #
 # Usage: scripts/bench-window.sh [SECTION...]: only those tables (all by
-# default): fps, specular, moves, global, edits, latency, kinds, relmse.
+# default): fps, specular, orbit, moves, global, edits, latency, kinds, relmse.
 # An unknown one is refused, exit status 2.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-sections=(fps specular moves global edits latency kinds relmse)
+sections=(fps specular orbit moves global edits latency kinds relmse)
 for want in "$@"; do
     case " ${sections[*]} " in
     *" $want "*) ;;
@@ -83,6 +83,23 @@ fi
 
 if want specular; then
 echo
+# The specular layer's cost (issue 15): the same still view with it on and
+# off, in the same run; its cube faces are drawn within a share of tau.
+echo "| layers | fps (still, 10^6 + 2.5 10^5) | frames | first frame s |"
+echo "| --- | ---: | ---: | ---: |"
+for layers in direct,caustic,global direct,caustic,global,specular; do
+    printf '4.5 quit\n' >"$tmp/spec.txt"
+    xvfb-run -a -s "-screen 0 1024x768x24" bin/photosplat "$scene" --size 512x512 --exposure 0.3 --overlay off \
+        --caustic-photons 1000000 --global-photons 250000 --script "$tmp/spec.txt" --layers "$layers" \
+        --stats "$tmp/spec-$layers.json" >/dev/null
+    f=$tmp/spec-$layers.json
+    printf '| %s | %.1f | %s | %.3f |\n' "$layers" "$(stat_of fps "$f")" "$(stat_of frames "$f")" \
+        "$(stat_of first_frame_seconds "$f")"
+done
+fi
+
+if want orbit; then
+echo
 # The camera's level of detail over the full maps (10^6 + 2.5 10^5 photons,
 # GL composite): orbiting a step every 0.05 s for 2.95 s (60 steps), then
 # still until every photon is drawn again. The window's own figures: the
@@ -104,20 +121,6 @@ mf=$(stat_of moving_frame_seconds_mean "$f")
 printf '| 1000000 + 250000 | %s | %.1f | %s | %.3f | %s |\n' "$(stat_of moving_frames "$f")" \
     "$(awk -v n="$(stat_of moving_frames "$f")" 'BEGIN { printf "%.1f", n / 2.95 }')" "$(ms "$mf")" \
     "$(stat_of full_after_stop_seconds "$f")" "$(stat_of tau "$f")"
-echo
-# The specular layer's cost (issue 15): the same still view with it on and
-# off, in the same run; its cube faces are drawn within a share of tau.
-echo "| layers | fps (still, 10^6 + 2.5 10^5) | frames | first frame s |"
-echo "| --- | ---: | ---: | ---: |"
-for layers in direct,caustic,global direct,caustic,global,specular; do
-    printf '4.5 quit\n' >"$tmp/spec.txt"
-    xvfb-run -a -s "-screen 0 1024x768x24" bin/photosplat "$scene" --size 512x512 --exposure 0.3 --overlay off \
-        --caustic-photons 1000000 --global-photons 250000 --script "$tmp/spec.txt" --layers "$layers" \
-        --stats "$tmp/spec-$layers.json" >/dev/null
-    f=$tmp/spec-$layers.json
-    printf '| %s | %.1f | %s | %.3f |\n' "$layers" "$(stat_of fps "$f")" "$(stat_of frames "$f")" \
-        "$(stat_of first_frame_seconds "$f")"
-done
 fi
 
 if want moves; then
