@@ -77,6 +77,19 @@ static double batch_wanted(const ps_splat_batch *b)
     return batch_sum(b) + per * ps_splat_batch_carry(b, 0);
 }
 
+/* A session of set over scene, started in the background, and its first
+ * refresh from the scene's camera (*cam) into *f. */
+static ps_session *start_and_refresh(ps_scene *scene, const ps_session_settings *set, ps_camera_frame *cam,
+                                     ps_session_frame *f)
+{
+    ps_session *s = open_session(scene, set);
+    ps_error err;
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    *cam = camera(scene);
+    refresh(s, cam, f);
+    return s;
+}
+
 /* Waits (at most 10 s) until the feed has ended. */
 static void wait_ended(ps_session *s)
 {
@@ -148,12 +161,9 @@ static void incremental_refresh_splats_each_photon_once(void **state)
     (void)state;
     ps_scene *scene = load();
     ps_session_settings set = settings(scene, true);
-    ps_session *s = open_session(scene, &set);
-    ps_error err;
-    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
-    ps_camera_frame cam = camera(scene);
+    ps_camera_frame cam;
     ps_session_frame f;
-    refresh(s, &cam, &f);
+    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
     assert_true(f.new_view);
     assert_near(f.direct_exposure, 1.0, 0.0);
     assert_near(f.direct_gain, EXPOSURE, 0.0);
@@ -187,6 +197,7 @@ static void incremental_refresh_splats_each_photon_once(void **state)
         assert_int_equal(f.emitted[k], set.caps[k]);
         assert_near(f.map[k].gain, EXPOSURE, 1e-12);
     }
+    ps_error err;
     assert_int_equal(ps_session_stop(s, &err), PS_OK);
     ps_session_destroy(s);
 
@@ -212,12 +223,9 @@ static void budget_bounds_a_refresh(void **state)
     ps_scene *scene = load();
     ps_session_settings set = settings(scene, true);
     set.caps[PS_MAP_CAUSTIC] = 4 * PS_FEED_BATCH;
-    ps_session *s = open_session(scene, &set);
-    ps_error err;
-    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
-    ps_camera_frame cam = camera(scene);
+    ps_camera_frame cam;
     ps_session_frame f;
-    refresh(s, &cam, &f);
+    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
     /* A second per splat: the budget falls to its floor, PS_SESSION_BUDGET_MIN. */
     ps_session_drawn(s, (double)f.splats);
     wait_ended(s);
@@ -238,12 +246,9 @@ static void counter_stops_shooting(void **state)
     ps_session_settings set = settings(scene, false);
     set.precision = PS_PRECISION_COUNTER;
     set.counter_threshold = 1e-6;
-    ps_session *s = open_session(scene, &set);
-    ps_error err;
-    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
-    ps_camera_frame cam = camera(scene);
+    ps_camera_frame cam;
     ps_session_frame f;
-    refresh(s, &cam, &f);
+    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
     assert_true(f.round_off > set.counter_threshold);
     uint64_t at = 0;
     assert_false(ps_session_counter_stopped(s, NULL));
@@ -394,12 +399,9 @@ static void moving_camera_level_of_detail(void **state)
     ps_scene *scene = load();
     ps_session_settings set = settings(scene, true);
     set.caps[PS_MAP_CAUSTIC] = 4 * PS_FEED_BATCH;
-    ps_session *s = open_session(scene, &set);
-    ps_error err;
-    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
-    ps_camera_frame cam = camera(scene);
+    ps_camera_frame cam;
     ps_session_frame f;
-    refresh(s, &cam, &f);
+    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
     assert_false(f.moving); /* the first view is no move */
     ps_session_drawn(s, 100.0); /* slow: the budget at its floor, a batch a refresh */
     wait_ended(s);
@@ -432,12 +434,9 @@ static void moving_growth_held(void **state)
     ps_scene *scene = load();
     ps_session_settings set = settings(scene, true);
     set.caps[PS_MAP_CAUSTIC] = 9 * PS_FEED_BATCH;
-    ps_session *s = open_session(scene, &set);
-    ps_error err;
-    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
-    ps_camera_frame cam = camera(scene);
+    ps_camera_frame cam;
     ps_session_frame f;
-    refresh(s, &cam, &f);
+    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
     ps_session_drawn(s, 100.0); /* the budget at its floor: a batch a refresh */
     wait_ended(s);
     cam.eye.x += 0.05;
@@ -488,12 +487,9 @@ static void after_the_stop_converges_to_the_whole_view(void **state)
     ps_scene *scene = load();
     ps_session_settings set = settings(scene, true);
     set.exposure = 1.0;
-    ps_session *s = open_session(scene, &set);
-    ps_error err;
-    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
-    ps_camera_frame cam = camera(scene);
+    ps_camera_frame cam;
     ps_session_frame f;
-    refresh(s, &cam, &f);
+    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
     ps_session_drawn(s, 100.0);
     wait_ended(s);
     cam.eye.x += 0.05;
@@ -516,6 +512,7 @@ static void after_the_stop_converges_to_the_whole_view(void **state)
     }
     assert_true(ps_session_settled(s));
     assert_true(refreshes > 2); /* spread over refreshes, not one */
+    ps_error err;
     assert_int_equal(ps_session_stop(s, &err), PS_OK);
     ps_session_destroy(s);
 

@@ -11,28 +11,14 @@
 #include <string.h>
 
 #include "photon/tracer.h"
+#include "two_lights.h"
 
 #define N_CAUSTIC 6000
 #define N_GLOBAL 3000
 
 static const char *scene_text(char *buf, size_t size, const char *spot_power)
 {
-    snprintf(buf, size,
-             "camera eye 0 1 3.4 target 0 1 0 up 0 1 0 fov 40\n"
-             "material white diffuse albedo 0.75 0.75 0.75\n"
-             "material red diffuse albedo 0.75 0.25 0.25\n"
-             "material glass dielectric ior 1.5\n"
-             "material mirror mirror reflectance 1 1 1\n"
-             "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
-             "quad corner -1 2 -1 edge1 2 0 0 edge2 0 0 2 material white\n"
-             "quad corner -1 0 -1 edge1 2 0 0 edge2 0 2 0 material white\n"
-             "quad corner -1 0 -1 edge1 0 2 0 edge2 0 0 2 material red\n"
-             "quad corner 1 0 -1 edge1 0 0 2 edge2 0 2 0 material white\n"
-             "sphere center 0.35 0.4 0.2 radius 0.4 material glass\n"
-             "sphere center -0.45 0.35 -0.4 radius 0.35 material mirror\n"
-             "light point position 0 1.9 0 power 100 100 100\n"
-             "light spot position 0.5 1.9 0.3 direction 0 -1 0 angle 40 power %s\n",
-             spot_power);
+    snprintf(buf, size, TWO_LIGHTS_SCENE "%s\n", spot_power);
     return buf;
 }
 

@@ -450,6 +450,24 @@ static void sleep_until(double until)
     nanosleep(&ts, NULL);
 }
 
+/* The snapshot at the end of a progressive run or a script, after status st
+ * of its loop: the feed stopped, everything that arrived drawn once more
+ * (layers: the batches not drawn yet, however many refreshes the budget
+ * takes), and the area lights with all their virtual lights. */
+static ps_status last_picture(snap_run *s, ps_status st, ps_error *err)
+{
+    ps_status stop = ps_session_stop(s->session, st == PS_OK ? err : NULL);
+    if (st == PS_OK)
+        st = stop;
+    ps_session_full_lights(s->session);
+    s->all_faces = true;
+    if (st == PS_OK)
+        st = refresh(s, err);
+    while (st == PS_OK && s->layers && !ps_session_settled(s->session))
+        st = refresh(s, err);
+    return st;
+}
+
 /* Progressive: trace in the background, refresh every tau. As in the window,
  * the first round is traced before the first frame, so that it already shows
  * photons. Time spent writing checkpoints is taken off the clock (the tracer
@@ -503,18 +521,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         if (counts.ended || ps_now_seconds() >= end)
             break;
     }
-    ps_status stop = ps_session_stop(s->session, st == PS_OK ? err : NULL);
-    if (st == PS_OK)
-        st = stop;
-    /* The snapshot: everything that arrived, drawn once more (layers: the
-     * batches not drawn yet, however many refreshes the budget takes), and
-     * the area lights with all their virtual lights. */
-    ps_session_full_lights(s->session);
-    s->all_faces = true;
-    if (st == PS_OK)
-        st = refresh(s, err);
-    while (st == PS_OK && s->layers && !ps_session_settled(s->session))
-        st = refresh(s, err);
+    st = last_picture(s, st, err);
     /* Checkpoints after the end (every cap reached, or the counter stopped
      * the tracer) show the final picture, at the time it was done. */
     double done = ps_now_seconds() - t_start - excluded;
@@ -738,16 +745,7 @@ static ps_status run_script(snap_run *s, double t_start, double *first_frame, ps
             due = now;
         sleep_until(due);
     }
-    ps_status stop = ps_session_stop(s->session, st == PS_OK ? err : NULL);
-    if (st == PS_OK)
-        st = stop;
-    ps_session_full_lights(s->session);
-    s->all_faces = true;
-    if (st == PS_OK)
-        st = refresh(s, err);
-    while (st == PS_OK && s->layers && !ps_session_settled(s->session))
-        st = refresh(s, err);
-    return st;
+    return last_picture(s, st, err);
 }
 
 static ps_status write_stats_and_report(snap_run *s, int width, int height, double t_start, double first_frame,
