@@ -703,17 +703,18 @@ static ps_status run_script(snap_run *s, double t_start, double *first_frame, ps
             t0 = now;
             *first_frame = now - t_start;
         }
-        while (st == PS_OK && !quit && next < count) {
+        /* A wait is over once everything is shown; checked before the next
+         * action, and also when `wait done` was the last one (then the
+         * script ends here: it used to refresh for ever). As the window's:
+         * with float layers the specular layer's last round too (whole
+         * refreshes draw every face). */
+        if (waiting && !ps_session_edited(s->session) && ps_session_settled(s->session) &&
+            (!s->layers || ps_gl_specular_done(s->spec, s->session))) {
+            waiting = false;
+            delay = now - t0 - wait_time;
+        }
+        while (st == PS_OK && !quit && !waiting && next < count) {
             const ps_script_action *act = ps_script_at(o->script, next);
-            if (waiting) {
-                /* As the window's: with float layers the specular layer's
-                 * last round too (whole refreshes draw every face). */
-                if (ps_session_edited(s->session) || !ps_session_settled(s->session) ||
-                    (s->layers && !ps_gl_specular_done(s->spec, s->session)))
-                    break;
-                waiting = false;
-                delay = now - t0 - wait_time;
-            }
             if (act->time + delay > now - t0)
                 break;
             next++;

@@ -24,6 +24,9 @@ struct ps_feed {
     bool store_limited;               /* under lock: ended at max_stored */
     size_t max_stored;                /* 0: no limit */
     bool started;
+    /* Set before the background thread starts: it leaves a repair's merge to
+     * ps_feed_merge (the drawing side's moment), see feed_main. */
+    bool threaded;
     uint64_t next[PS_MAP_COUNT]; /* the feeding thread's: first photon not yet traced */
     uint64_t round;
     pthread_t thread;
@@ -252,11 +255,16 @@ static void *feed_main(void *arg)
         more = round_once(f, &st, &err);
     }
     /* Every photon traced: the maps back in index order, as a fresh trace
-     * of the edited scene has them. */
+     * of the edited scene has them. The background thread leaves that to
+     * ps_feed_merge: a merge reorders what an incremental picture has drawn
+     * only in part, which then starts over from one batch (a picture that
+     * got worse a quarter of a second after an edit, and took seconds to
+     * come back); the drawing side merges once it has drawn every photon,
+     * or is starting over anyway. */
     pthread_mutex_lock(&f->lock);
     bool stopped = f->stop;
     pthread_mutex_unlock(&f->lock);
-    if (st == PS_OK && !stopped)
+    if (st == PS_OK && !stopped && !f->threaded)
         st = merge(f, &err);
     pthread_mutex_lock(&f->lock);
     f->status = st;
@@ -294,8 +302,11 @@ ps_status ps_feed_run(ps_feed *f, ps_error *err)
 
 ps_status ps_feed_start(ps_feed *f, ps_error *err)
 {
-    if (pthread_create(&f->thread, NULL, feed_main, f) != 0)
+    f->threaded = true;
+    if (pthread_create(&f->thread, NULL, feed_main, f) != 0) {
+        f->threaded = false;
         return ps_error_set(err, PS_ERR_NOMEM, "could not start the photon tracing thread");
+    }
     f->started = true;
     return PS_OK;
 }
@@ -488,6 +499,61 @@ static ps_status merge(ps_feed *f, ps_error *err)
     ps_status st = PS_OK;
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
         st = merge_map(f, k, err);
+    return st;
+}
+
+ps_status ps_feed_retrace_for(ps_feed *f, double max_seconds, bool *done, ps_error *err)
+{
+    double t0 = ps_now_seconds(), last = 0.0;
+    ps_status st = PS_OK;
+    bool left = false;
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
+        while (st == PS_OK && f->pending_done[k] < f->pending_count[k] && !f->store_limited) {
+            /* Between batches: stop where the next one, as long as the
+             * last, would pass the time given. */
+            double now = ps_now_seconds();
+            if (now - t0 + last > max_seconds) {
+                left = true;
+                break;
+            }
+            st = retrace_batch(f, k, err);
+            last = ps_now_seconds() - now;
+        }
+    /* Nothing left to retrace: in index order at once, so that the
+     * picture never needs to start over for it. */
+    if (st == PS_OK && !left)
+        st = merge(f, err);
+    f->seconds += ps_now_seconds() - t0;
+    *done = st == PS_OK && !left;
+    return st;
+}
+
+bool ps_feed_merge_pending(const ps_feed *f)
+{
+    if (!f->ended || f->status != PS_OK)
+        return false;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        if (f->repairing[k])
+            return true;
+    return false;
+}
+
+ps_status ps_feed_merge(ps_feed *f, ps_error *err)
+{
+    pthread_mutex_lock(&f->lock);
+    bool pending = ps_feed_merge_pending(f);
+    pthread_mutex_unlock(&f->lock);
+    if (!pending)
+        return PS_OK;
+    /* The thread has ended: nothing else touches the maps but under the
+     * lock merge_map takes to swap them. */
+    ps_status st = merge(f, err);
+    if (st != PS_OK) {
+        pthread_mutex_lock(&f->lock);
+        f->status = st;
+        f->err = *err;
+        pthread_mutex_unlock(&f->lock);
+    }
     return st;
 }
 

@@ -127,5 +127,21 @@ ps_feed_repair_count ps_feed_repair_counts(const ps_feed *f);
 /* Under the lock: how many times a map was reordered (a drawn prefix of it
  * is then not the same photons). */
 uint64_t ps_feed_generation(const ps_feed *f);
+/* A feed traced by its background thread (ps_feed_start) does not put its
+ * maps back in index order when it ends: the drawing side does, with
+ * ps_feed_merge, when a reorder costs its picture nothing (every photon
+ * drawn, or a new view). ps_feed_run and ps_feed_stop merge themselves.
+ * Under the lock: whether the feed has ended with a map still in repair
+ * order. */
+bool ps_feed_merge_pending(const ps_feed *f);
+/* Before run, prime or start of a repaired feed: its retrace (the pending
+ * indices, PS_FEED_BATCH at a time) on the calling thread for at most about
+ * max_seconds (checked between batches); once all is retraced the maps are
+ * put in index order at once (*done true), else the rest is the thread's. */
+ps_status ps_feed_retrace_for(ps_feed *f, double max_seconds, bool *done, ps_error *err);
+/* Not under the lock: once the feed has ended, its maps in index order (a
+ * no-op when none is in repair order); counts a generation per map
+ * reordered. On an error (out of memory) the feed's status is it. */
+ps_status ps_feed_merge(ps_feed *f, ps_error *err);
 
 #endif

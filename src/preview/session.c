@@ -501,6 +501,13 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         s->view_dirty = true;
     }
     out->moving = s->moving;
+    /* A repair's maps back in index order (feed.h) before a view that starts
+     * over anyway: it then draws a prefix of index order, as a fresh trace's. */
+    if (s->view_dirty) {
+        ps_status mst = ps_feed_merge(s->feed, err);
+        if (mst != PS_OK)
+            return mst;
+    }
     ps_feed_lock(s->feed);
     uint64_t gen = ps_feed_generation(s->feed);
     if (gen != s->feed_gen) {
@@ -603,13 +610,18 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         lost += b->lost;
         out->splats += b->splats;
     }
-    if (s->catch_up) { /* the view is whole again once every stored photon is drawn */
-        bool whole = true;
-        for (int k = 0; k < PS_MAP_COUNT; k++)
-            whole = whole && s->drawn[k] >= maps[k].count;
+    bool whole = true;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        whole = whole && s->drawn[k] >= maps[k].count;
+    if (s->catch_up) /* the view is whole again once every stored photon is drawn */
         s->catch_up = !whole && !s->moving;
-    }
+    bool merge = whole && ps_feed_merge_pending(s->feed);
     ps_feed_unlock(s->feed);
+    /* Every photon of a repaired feed drawn: its maps back in index order
+     * now costs the picture nothing (the next refresh sees the whole map
+     * drawn, and keeps the layers). */
+    if (merge && st == PS_OK)
+        st = ps_feed_merge(s->feed, err);
     s->round_off = wanted > 0.0 ? lost / wanted : 0.0;
     s->last_splats = out->splats;
     s->last_build = ps_now_seconds() - t0;
@@ -698,7 +710,8 @@ bool ps_session_settled(ps_session *s)
     if (s->user_paused || s->counter_stopped)
         return true;
     ps_feed_lock(s->feed);
-    bool over = ps_feed_ended(s->feed) && ps_feed_generation(s->feed) == s->feed_gen;
+    bool over = ps_feed_ended(s->feed) && !ps_feed_merge_pending(s->feed) &&
+                ps_feed_generation(s->feed) == s->feed_gen;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         over = over && s->drawn[k] >= ps_feed_maps(s->feed)[k].count;
     ps_feed_unlock(s->feed);
@@ -913,13 +926,23 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
         if (s->repaired) {
             s->feed = f;
             s->repair = ps_feed_repair_counts(f);
-            /* A map that kept nothing gets its first retraced batch before the
-             * first picture, as after a restart; one that kept photons shows
+            /* What the edit changed is retraced first, here for up to
+             * PS_SESSION_RETRACE_WAIT of tau: where that is all of it (a
+             * few photons a cap, or an edit near few paths) the first
+             * picture has no hole where the moved object was, and the maps
+             * are in index order from the start. */
+            bool done = false;
+            if (s->started)
+                st = ps_feed_retrace_for(f, PS_SESSION_RETRACE_WAIT * s->set.tau, &done, err);
+            /* A map that has nothing yet gets its first batch before the
+             * first picture, as after a restart; one that has photons shows
              * them at once. */
-            bool kept_all_maps = true;
+            bool all_maps_have = true;
+            ps_feed_lock(f);
             for (int k = 0; k < PS_MAP_COUNT; k++)
-                kept_all_maps = kept_all_maps && (s->repair.kept_photons[k] > 0 || s->repair.retraced[k] == 0);
-            s->skip_prime = kept_all_maps;
+                all_maps_have = all_maps_have && (ps_feed_maps(f)[k].count > 0 || s->repair.retraced[k] == 0);
+            ps_feed_unlock(f);
+            s->skip_prime = all_maps_have;
             forget_drawn(s);
         }
     }
@@ -1024,6 +1047,10 @@ const ps_photon_map *ps_session_maps(const ps_session *s) { return ps_feed_maps(
 
 const ps_photon_map *ps_session_lock_maps(ps_session *s)
 {
+    /* In index order once tracing ended (a dump compares with a fresh
+     * trace's); an error is the feed's status (ps_session_status). */
+    ps_error err;
+    (void)ps_feed_merge(s->feed, &err);
     ps_feed_lock(s->feed);
     return ps_feed_maps(s->feed);
 }
