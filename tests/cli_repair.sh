@@ -165,6 +165,13 @@ if [ -x "$win" ] && command -v xvfb-run >/dev/null; then
     fi
 fi
 
+# A script whose last action is "wait done" ends once everything is shown,
+# with the picture written (it used to refresh for ever).
+printf '0 move object 6  0.1 0 0\n0 wait done\n' >"$cli_tmp/wait-last.script"
+expect_success "wait done last" timeout 120 "$snap" "$scene" --script "$cli_tmp/wait-last.script" "${photons[@]}" \
+    "${fast[@]}" -o "$cli_tmp/wait-last.png"
+[ -s "$cli_tmp/wait-last.png" ] && ok || bad "wait done last: no picture written"
+
 # Bad scripts: one line, exit 2, nothing written.
 printf '0 dump photons\n' >"$cli_tmp/bad1.script"
 expect_usage_error "dump without a path" "$snap" "$scene" --script "$cli_tmp/bad1.script"

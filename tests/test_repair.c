@@ -6,6 +6,7 @@
 #include "test.h"
 
 #include <string.h>
+#include <time.h>
 
 #include "photon/tracer.h"
 #include "photon/world.h"
@@ -51,7 +52,8 @@ static ps_session *open_traced(ps_scene *scene)
 }
 
 /* The maps of a fresh trace of scene (as photosplat-ref --photons-only). */
-static void fresh_trace(const ps_scene *scene, ps_photon_map maps[PS_MAP_COUNT])
+static void fresh_trace(const ps_scene *scene, ps_photon_map maps[PS_MAP_COUNT], uint64_t caustic_cap,
+                        uint64_t global_cap)
 {
     ps_world *w;
     ps_tracer *t;
@@ -61,7 +63,7 @@ static void fresh_trace(const ps_scene *scene, ps_photon_map maps[PS_MAP_COUNT])
     o.seed = SEED;
     o.threads = 2;
     assert_int_equal(ps_tracer_create(w, &o, &t, &err), PS_OK);
-    const uint64_t caps[PS_MAP_COUNT] = {CAUSTIC_CAP, GLOBAL_CAP};
+    const uint64_t caps[PS_MAP_COUNT] = {caustic_cap, global_cap};
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_photon_map_init(&maps[k], (ps_map_kind)k);
         assert_int_equal(ps_tracer_trace(t, (ps_map_kind)k, 0, caps[k], caps[k], &maps[k], &err), PS_OK);
@@ -89,7 +91,7 @@ static void traced_equals_fresh(ps_session *s, const ps_scene *scene)
     ps_error err;
     assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
     ps_photon_map fresh[PS_MAP_COUNT];
-    fresh_trace(scene, fresh);
+    fresh_trace(scene, fresh, CAUSTIC_CAP, GLOBAL_CAP);
     assert_same_maps(ps_session_maps(s), fresh);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_photon_map_free(&fresh[k]);
@@ -118,7 +120,8 @@ static void apply(ps_session *s, edit_kind e, int step)
         fail_msg("edit %d: %s", (int)e, err.msg);
 }
 
-static void update(ps_session *s, uint64_t kept[PS_MAP_COUNT], uint64_t retraced[PS_MAP_COUNT])
+static void update_caps(ps_session *s, uint64_t kept[PS_MAP_COUNT], uint64_t retraced[PS_MAP_COUNT],
+                        uint64_t caustic_cap, uint64_t global_cap)
 {
     ps_error err;
     ps_session_changes ch;
@@ -126,9 +129,14 @@ static void update(ps_session *s, uint64_t kept[PS_MAP_COUNT], uint64_t retraced
     bool repaired;
     ps_session_repair_counts(s, &repaired, kept, retraced);
     assert_true(repaired);
-    const uint64_t caps[PS_MAP_COUNT] = {CAUSTIC_CAP, GLOBAL_CAP};
+    const uint64_t caps[PS_MAP_COUNT] = {caustic_cap, global_cap};
     for (int k = 0; k < PS_MAP_COUNT; k++)
         assert_int_equal(kept[k] + retraced[k], caps[k]); /* every index: one or the other */
+}
+
+static void update(ps_session *s, uint64_t kept[PS_MAP_COUNT], uint64_t retraced[PS_MAP_COUNT])
+{
+    update_caps(s, kept, retraced, CAUSTIC_CAP, GLOBAL_CAP);
 }
 
 /* Each kind of edit, once and twice in a row, then traced to the caps. */
@@ -325,6 +333,123 @@ static void marks_after_a_repair_are_a_fresh_feeds(void **state)
     ps_scene_destroy(scene);
 }
 
+/* ---- a started session: what the picture sees of a repair ------------------------ */
+
+/* The window's session (incremental float layers, a tracing thread) of the
+ * two-light scene, with caps of several batches (so that a picture draws a
+ * map over several refreshes at the least budget); tau as given. */
+#define SHOWN_CAUSTIC_CAP (4 * PS_FEED_BATCH)
+#define SHOWN_GLOBAL_CAP PS_FEED_BATCH
+static ps_session *open_shown(ps_scene *scene, double tau, ps_camera_frame *cam)
+{
+    ps_session_settings set = ps_session_default_settings(scene);
+    set.caps[PS_MAP_CAUSTIC] = SHOWN_CAUSTIC_CAP;
+    set.caps[PS_MAP_GLOBAL] = SHOWN_GLOBAL_CAP;
+    set.seed = SEED;
+    set.threads = 2;
+    set.repair = true;
+    set.float_buffer = set.incremental = true;
+    set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
+    set.tau = tau;
+    ps_session *s;
+    ps_error err;
+    if (ps_session_create(scene, &set, &s, &err) != PS_OK)
+        fail_msg("session: %s", err.msg);
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    *cam = ps_camera_frame_make(ps_scene_camera(scene), 64, 64);
+    return s;
+}
+
+/* Refreshes (each said drawn at once) until everything is shown; how many
+ * of them after the first started the view over. With wait_end, tracing
+ * ends after the first (before the picture has drawn everything). */
+static int refresh_until_settled(ps_session *s, const ps_camera_frame *cam, bool wait_end)
+{
+    int restarts = 0, i = 0;
+    for (; i < 100000 && !ps_session_settled(s); i++) {
+        ps_session_frame f;
+        ps_error err;
+        if (ps_session_refresh(s, cam, &f, &err) != PS_OK)
+            fail_msg("refresh: %s", err.msg);
+        restarts += i > 0 && f.new_view;
+        ps_session_drawn(s, 1e-4);
+        ps_session_counts c;
+        do {
+            struct timespec ts = {0, 200000};
+            nanosleep(&ts, NULL);
+            ps_session_get_counts(s, &c);
+        } while (i == 0 && wait_end && !c.ended);
+        if (i == 0 && wait_end)
+            for (int k = 0; k < PS_MAP_COUNT; k++)
+                assert_true(f.map[k].batch->splats < c.map[k].stored); /* drawn: not all yet */
+    }
+    assert_true(ps_session_settled(s));
+    return restarts;
+}
+
+/* The maps a picture may read now (in index order once tracing ended)
+ * against a fresh trace of scene. */
+static void shown_equals_fresh(ps_session *s, const ps_scene *scene)
+{
+    ps_photon_map fresh[PS_MAP_COUNT];
+    fresh_trace(scene, fresh, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+    assert_same_maps(ps_session_lock_maps(s), fresh);
+    ps_session_unlock_maps(s);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_free(&fresh[k]);
+}
+
+/* A repair left to the tracing thread (no time to retrace before the first
+ * picture: tau ~0) while the picture draws a little each refresh: the
+ * thread's end used to put the maps back in index order at once, which
+ * started the view over from one batch (the picture got worse a quarter
+ * of a second after an edit); now the merge waits until every photon is
+ * drawn, so only the edit's own refresh starts a view, and the maps shown
+ * at the end are a fresh trace's. */
+static void a_background_repair_keeps_the_view(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_camera_frame cam;
+    ps_session *s = open_shown(scene, 1e-9, &cam);
+    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
+    for (int e = 0; e < 3; e++) {
+        apply(s, e == 0 ? MOVE_MIRROR : e == 1 ? MOVE_SPOT : MOVE_FLOOR, e);
+        uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
+        update_caps(s, kept, retraced, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+        assert_true(retraced[PS_MAP_CAUSTIC] + retraced[PS_MAP_GLOBAL] > 0);
+        assert_int_equal(refresh_until_settled(s, &cam, true), 0);
+        shown_equals_fresh(s, scene);
+    }
+    ps_error err;
+    assert_int_equal(ps_session_stop(s, &err), PS_OK);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* A repair small enough for its time (tau 10 s: half of it): every changed
+ * photon is retraced in the update, so the maps are a fresh trace's before
+ * the first picture after the edit (no hole where the mirror was), and no
+ * refresh after it starts over. */
+static void a_small_repair_is_done_before_the_first_picture(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_camera_frame cam;
+    ps_session *s = open_shown(scene, 10.0, &cam);
+    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
+    apply(s, MOVE_MIRROR, 0);
+    uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
+    update_caps(s, kept, retraced, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+    assert_true(retraced[PS_MAP_CAUSTIC] > 0 && retraced[PS_MAP_GLOBAL] > 0);
+    shown_equals_fresh(s, scene); /* before any refresh */
+    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
+    ps_error err;
+    assert_int_equal(ps_session_stop(s, &err), PS_OK);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -332,6 +457,8 @@ int main(void)
         cmocka_unit_test(edits_mid_repair),
         cmocka_unit_test(repair_keeps_what_it_should),
         cmocka_unit_test(marks_after_a_repair_are_a_fresh_feeds),
+        cmocka_unit_test(a_background_repair_keeps_the_view),
+        cmocka_unit_test(a_small_repair_is_done_before_the_first_picture),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
