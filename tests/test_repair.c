@@ -337,10 +337,11 @@ static void marks_after_a_repair_are_a_fresh_feeds(void **state)
 
 /* The window's session (incremental float layers, a tracing thread) of the
  * two-light scene, with caps of several batches (so that a picture draws a
- * map over several refreshes at the least budget); tau as given. */
+ * map over several refreshes at the least budget); retraced before the
+ * first picture after an edit: up to retrace_first photons. */
 #define SHOWN_CAUSTIC_CAP (4 * PS_FEED_BATCH)
 #define SHOWN_GLOBAL_CAP PS_FEED_BATCH
-static ps_session *open_shown(ps_scene *scene, double tau, ps_camera_frame *cam)
+static ps_session *open_shown(ps_scene *scene, uint64_t retrace_first, ps_camera_frame *cam)
 {
     ps_session_settings set = ps_session_default_settings(scene);
     set.caps[PS_MAP_CAUSTIC] = SHOWN_CAUSTIC_CAP;
@@ -350,7 +351,8 @@ static ps_session *open_shown(ps_scene *scene, double tau, ps_camera_frame *cam)
     set.repair = true;
     set.float_buffer = set.incremental = true;
     set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
-    set.tau = tau;
+    set.retrace_first = retrace_first;
+    set.tau = 1e-9; /* the least budget: a map over several refreshes */
     ps_session *s;
     ps_error err;
     if (ps_session_create(scene, &set, &s, &err) != PS_OK)
@@ -399,8 +401,8 @@ static void shown_equals_fresh(ps_session *s, const ps_scene *scene)
         ps_photon_map_free(&fresh[k]);
 }
 
-/* A repair left to the tracing thread (no time to retrace before the first
- * picture: tau ~0) while the picture draws a little each refresh: the
+/* A repair left to the tracing thread (nothing retraced before the first
+ * picture: retrace_first 0, as a repair past PS_SESSION_RETRACE_FIRST) while the picture draws a little each refresh: the
  * thread's end used to put the maps back in index order at once, which
  * started the view over from one batch (the picture got worse a quarter
  * of a second after an edit); now the merge waits until every photon is
@@ -411,7 +413,7 @@ static void a_background_repair_keeps_the_view(void **state)
     (void)state;
     ps_scene *scene = load();
     ps_camera_frame cam;
-    ps_session *s = open_shown(scene, 1e-9, &cam);
+    ps_session *s = open_shown(scene, 0, &cam);
     assert_int_equal(refresh_until_settled(s, &cam, false), 0);
     for (int e = 0; e < 3; e++) {
         apply(s, e == 0 ? MOVE_MIRROR : e == 1 ? MOVE_SPOT : MOVE_FLOOR, e);
@@ -427,8 +429,8 @@ static void a_background_repair_keeps_the_view(void **state)
     ps_scene_destroy(scene);
 }
 
-/* A repair small enough for its time (tau 10 s: half of it): every changed
- * photon is retraced in the update, so the maps are a fresh trace's before
+/* A repair within PS_SESSION_RETRACE_FIRST: every changed photon is
+ * retraced in the update, so the maps are a fresh trace's before
  * the first picture after the edit (no hole where the mirror was), and no
  * refresh after it starts over. */
 static void a_small_repair_is_done_before_the_first_picture(void **state)
@@ -436,7 +438,7 @@ static void a_small_repair_is_done_before_the_first_picture(void **state)
     (void)state;
     ps_scene *scene = load();
     ps_camera_frame cam;
-    ps_session *s = open_shown(scene, 10.0, &cam);
+    ps_session *s = open_shown(scene, PS_SESSION_RETRACE_FIRST, &cam);
     assert_int_equal(refresh_until_settled(s, &cam, false), 0);
     apply(s, MOVE_MIRROR, 0);
     uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];

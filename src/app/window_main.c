@@ -38,7 +38,7 @@
 /* The memory plan (ps_check_run_memory): a pixel is the float splat layers,
  * the linear and the shown composite, and the window's own colour and depth;
  * the specular layer's texture, cube maps and glossy levels come on top
- * (ps_specular_plan_bytes: 10.3 MB at most for 8 cubes, 4.2 MB more a 512^2
+ * (ps_specular_plan_bytes: 16.6 MB at most for 8 cubes, 4.2 MB more a 512^2
  * texture). */
 #define WIN_PIXEL_BYTES (3 * 4 * sizeof(float) + 4 * sizeof(float) + 4 + 4 + 4)
 /* Camera controls, as in Blender: degrees of orbit per pixel dragged, the

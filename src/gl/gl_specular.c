@@ -25,7 +25,15 @@ static const float face_axes[6][3][3] = {
 
 struct ps_gl_specular {
     int size;
-    GLuint cube[PS_SPECULAR_MAX_CUBES];
+    /* Two maps a cube: the one shown, and the one its faces are rendered
+     * into (back), which is shown once all six faces of it were rendered
+     * from one centre since the last change (back_faces, a bit a face). A
+     * map is never shown with faces from two places or two scenes: after
+     * an edit the old one shows (its lookups looking from the old centre,
+     * ps_specular_set_lookup_centre) until the new one is whole. */
+    GLuint cube[PS_SPECULAR_MAX_CUBES], back[PS_SPECULAR_MAX_CUBES];
+    unsigned back_faces[PS_SPECULAR_MAX_CUBES];
+    ps_vec3 back_centre[PS_SPECULAR_MAX_CUBES];
     int cube_count;
     GLuint fbo, depth_stencil;
     ps_splat_batch batch;
@@ -83,8 +91,10 @@ void ps_gl_specular_destroy(ps_gl_specular *g)
 {
     if (!g)
         return;
-    if (g->cube_count)
+    if (g->cube_count) {
         glDeleteTextures(g->cube_count, g->cube);
+        glDeleteTextures(g->cube_count, g->back);
+    }
     glDeleteFramebuffers(1, &g->fbo);
     glDeleteRenderbuffers(1, &g->depth_stencil);
     if (g->layer_tex)
@@ -100,29 +110,51 @@ void ps_gl_specular_destroy(ps_gl_specular *g)
 
 unsigned ps_gl_specular_faces_rendered(const ps_gl_specular *g) { return g->faces_rendered; }
 
-/* Cube textures for n cubes, black until rendered. */
-static void ensure_cubes(ps_gl_specular *g, int n)
+static void new_cube_textures(ps_gl_specular *g, int n, GLuint *tex, const float *black)
 {
-    if (n == g->cube_count)
-        return;
-    if (g->cube_count)
-        glDeleteTextures(g->cube_count, g->cube);
-    g->cube_count = n;
-    g->cursor = 0;
-    g->since_change = g->since_settled = 0;
-    if (n == 0)
-        return;
-    glGenTextures(n, g->cube);
-    float *black = calloc(4 * (size_t)g->size * (size_t)g->size, sizeof *black);
+    glGenTextures(n, tex);
     for (int c = 0; c < n; c++) {
-        glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[c]);
+        glBindTexture(GL_TEXTURE_CUBE_MAP, tex[c]);
         for (int f = 0; f < 6; f++)
             glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_RGBA16F, g->size, g->size, 0, GL_RGBA, GL_FLOAT,
                          black);
         ps_gl_cube_linear_clamped();
     }
     glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+}
+
+/* Cube textures (shown and back) for n cubes, black until rendered. */
+static void ensure_cubes(ps_gl_specular *g, int n)
+{
+    if (n == g->cube_count)
+        return;
+    if (g->cube_count) {
+        glDeleteTextures(g->cube_count, g->cube);
+        glDeleteTextures(g->cube_count, g->back);
+    }
+    g->cube_count = n;
+    g->cursor = 0;
+    g->since_change = g->since_settled = 0;
+    memset(g->back_faces, 0, sizeof g->back_faces);
+    if (n == 0)
+        return;
+    float *black = calloc(4 * (size_t)g->size * (size_t)g->size, sizeof *black);
+    new_cube_textures(g, n, g->cube, black);
+    new_cube_textures(g, n, g->back, black);
     free(black);
+}
+
+/* Cube c's back map has all six faces from one centre: shown from now on,
+ * its lookups looking from that centre (traced again at once when it
+ * moved, so that this refresh's layer is drawn with lookups that match). */
+static void show_back(ps_gl_specular *g, ps_session *s, int c)
+{
+    GLuint t = g->cube[c];
+    g->cube[c] = g->back[c];
+    g->back[c] = t;
+    g->back_faces[c] = 0;
+    ps_session_set_specular_centre(s, c, g->back_centre[c]);
+    g->cubes_changed = true;
 }
 
 void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value)
@@ -138,6 +170,7 @@ void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value)
         glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[c]);
         for (int f = 0; f < 6; f++)
             glTexSubImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, 0, 0, g->size, g->size, GL_RGBA, GL_FLOAT, texels);
+        g->back_faces[c] = 0;
     }
     glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
     free(texels);
@@ -152,6 +185,8 @@ void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value)
     g->frozen = true;
     g->cubes_changed = true;
 }
+
+static bool same_point(ps_vec3 a, ps_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
 /* Face f of cube c: the preview seen from the cube's centre, mirrors and
  * glass left out, at exposure 1. */
@@ -172,8 +207,13 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
     if (fr->direct && r->opt.shadows && !r->shadows_valid)
         ps_gl_make_shadow_maps(r);
 
+    /* Into the back map, whose faces must all be from one centre. */
+    if (g->back_faces[c] != 0 && !same_point(g->back_centre[c], cam.eye))
+        g->back_faces[c] = 0;
+    g->back_centre[c] = cam.eye;
+    g->back_faces[c] |= 1u << f;
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, g->cube[c], 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, g->back[c], 0);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, g->depth_stencil);
     r->skip_specular = true;
     bool hide = r->in.hide_emitters;
@@ -230,6 +270,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
         g->edits = ps_session_edits(s);
         g->epoch = ps_session_maps_epoch(s);
         g->since_change = g->since_settled = 0;
+        memset(g->back_faces, 0, sizeof g->back_faces); /* faces of before the change */
     }
     /* Settled: every photon has arrived (the feed ended; a new view of the
      * same photons changes no cube), and since the last arrived a whole
@@ -241,6 +282,11 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     bool settled = counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL);
     if (arrived != g->arrived || !settled) {
         g->arrived = arrived;
+        /* The last photons arrived: the round from here on is every face
+         * from them (a back map half drawn before would complete a cube
+         * with older faces, and leave newer ones unshown at the round's end). */
+        if (settled)
+            memset(g->back_faces, 0, sizeof g->back_faces);
         g->since_settled = 0;
     }
     if (settled && g->since_settled >= total && g->since_change >= total)
@@ -283,12 +329,13 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     ps_status st = PS_OK;
     double t0 = ps_now_seconds();
     for (int i = 0; i < n && st == PS_OK; i++) {
-        st = render_face(g, r, s, f, g->cursor / 6, g->cursor % 6, faces > 0 && first_round && !settled, err);
-        ps_gl_glossy_read_face(g->glossy, g->cursor / 6, g->cursor % 6, g->cube[g->cursor / 6], g->size);
+        int c = g->cursor / 6;
+        st = render_face(g, r, s, f, c, g->cursor % 6, faces > 0 && first_round && !settled, err);
+        ps_gl_glossy_read_face(g->glossy, c, g->cursor % 6, g->back[c], g->size);
         g->cursor = (g->cursor + 1) % total;
         /* The layer is redrawn when a cube is whole again, not each face. */
-        if (g->cursor % 6 == 0)
-            g->cubes_changed = true;
+        if (st == PS_OK && g->back_faces[c] == 0x3fu)
+            show_back(g, s, c);
     }
     if (faces <= 0 && ps_gl_glossy_blur(g->glossy, 0)) /* all at once: the levels too */
         g->cubes_changed = true;
@@ -298,11 +345,6 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     }
     g->since_change += n;
     g->since_settled += n;
-    /* The last round done: the layer from every face of it. A round need not
-     * start at a cube's first face, so the faces it drew last may be the
-     * first ones of a cube, which completed no cube above. */
-    if (settled && g->since_settled >= total)
-        g->cubes_changed = true;
     /* Back to the view. */
     memcpy(r->view, view, sizeof view);
     memcpy(r->proj, proj, sizeof proj);
@@ -326,6 +368,9 @@ bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s)
     if (g->cube_count != cubes || g->layers != layers || g->edits != ps_session_edits(s) || g->cubes_changed ||
         ps_gl_glossy_pending(g->glossy))
         return false;
+    for (int c = 0; c < cubes; c++)
+        if (g->back_faces[c] != 0) /* a map still being rendered */
+            return false;
     /* The still camera's per-pixel paths traced (and so drawn: they mark the
      * layer changed), not the per-vertex lookups shown until then. */
     if (!ps_specular_pixel_points(ps_session_specular(s)).ready)

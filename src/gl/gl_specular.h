@@ -17,7 +17,12 @@
  * picture, the first after an edit and a moving camera's come as fast as
  * without the layer), the last round once they all arrived
  * over a few refreshes whatever the budget, all at once for a single frame and a snapshot's last
- * picture; the objects are redrawn when a cube is whole again. They are kept
+ * picture. Faces are rendered into a second map of the cube, shown once its
+ * six faces are from one centre and one state of the scene (then the objects
+ * are redrawn); until then the last whole map shows, its lookups looking
+ * from where it was rendered (ps_session_set_specular_centre), so that an
+ * object moved shows at once what its old map saw of the points its new eye
+ * paths reach. They are kept
  * while only the camera moves; a new layer set, an edit or new GL lights
  * start a new round. Once the camera holds still and its per-pixel paths
  * are traced (preview/specular.h), each path is drawn as a one-pixel point

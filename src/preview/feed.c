@@ -502,23 +502,34 @@ static ps_status merge(ps_feed *f, ps_error *err)
     return st;
 }
 
-ps_status ps_feed_retrace_for(ps_feed *f, double max_seconds, bool *done, ps_error *err)
+ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, bool *done, ps_error *err)
 {
-    double t0 = ps_now_seconds(), last = 0.0;
+    double t0 = ps_now_seconds();
     ps_status st = PS_OK;
+    uint64_t traced = 0;
     bool left = false;
-    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
-        while (st == PS_OK && f->pending_done[k] < f->pending_count[k] && !f->store_limited) {
-            /* Between batches: stop where the next one, as long as the
-             * last, would pass the time given. */
-            double now = ps_now_seconds();
-            if (now - t0 + last > max_seconds) {
-                left = true;
-                break;
+    /* Rounds as the thread's (a batch of each map's pending indices), the
+     * maps in proportion, while the next round stays within the bound. */
+    for (;;) {
+        uint64_t round = 0;
+        bool pending = false;
+        for (int k = 0; k < PS_MAP_COUNT; k++)
+            if (f->pending_done[k] < f->pending_count[k]) {
+                size_t n = f->pending_count[k] - f->pending_done[k];
+                round += n < batch_of(f, k) ? n : batch_of(f, k);
+                pending = true;
             }
-            st = retrace_batch(f, k, err);
-            last = ps_now_seconds() - now;
+        if (!pending || st != PS_OK || f->store_limited)
+            break;
+        if (traced + round > max_photons) {
+            left = true;
+            break;
         }
+        for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
+            if (f->pending_done[k] < f->pending_count[k])
+                st = retrace_batch(f, k, err);
+        traced += round;
+    }
     /* Nothing left to retrace: in index order at once, so that the
      * picture never needs to start over for it. */
     if (st == PS_OK && !left)

@@ -135,10 +135,12 @@ uint64_t ps_feed_generation(const ps_feed *f);
  * order. */
 bool ps_feed_merge_pending(const ps_feed *f);
 /* Before run, prime or start of a repaired feed: its retrace (the pending
- * indices, PS_FEED_BATCH at a time) on the calling thread for at most about
- * max_seconds (checked between batches); once all is retraced the maps are
- * put in index order at once (*done true), else the rest is the thread's. */
-ps_status ps_feed_retrace_for(ps_feed *f, double max_seconds, bool *done, ps_error *err);
+ * indices, a batch of each map a round, as the thread's) on the calling
+ * thread, as many rounds as keep within max_photons in all; once all is
+ * retraced the maps are put in index order at once (*done true), else the
+ * rest is the thread's. A count, not a time: what the first picture after
+ * an edit shows does not depend on the machine's load. */
+ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, bool *done, ps_error *err);
 /* Not under the lock: once the feed has ended, its maps in index order (a
  * no-op when none is in repair order); counts a generation per map
  * reordered. On an error (out of memory) the feed's status is it. */

@@ -94,6 +94,7 @@ ps_session_settings ps_session_default_settings(const ps_scene *scene)
     set.splat_share = PS_SESSION_SPLAT_TIME_SHARE;
     set.shadow_size = PS_SHADOW_SIZE_DEFAULT;
     set.repair = true;
+    set.retrace_first = PS_SESSION_RETRACE_FIRST;
     return set;
 }
 
@@ -116,6 +117,10 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
 {
     ps_world_destroy(s->world);
     s->world = NULL;
+    int old_cubes = s->spec ? ps_specular_cube_count(s->spec) : 0;
+    ps_vec3 looked[PS_SPECULAR_MAX_CUBES];
+    for (int c = 0; c < old_cubes; c++)
+        looked[c] = ps_specular_lookup_centre(s->spec, c);
     ps_specular_destroy(s->spec);
     s->spec = NULL;
     ps_preview_mesh_free(&s->mesh);
@@ -127,6 +132,10 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
     size_t nm;
     if (st == PS_OK)
         st = ps_specular_create(&s->mesh, ps_scene_materials(s->scene, &nm), &s->spec, err);
+    /* The drawing side still shows the maps it had (ps_session_set_specular_centre). */
+    if (st == PS_OK && ps_specular_cube_count(s->spec) == old_cubes)
+        for (int c = 0; c < old_cubes; c++)
+            ps_specular_set_lookup_centre(s->spec, c, looked[c]);
     /* The scene's own triangles, not subdivided, for depth-only passes:
      * subdividing changes no depth, only how many vertices are lit. */
     mo.max_edge = HUGE_VAL;
@@ -926,14 +935,14 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
         if (s->repaired) {
             s->feed = f;
             s->repair = ps_feed_repair_counts(f);
-            /* What the edit changed is retraced first, here for up to
-             * PS_SESSION_RETRACE_WAIT of tau: where that is all of it (a
-             * few photons a cap, or an edit near few paths) the first
-             * picture has no hole where the moved object was, and the maps
-             * are in index order from the start. */
+            /* What the edit changed is retraced first, here up to
+             * PS_SESSION_RETRACE_FIRST photons: where that is all of it (the
+             * default caps, or an edit near few paths) the first picture has
+             * no hole where the moved object was, and the maps are in index
+             * order from the start (settings.retrace_first). */
             bool done = false;
             if (s->started)
-                st = ps_feed_retrace_for(f, PS_SESSION_RETRACE_WAIT * s->set.tau, &done, err);
+                st = ps_feed_retrace_first(f, s->set.retrace_first, &done, err);
             /* A map that has nothing yet gets its first batch before the
              * first picture, as after a restart; one that has photons shows
              * them at once. */
@@ -972,6 +981,18 @@ const ps_preview_lights *ps_session_lights(const ps_session *s) { return &s->lig
 const ps_kernel_texture *ps_session_kernel(const ps_session *s) { return &s->kernel; }
 const ps_tracer *ps_session_tracer(const ps_session *s) { return s->tracer; }
 ps_specular *ps_session_specular(ps_session *s) { return s->spec; }
+
+void ps_session_set_specular_centre(ps_session *s, int cube, ps_vec3 centre)
+{
+    if (cube < 0 || cube >= ps_specular_cube_count(s->spec))
+        return;
+    ps_vec3 was = ps_specular_lookup_centre(s->spec, cube);
+    if (was.x == centre.x && was.y == centre.y && was.z == centre.z)
+        return;
+    ps_specular_set_lookup_centre(s->spec, cube, centre);
+    if (s->have_cam)
+        ps_specular_update(s->spec, s->world, s->cam.eye, 0);
+}
 uint64_t ps_session_maps_epoch(const ps_session *s) { return s->maps_epoch; }
 
 ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_frame *view, size_t max_photons,

@@ -80,11 +80,13 @@
  * the rest (the default scene's 10^4 in 12 ms were a fifth of a moving frame). */
 #define PS_SESSION_SPECULAR_VERTICES_MOVING 2048
 /* After an edit that repairs the maps, the photons it changed are retraced
- * before the first picture for up to this share of tau (the rest by the
- * tracing thread, first thing): the default caps' mirror move, about 9*10^4
- * photons, is done in about 0.05 s on 2 cores, and its first picture has no
- * hole under the moved mirror (docs/repair.md). */
-#define PS_SESSION_RETRACE_WAIT 0.5
+ * before the first picture, up to this many in both maps (the rest by the
+ * tracing thread, first thing): at the default caps a move of the default
+ * scene's mirror retraces about 9*10^4, 0.05 s on 2 cores, and its first
+ * picture has no hole under the moved mirror (docs/repair.md). A count,
+ * not a share of tau: a time bound was met or missed with the machine's
+ * load, and the first picture with it. */
+#define PS_SESSION_RETRACE_FIRST 131072
 
 typedef struct ps_session_settings {
     /* The photons. */
@@ -127,6 +129,9 @@ typedef struct ps_session_settings {
     bool repair;                   /* edits keep the photons they cannot change (repair.h):
                                     * path records cost PS_PATH_PLAN_BYTES an emitted
                                     * photon (default on) */
+    uint64_t retrace_first;        /* ... and retrace up to this many of the others before
+                                    * the first picture after an edit, the rest in the
+                                    * background (PS_SESSION_RETRACE_FIRST) */
 } ps_session_settings;
 
 /* Defaults: the scene's photon counts and radii, every layer, triangles, the
@@ -288,6 +293,13 @@ const ps_kernel_texture *ps_session_kernel(const ps_session *s);
 const ps_tracer *ps_session_tracer(const ps_session *s);
 /* The specular layer's lookups over the fine mesh (preview/specular.h). */
 struct ps_specular *ps_session_specular(ps_session *s);
+/* The drawing side shows cube map `cube` rendered from `centre` now: its
+ * lookups look from there (ps_specular_set_lookup_centre), traced again at
+ * once for the last refresh's eye when that moved them (the per-pixel paths
+ * over the next refreshes). Kept across edits that rebuild the lookups,
+ * while the cubes stay the same in number (the maps shown are the old ones
+ * until new ones are whole). */
+void ps_session_set_specular_centre(ps_session *s, int cube, ps_vec3 centre);
 /* For the specular layer's cube maps: map k's photons so far (at most
  * max_photons, a prefix ending at a feed mark, scaled by N / n to radiance
  * at exposure 1) as triangle splats seen from `view` (photons behind its eye

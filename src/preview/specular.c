@@ -62,6 +62,9 @@ struct ps_specular {
     ps_specular_range *ranges;
     size_t range_count;
     ps_vec3 centre[PS_SPECULAR_MAX_CUBES];
+    /* Where each cube's lookups look from: the centre its shown map was
+     * rendered from (ps_specular_set_lookup_centre), the centre until then. */
+    ps_vec3 lookup_centre[PS_SPECULAR_MAX_CUBES];
     int cube_count;
     /* The lookup arrays: one entry a vertex of the listed ranges. */
     size_t vertex_count;
@@ -233,7 +236,7 @@ ps_status ps_specular_create(const ps_preview_mesh *mesh, const ps_material *mat
         sp->vertex_count += rg->count;
     }
     for (int c = 0; c < sp->cube_count; c++)
-        sp->centre[c] = ps_aabb_center(box[c]);
+        sp->centre[c] = sp->lookup_centre[c] = ps_aabb_center(box[c]);
     size_t nr = sp->range_count ? sp->range_count : 1;
     sp->range_box = malloc(nr * sizeof *sp->range_box);
     sp->rect = malloc(nr * sizeof *sp->rect);
@@ -290,6 +293,17 @@ size_t ps_specular_range_count(const ps_specular *sp) { return sp->range_count; 
 const ps_specular_range *ps_specular_ranges(const ps_specular *sp) { return sp->ranges; }
 int ps_specular_cube_count(const ps_specular *sp) { return sp->cube_count; }
 ps_vec3 ps_specular_cube_centre(const ps_specular *sp, int cube) { return sp->centre[cube]; }
+ps_vec3 ps_specular_lookup_centre(const ps_specular *sp, int cube) { return sp->lookup_centre[cube]; }
+
+static bool same_vec(ps_vec3 a, ps_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+void ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre)
+{
+    if (cube < 0 || cube >= sp->cube_count || same_vec(centre, sp->lookup_centre[cube]))
+        return;
+    sp->lookup_centre[cube] = centre;
+    ps_specular_invalidate(sp);
+}
 const float *ps_specular_dirs(const ps_specular *sp, int k) { return sp->dirs[k]; }
 const float *ps_specular_weights(const ps_specular *sp, int k) { return sp->weights[k]; }
 
@@ -476,7 +490,6 @@ int ps_specular_trace_point(const ps_world *world, const ps_material *materials,
     return k;
 }
 
-static bool same_vec(ps_vec3 a, ps_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
 /* Which listed range holds lookup vertex k (ranges are in offset order). */
 static size_t range_of(const ps_specular *sp, size_t k)
@@ -514,7 +527,7 @@ size_t ps_specular_update(ps_specular *sp, const ps_world *world, ps_vec3 eye, s
         const ps_specular_range *lr = &sp->ranges[range_of(sp, k)];
         size_t v = sp->mesh->ranges[lr->range].first + (k - lr->offset);
         const float *nn = sp->mesh->normals + 3 * v;
-        c.centre = sp->centre[lr->cube];
+        c.centre = sp->lookup_centre[lr->cube];
         ps_specular_term t[PS_SPECULAR_TERMS];
         const ps_material *m = range_material(sp, lr->range);
         int count = ps_glossy_wants(m) /* the lobe's lookup (specular_glossy.h) */
@@ -625,7 +638,7 @@ static bool trace_pixel(ps_specular *sp, path_ctx *c, const ps_camera_frame *cam
                 continue;
             c->count = 0;
             c->dropped = 0.0;
-            c->centre = sp->centre[cube];
+            c->centre = sp->lookup_centre[cube];
             c->first = hit.t;
             scatter(c, &hit, m, ray.d, ps_rgb_gray(1.0), 0, hit.t);
             ps_specular_term t[PS_SPECULAR_TERMS];

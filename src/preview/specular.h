@@ -74,6 +74,15 @@ size_t ps_specular_range_count(const ps_specular *sp);
 const ps_specular_range *ps_specular_ranges(const ps_specular *sp);
 int ps_specular_cube_count(const ps_specular *sp);
 ps_vec3 ps_specular_cube_centre(const ps_specular *sp, int cube);
+/* Where cube's lookups look from: the centre its shown map was rendered
+ * from. Until set, the cube's centre; after an edit that moved the object,
+ * the old centre until a map from the new one is whole (src/gl keeps the
+ * map it shows until then), so that the lookups find in the old map the
+ * very points the eye paths end at, not the same directions from elsewhere
+ * (the default scene's mirror moved 10 cm showed its reflections shifted
+ * for the seconds a new map took). A new centre traces every lookup again. */
+ps_vec3 ps_specular_lookup_centre(const ps_specular *sp, int cube);
+void ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre);
 
 /* Traces the lookups for an eye at `eye` through `world` (the session's:
  * the same surfaces as the mesh), at most max_vertices distinct vertices

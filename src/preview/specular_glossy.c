@@ -266,7 +266,8 @@ void ps_glossy_filter_face(const ps_glossy_filter *f, int face, float *rgba)
 
 uint64_t ps_specular_plan_bytes(int cube_size, int width, int height)
 {
-    uint64_t cube = 6 * (uint64_t)cube_size * (uint64_t)cube_size * 4 * 2; /* RGBA16F */
+    /* RGBA16F, two a cube: the one shown and the one being rendered (gl_specular.c). */
+    uint64_t cube = 2 * 6 * (uint64_t)cube_size * (uint64_t)cube_size * 4 * 2;
     uint64_t level = 6 * (uint64_t)PS_GLOSSY_MAX_LEVEL * PS_GLOSSY_MAX_LEVEL;
     /* A level: the texture (RGBA16F), the kept texels, directions and solid
      * angles (7 floats), one face's upload (RGBA floats), and one read-back

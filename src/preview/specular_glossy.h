@@ -102,7 +102,8 @@ void ps_glossy_filter_face(const ps_glossy_filter *f, int face, float *rgba);
 /* ---- the memory plan ------------------------------------------------------------ */
 
 /* What the specular layer holds at most besides its lookups: cube maps of
- * cube_size (RGBA16F) for PS_SPECULAR_MAX_CUBES cubes, their blurred levels
+ * cube_size (RGBA16F, two a cube: shown and being rendered) for
+ * PS_SPECULAR_MAX_CUBES cubes, their blurred levels
  * (textures and the CPU's copies), and the layer texture of width x height
  * (RGBA32F). */
 uint64_t ps_specular_plan_bytes(int cube_size, int width, int height);
