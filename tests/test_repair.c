@@ -337,8 +337,8 @@ static void marks_after_a_repair_are_a_fresh_feeds(void **state)
 
 /* The window's session (incremental float layers, a tracing thread) of the
  * two-light scene, with caps of several batches (so that a picture draws a
- * map over several refreshes at the least budget); retraced before the
- * first picture after an edit: up to retrace_first photons. */
+ * map over several refreshes at the least budget); an edit's photons are
+ * retraced before its first picture when at most retrace_first. */
 #define SHOWN_CAUSTIC_CAP (4 * PS_FEED_BATCH)
 #define SHOWN_GLOBAL_CAP PS_FEED_BATCH
 static ps_session *open_shown(ps_scene *scene, uint64_t retrace_first, ps_camera_frame *cam)
@@ -401,13 +401,13 @@ static void shown_equals_fresh(ps_session *s, const ps_scene *scene)
         ps_photon_map_free(&fresh[k]);
 }
 
-/* A repair left to the tracing thread (nothing retraced before the first
- * picture: retrace_first 0, as a repair past PS_SESSION_RETRACE_FIRST) while the picture draws a little each refresh: the
- * thread's end used to put the maps back in index order at once, which
- * started the view over from one batch (the picture got worse a quarter
- * of a second after an edit); now the merge waits until every photon is
- * drawn, so only the edit's own refresh starts a view, and the maps shown
- * at the end are a fresh trace's. */
+/* A repair left to the tracing thread (retrace_first 0: as one of more than
+ * PS_SESSION_RETRACE_FIRST photons) while the picture draws a little each
+ * refresh: the thread's end used to put the maps back in index order at
+ * once, which started the view over from one batch (the picture got worse
+ * a quarter of a second after an edit); now the merge waits until every
+ * photon is drawn, so only the edit's own refresh starts a view, and the
+ * maps shown at the end are a fresh trace's. */
 static void a_background_repair_keeps_the_view(void **state)
 {
     (void)state;

@@ -504,32 +504,28 @@ static ps_status merge(ps_feed *f, ps_error *err)
 
 ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, bool *done, ps_error *err)
 {
+    *done = false;
+    uint64_t pending = 0;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        pending += f->pending_count[k] - f->pending_done[k];
+    /* All or nothing: a part would cost the first picture its time and
+     * still leave a hole (and a merge) to the thread. */
+    if (pending > max_photons)
+        return PS_OK;
     double t0 = ps_now_seconds();
     ps_status st = PS_OK;
-    uint64_t traced = 0;
-    bool left = false;
-    /* Rounds as the thread's (a batch of each map's pending indices), the
-     * maps in proportion, while the next round stays within the bound. */
-    for (;;) {
-        uint64_t round = 0;
-        bool pending = false;
-        for (int k = 0; k < PS_MAP_COUNT; k++)
-            if (f->pending_done[k] < f->pending_count[k]) {
-                size_t n = f->pending_count[k] - f->pending_done[k];
-                round += n < batch_of(f, k) ? n : batch_of(f, k);
-                pending = true;
-            }
-        if (!pending || st != PS_OK || f->store_limited)
-            break;
-        if (traced + round > max_photons) {
-            left = true;
-            break;
-        }
+    /* Rounds as the thread's: a batch of each map's pending indices. */
+    for (bool more = true; more && st == PS_OK && !f->store_limited;) {
+        more = false;
         for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
-            if (f->pending_done[k] < f->pending_count[k])
+            if (f->pending_done[k] < f->pending_count[k]) {
                 st = retrace_batch(f, k, err);
-        traced += round;
+                more = true;
+            }
     }
+    bool left = false;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        left = left || f->pending_done[k] < f->pending_count[k];
     /* Nothing left to retrace: in index order at once, so that the
      * picture never needs to start over for it. */
     if (st == PS_OK && !left)

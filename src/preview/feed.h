@@ -134,12 +134,12 @@ uint64_t ps_feed_generation(const ps_feed *f);
  * Under the lock: whether the feed has ended with a map still in repair
  * order. */
 bool ps_feed_merge_pending(const ps_feed *f);
-/* Before run, prime or start of a repaired feed: its retrace (the pending
- * indices, a batch of each map a round, as the thread's) on the calling
- * thread, as many rounds as keep within max_photons in all; once all is
- * retraced the maps are put in index order at once (*done true), else the
- * rest is the thread's. A count, not a time: what the first picture after
- * an edit shows does not depend on the machine's load. */
+/* Before run, prime or start of a repaired feed: when its retrace (the
+ * pending indices of both maps) is at most max_photons, all of it on the
+ * calling thread, as the thread's rounds would, and the maps put in index
+ * order at once (*done true); else nothing, the thread's. A count, not a
+ * time: what the first picture after an edit shows does not depend on the
+ * machine's load. */
 ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, bool *done, ps_error *err);
 /* Not under the lock: once the feed has ended, its maps in index order (a
  * no-op when none is in repair order); counts a generation per map

@@ -935,11 +935,11 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
         if (s->repaired) {
             s->feed = f;
             s->repair = ps_feed_repair_counts(f);
-            /* What the edit changed is retraced first, here up to
-             * PS_SESSION_RETRACE_FIRST photons: where that is all of it (the
-             * default caps, or an edit near few paths) the first picture has
-             * no hole where the moved object was, and the maps are in index
-             * order from the start (settings.retrace_first). */
+            /* What the edit changed is retraced first: here when it is at
+             * most settings.retrace_first photons (the default caps, or an
+             * edit near few paths), so that the first picture has no hole
+             * where the moved object was and the maps are in index order
+             * from the start; else by the thread. */
             bool done = false;
             if (s->started)
                 st = ps_feed_retrace_first(f, s->set.retrace_first, &done, err);

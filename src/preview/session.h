@@ -80,12 +80,13 @@
  * the rest (the default scene's 10^4 in 12 ms were a fifth of a moving frame). */
 #define PS_SESSION_SPECULAR_VERTICES_MOVING 2048
 /* After an edit that repairs the maps, the photons it changed are retraced
- * before the first picture, up to this many in both maps (the rest by the
- * tracing thread, first thing): at the default caps a move of the default
- * scene's mirror retraces about 9*10^4, 0.05 s on 2 cores, and its first
- * picture has no hole under the moved mirror (docs/repair.md). A count,
- * not a share of tau: a time bound was met or missed with the machine's
- * load, and the first picture with it. */
+ * before the first picture when they are at most this many in both maps
+ * (else all by the tracing thread, first thing, and the first picture comes
+ * at once with a hole where they were): at the default caps a move of the
+ * default scene's mirror retraces about 9*10^4, 0.05 s on 2 cores, and its
+ * first picture is whole (docs/repair.md). A count, not a share of tau: a
+ * time bound was met or missed with the machine's load, and the first
+ * picture with it. */
 #define PS_SESSION_RETRACE_FIRST 131072
 
 typedef struct ps_session_settings {
@@ -129,9 +130,9 @@ typedef struct ps_session_settings {
     bool repair;                   /* edits keep the photons they cannot change (repair.h):
                                     * path records cost PS_PATH_PLAN_BYTES an emitted
                                     * photon (default on) */
-    uint64_t retrace_first;        /* ... and retrace up to this many of the others before
-                                    * the first picture after an edit, the rest in the
-                                    * background (PS_SESSION_RETRACE_FIRST) */
+    uint64_t retrace_first;        /* ... and retrace the others before the first picture
+                                    * after an edit when they are at most this many, else in
+                                    * the background (PS_SESSION_RETRACE_FIRST) */
 } ps_session_settings;
 
 /* Defaults: the scene's photon counts and radii, every layer, triangles, the
