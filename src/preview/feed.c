@@ -574,6 +574,60 @@ bool ps_feed_repairable(const ps_feed *f)
     return true;
 }
 
+/* The keep tests of a repair (every kept source's path against the moved
+ * boxes: most of an update's time at 10^6 photons) on the tracer's threads,
+ * each over a fixed range of indices: a flag an index, the same whatever
+ * the thread count. */
+typedef struct keep_job {
+    const ps_feed_repair_fns *fns;
+    int k;
+    const ps_photon_source *src;
+    const ps_path_store *paths;
+    uint64_t end, from, to;
+    uint8_t *kept;
+} keep_job;
+
+static void *keep_range(void *arg)
+{
+    keep_job *j = arg;
+    const ps_path_rec *rec = j->paths->rec;
+    for (uint64_t i = j->from; i < j->to; i++) {
+        uint64_t o = j->src[i].from;
+        j->kept[i] = o < j->end && !(rec[o].flags & REC_PENDING) &&
+                     j->fns->keep(j->fns->ctx, (ps_map_kind)j->k, o, j->paths, &rec[o]);
+    }
+    return NULL;
+}
+
+#define KEEP_MAX_THREADS 64
+
+static void keep_all(ps_feed *f, const ps_feed_repair_fns *fns, int k, const ps_photon_source *src,
+                     const ps_path_store *paths, uint64_t end, uint8_t *kept)
+{
+    int threads = ps_tracer_threads(f->tracer);
+    if (threads > KEEP_MAX_THREADS)
+        threads = KEEP_MAX_THREADS;
+    if (threads < 1 || end < (uint64_t)threads * 4096)
+        threads = 1;
+    keep_job jobs[KEEP_MAX_THREADS];
+    pthread_t tid[KEEP_MAX_THREADS];
+    bool started[KEEP_MAX_THREADS] = {false};
+    for (int t = 0; t < threads; t++) {
+        jobs[t] = (keep_job){fns, k, src, paths, end, end * (uint64_t)t / (uint64_t)threads,
+                             end * (uint64_t)(t + 1) / (uint64_t)threads, kept};
+        /* The first range on this thread; one that cannot start runs here too. */
+        if (t > 0)
+            started[t] = pthread_create(&tid[t], NULL, keep_range, &jobs[t]) == 0;
+    }
+    keep_range(&jobs[0]);
+    for (int t = 1; t < threads; t++) {
+        if (started[t])
+            pthread_join(tid[t], NULL);
+        else
+            keep_range(&jobs[t]);
+    }
+}
+
 /* Map k of the repaired feed f from the old one's (in index order, with
  * complete records): photon i of the edited scene takes the photons and
  * record of the old index its source names, when keep() lets it, with their
@@ -591,8 +645,9 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
         return ps_error_set(err, PS_ERR_NOMEM, "the %s map's path records are incomplete", ps_map_name((ps_map_kind)k));
     ps_photon_source *src = malloc(end * sizeof *src);
     size_t *off = malloc((end + 1) * sizeof *off);
-    if (!src || !off) {
-        free(src), free(off);
+    uint8_t *kept = malloc(end);
+    if (!src || !off || !kept) {
+        free(src), free(off), free(kept);
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
     }
     ps_status st = fns->sources(fns->ctx, (ps_map_kind)k, end, src, err);
@@ -614,6 +669,8 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
         st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
     }
     ps_path_rec *orec = op->rec;
+    if (st == PS_OK)
+        keep_all(f, fns, k, src, op, end, kept);
     off[0] = 0;
     for (uint64_t i = 0; i < end; i++)
         off[i + 1] = off[i] + ((orec[i].flags & REC_PENDING) ? 0 : orec[i].stored);
@@ -622,7 +679,7 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
     for (uint64_t i = 0; i < end && st == PS_OK; i++) {
         uint64_t o = src[i].from;
         ps_path_rec *r = &np->rec[i];
-        if (o < end && !(orec[o].flags & REC_PENDING) && fns->keep(fns->ctx, (ps_map_kind)k, o, op, &orec[o])) {
+        if (kept[i]) {
             size_t n = orec[o].stored;
             /* In place, source and destination may overlap (to <= off[o]). */
             if (n == 1) { /* most paths: plain copies, no calls */
@@ -664,7 +721,7 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
             f->marks[k][f->mark_count[k]++] = mk;
         }
     }
-    free(src), free(off);
+    free(src), free(off), free(kept);
     if (st != PS_OK)
         return st;
     np->count = end;
