@@ -599,19 +599,17 @@ static void *keep_range(void *arg)
     return NULL;
 }
 
-#define KEEP_MAX_THREADS 64
-
 static void keep_all(ps_feed *f, const ps_feed_repair_fns *fns, int k, const ps_photon_source *src,
                      const ps_path_store *paths, uint64_t end, uint8_t *kept)
 {
     int threads = ps_tracer_threads(f->tracer);
-    if (threads > KEEP_MAX_THREADS)
-        threads = KEEP_MAX_THREADS;
+    if (threads > PS_TRACER_MAX_THREADS)
+        threads = PS_TRACER_MAX_THREADS;
     if (threads < 1 || end < (uint64_t)threads * 4096)
         threads = 1;
-    keep_job jobs[KEEP_MAX_THREADS];
-    pthread_t tid[KEEP_MAX_THREADS];
-    bool started[KEEP_MAX_THREADS] = {false};
+    keep_job jobs[PS_TRACER_MAX_THREADS];
+    pthread_t tid[PS_TRACER_MAX_THREADS];
+    bool started[PS_TRACER_MAX_THREADS] = {false};
     for (int t = 0; t < threads; t++) {
         jobs[t] = (keep_job){fns, k, src, paths, end, end * (uint64_t)t / (uint64_t)threads,
                              end * (uint64_t)(t + 1) / (uint64_t)threads, kept};
