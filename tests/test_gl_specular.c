@@ -2,7 +2,8 @@
  * buffers) against closed forms and the reference renderer: a planar
  * mirror showing the floor's direct light at the mirrored point, a mirror
  * and a glass sphere in a furnace (cube maps of radiance 1), and the default
- * scene's spheres against photosplat-ref's `specular` component. */
+ * scene's spheres against photosplat-ref's `specular` component; and the
+ * faces' deadline (photosplat-snap's checkpoints) holding faces back. */
 #include "test.h"
 
 #include <GL/osmesa.h>
@@ -10,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/clock.h"
 #include "gl/gl_render.h"
 #include "gl/gl_specular.h"
 #include "photon/world.h"
@@ -292,6 +294,46 @@ static void default_scene_against_reference(void **state)
     rig_free(&r);
 }
 
+/* ps_gl_specular_set_deadline: a face that would pass the deadline waits
+ * (none drawn in a refresh whose deadline is past), and none set or one far
+ * off draws as before; a face not timed yet is allowed until the deadline. */
+static void deadline_holds_faces(void **state)
+{
+    (void)state;
+    assert_true(ps_gl_specular_face_fits(10.0, 0.0, 5.0));
+    assert_true(ps_gl_specular_face_fits(10.0, 10.5, 0.5));
+    assert_false(ps_gl_specular_face_fits(10.0, 10.5, 0.6));
+    assert_false(ps_gl_specular_face_fits(10.0, 9.0, 0.0));
+    rig r;
+    rig_make(&r, load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
+                           "material mirror mirror reflectance 1 1 1\n"
+                           "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0\n"
+                           "sphere center 0 0.5 -0.5 radius 0.3 material mirror\n"
+                           "light point position 0 1.2 0.3 power 50 50 50\n"),
+             64, 64);
+    ps_error err;
+    ps_session_frame f;
+    /* The first refresh is a new view: faces wait for the next. */
+    assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
+    assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
+    assert_true(f.specular && !f.new_view);
+    ps_gl_specular_set_deadline(r.spec, ps_now_seconds() - 1.0);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 1, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
+    ps_gl_specular_set_deadline(r.spec, ps_now_seconds() + 1000.0);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 1, &err), PS_OK);
+    unsigned timed = ps_gl_specular_faces_rendered(r.spec);
+    assert_true(timed > 0);
+    /* Timed now: a deadline shorter than those faces holds the next. */
+    ps_gl_specular_set_deadline(r.spec, ps_now_seconds() + 1e-9);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 1, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), timed);
+    ps_gl_specular_set_deadline(r.spec, 0.0);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 1, &err), PS_OK);
+    assert_true(ps_gl_specular_faces_rendered(r.spec) > timed);
+    rig_free(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -299,6 +341,7 @@ int main(void)
         cmocka_unit_test(furnace_mirror_sphere),
         cmocka_unit_test(furnace_glass_sphere),
         cmocka_unit_test(default_scene_against_reference),
+        cmocka_unit_test(deadline_holds_faces),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

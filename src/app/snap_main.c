@@ -13,6 +13,7 @@
 #include "app/interrupt.h"
 #include "app/latency.h"
 #include "app/options.h"
+#include "app/pace.h"
 #include "app/stats.h"
 #include "core/fileio.h"
 #include "gl/gl_render.h"
@@ -182,6 +183,7 @@ typedef struct snap_run {
     double draw_seconds;
     ps_latency lat;     /* --script: each edit's first refresh, phase by phase (app/latency.h) */
     bool awaiting_edit; /* the next refresh is the first after an update */
+    ps_pace_model pace; /* --checkpoints: the last refresh, to plan the next (app/pace.h) */
 } snap_run;
 
 /* One refresh: what the session says, drawn into the layers (the new
@@ -239,6 +241,16 @@ static ps_status refresh(snap_run *s, ps_error *err)
     s->draw_seconds += spent;
     s->frames++;
     ps_session_drawn(s->session, spent);
+    /* The pace's model: this refresh less its cube faces and shadow maps
+     * (made once for new lights). Incremental refreshes learn nothing from
+     * a new view or new lights (the direct layer drawn again, once), unless
+     * nothing is known yet; whole ones redraw everything every time. */
+    double plain = (t1 - t_refresh) - (t_draw - t0) - gst.shadow_seconds_last;
+    if (!s->layers || s->pace.seconds <= 0.0 || !(s->frame.new_view || s->frame.lights_changed))
+    {
+        ps_pace_learn(&s->pace, fmax(plain, 1e-6), (double)(s->frame.emitted[0] + s->frame.emitted[1]), !s->layers);
+        s->pace.lead = t0 - t_refresh;
+    }
     return PS_OK;
 }
 
@@ -478,6 +490,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
     snap_checkpoint_row rows[SNAP_MAX_CHECKPOINTS];
     ps_status st = ps_session_start(s->session, false, err);
     double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
+    double last_now = 0.0, last_photons = 0.0; /* the trace rate for the pace */
     int cp = 0;
     while (st == PS_OK) {
         if (ps_cancelled(o->cancel)) {
@@ -485,11 +498,19 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
                               ps_now_seconds() - t_start, o->time);
             break;
         }
-        double until = next < end ? next : end;
-        if (cp < o->checkpoint_count && t_start + excluded + o->checkpoints[cp] < until)
-            until = t_start + excluded + o->checkpoints[cp];
-        sleep_until(until);
+        /* When to refresh, and how long its cube faces may take, so that
+         * the frame each checkpoint shows lands soon after it (pace.h). */
+        double clock = t_start + excluded, at_plan = ps_now_seconds() - clock;
         ps_session_counts counts;
+        ps_session_get_counts(s->session, &counts);
+        double photons = (double)(counts.map[0].emitted + counts.map[1].emitted);
+        if (at_plan > last_now && photons >= last_photons)
+            s->pace.rate = (photons - last_photons) / (at_plan - last_now);
+        last_now = at_plan, last_photons = photons;
+        ps_pace_plan plan = ps_pace_next(&s->pace, at_plan, photons, fmin(next, end) - clock, o->checkpoints + cp,
+                                         o->checkpoint_count - cp);
+        ps_gl_specular_set_deadline(s->spec, isfinite(plan.faces_deadline) ? clock + plan.faces_deadline : 0.0);
+        sleep_until(clock + plan.start);
         ps_session_get_counts(s->session, &counts);
         st = refresh(s, err);
         if (st != PS_OK)
@@ -521,6 +542,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         if (counts.ended || ps_now_seconds() >= end)
             break;
     }
+    ps_gl_specular_set_deadline(s->spec, 0.0);
     st = last_picture(s, st, err);
     /* Checkpoints after the end (every cap reached, or the counter stopped
      * the tracer) show the final picture, at the time it was done. */

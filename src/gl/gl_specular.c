@@ -61,7 +61,26 @@ struct ps_gl_specular {
     float *xy; /* the per-pixel points' window coordinates */
     size_t xy_cap;
     int first_refreshes; /* the first round over this many refreshes; 0: budgeted */
+    /* ps_gl_specular_set_deadline: faces end by `deadline` (0: none), as each
+     * face's last time predicts, quick (the first round) and full apart: the
+     * faces differ several-fold (one looking down on the caustic, the shadows
+     * of an area light's virtual lights). face_max: the dearest seen, for a
+     * face not timed yet. */
+    double deadline;
+    float face_time[PS_SPECULAR_MAX_CUBES * 6][2];
+    double face_max;
 };
+
+void ps_gl_specular_set_deadline(ps_gl_specular *g, double at) { g->deadline = at > 0.0 ? at : 0.0; }
+
+bool ps_gl_specular_face_fits(double now, double at, double estimate) { return at <= 0.0 || now + estimate <= at; }
+
+/* The face at the cursor's predicted time. */
+static double face_estimate(const ps_gl_specular *g, bool quick)
+{
+    double t = g->face_time[g->cursor][quick];
+    return t > 0.0 ? t : g->face_max;
+}
 
 void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes) { g->first_refreshes = refreshes > 0 ? refreshes : 0; }
 
@@ -134,6 +153,7 @@ static void ensure_cubes(ps_gl_specular *g, int n)
     }
     g->cube_count = n;
     g->cursor = 0;
+    memset(g->face_time, 0, sizeof g->face_time); /* other cubes: other faces */
     g->since_change = g->since_settled = 0;
     memset(g->back_faces, 0, sizeof g->back_faces);
     if (n == 0)
@@ -309,6 +329,10 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
      * camera) comes as soon as without the layer: its faces wait. */
     if (faces > 0 && f->new_view)
         return PS_OK;
+    bool quick = faces > 0 && first_round && !settled;
+    bool timed = faces > 0 && g->deadline > 0.0;
+    if (timed && !ps_gl_specular_face_fits(ps_now_seconds(), g->deadline, face_estimate(g, quick)))
+        return PS_OK; /* before the budget's credit is spent on it */
     if (faces > 0 && !settled && !first_round) {
         /* A face only when the refreshes' share of tau has saved up for one
          * (it took face_seconds last time; the first comes at once). */
@@ -328,15 +352,33 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     double eye_extent = r->eye_extent;
     ps_status st = PS_OK;
     double t0 = ps_now_seconds();
+    /* Timed faces: the shadow maps (new GL lights) first, which the view's
+     * drawing would make anyway, so that they are no face's time. */
+    if (timed && f->direct && r->opt.shadows && !r->shadows_valid) {
+        ps_gl_make_shadow_maps(r);
+        glFinish();
+    }
+    int drawn = 0;
     for (int i = 0; i < n && st == PS_OK; i++) {
         int c = g->cursor / 6;
-        st = render_face(g, r, s, f, c, g->cursor % 6, faces > 0 && first_round && !settled, err);
+        double tf = ps_now_seconds();
+        if (timed && i > 0 && !ps_gl_specular_face_fits(tf, g->deadline, face_estimate(g, quick)))
+            break;
+        st = render_face(g, r, s, f, c, g->cursor % 6, quick, err);
         ps_gl_glossy_read_face(g->glossy, c, g->cursor % 6, g->back[c], g->size);
+        if (timed) {
+            glFinish(); /* llvmpipe draws when flushed */
+            double spent = ps_now_seconds() - tf;
+            g->face_time[g->cursor][quick] = (float)spent;
+            g->face_max = fmax(g->face_max, spent);
+        }
+        drawn++;
         g->cursor = (g->cursor + 1) % total;
         /* The layer is redrawn when a cube is whole again, not each face. */
         if (st == PS_OK && g->back_faces[c] == 0x3fu)
             show_back(g, s, c);
     }
+    n = drawn;
     if (faces <= 0 && ps_gl_glossy_blur(g->glossy, 0)) /* all at once: the levels too */
         g->cubes_changed = true;
     if (faces > 0) {

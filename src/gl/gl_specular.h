@@ -17,12 +17,13 @@
  * picture, the first after an edit and a moving camera's come as fast as
  * without the layer), the last round once they all arrived
  * over a few refreshes whatever the budget, all at once for a single frame and a snapshot's last
- * picture. Faces are rendered into a second map of the cube, shown once its
- * six faces are from one centre and one state of the scene (then the objects
- * are redrawn); until then the last whole map shows, its lookups looking
- * from where it was rendered (ps_session_set_specular_centre), so that an
- * object moved shows at once what its old map saw of the points its new eye
- * paths reach. They are kept
+ * picture (with a deadline, snap's checkpoints: only the faces that end
+ * before it). Faces are rendered into a second map of the cube, shown once
+ * its six faces are from one centre and one state of the scene (then the
+ * objects are redrawn); until then the last whole map shows, its lookups
+ * looking from where it was rendered (ps_session_set_specular_centre), so
+ * that an object moved shows at once what its old map saw of the points its
+ * new eye paths reach. They are kept
  * while only the camera moves; a new layer set, an edit or new GL lights
  * start a new round. Once the camera holds still and its per-pixel paths
  * are traced (preview/specular.h), each path is drawn as a one-pixel point
@@ -71,6 +72,17 @@ void ps_gl_specular_destroy(ps_gl_specular *g); /* accepts NULL */
 /* The first round of faces after a change over `refreshes` refreshes
  * whatever the budget (0, the default: within the budget, as later rounds). */
 void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes);
+
+/* The next refreshes' cube faces end by `at` (ps_now_seconds' clock; 0: no
+ * limit), as each face's last time predicts: a face that would pass it waits
+ * for a later refresh (photosplat-snap: the refreshes before a checkpoint
+ * leave it on time, pace.h). Not for `faces` 0 (all at once). Each face is
+ * then finished and timed on its own. */
+void ps_gl_specular_set_deadline(ps_gl_specular *g, double at);
+/* Whether a face predicted to take `estimate` seconds (0: not timed yet,
+ * allowed until the deadline) may start at `now` under deadline `at` (0:
+ * none). */
+bool ps_gl_specular_face_fits(double now, double at, double estimate);
 
 /* Before drawing refresh f of session s: up to `faces` cube faces rendered
  * (0: every face of every cube), when f shows the specular layer. Leaves the
