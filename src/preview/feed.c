@@ -47,6 +47,15 @@ struct ps_feed {
     size_t kept_end[PS_MAP_COUNT];
     uint64_t repair_end[PS_MAP_COUNT];
     bool repairing[PS_MAP_COUNT];
+    /* A merge made ready by the thread at its end (prepare_map), swapped in
+     * when the drawing side asks (commit_map): the copying off the next
+     * edit's update, the swap when it costs the picture nothing
+     * (ps_feed_merge). */
+    bool prepared[PS_MAP_COUNT];
+    ps_photon_map merged[PS_MAP_COUNT];
+    ps_feed_mark *merged_marks[PS_MAP_COUNT];
+    size_t merged_nmarks[PS_MAP_COUNT];
+    ps_path_thr *merged_thr[PS_MAP_COUNT];
     uint64_t generation;            /* under lock */
     ps_feed_repair_count repair;    /* what the repair that made this feed kept */
 };
@@ -78,6 +87,7 @@ ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const 
 
 static ps_status hand_over(ps_feed *f, int k, ps_traced *traced, const uint64_t *idx, ps_error *err);
 static ps_status merge(ps_feed *f, ps_error *err);
+static ps_status prepare_map(ps_feed *f, int k, ps_error *err);
 
 /* Traces photons [first, first + count) of map k outside the lock, then
  * joins them to the map under it: each photon is copied once, from the
@@ -255,8 +265,8 @@ static void *feed_main(void *arg)
         more = round_once(f, &st, &err);
     }
     /* Every photon traced: the maps back in index order, as a fresh trace
-     * of the edited scene has them. The background thread leaves that to
-     * ps_feed_merge: a merge reorders what an incremental picture has drawn
+     * of the edited scene has them. The background thread leaves the swap
+     * to ps_feed_merge: a merge reorders what an incremental picture has drawn
      * only in part, which then starts over from one batch (a picture that
      * got worse a quarter of a second after an edit, and took seconds to
      * come back); the drawing side merges once it has drawn every photon,
@@ -266,6 +276,9 @@ static void *feed_main(void *arg)
     pthread_mutex_unlock(&f->lock);
     if (st == PS_OK && !stopped && !f->threaded)
         st = merge(f, &err);
+    /* ... but makes it ready, off the drawing side's time. */
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK && !stopped && f->threaded; k++)
+        st = prepare_map(f, k, &err);
     pthread_mutex_lock(&f->lock);
     f->status = st;
     f->err = err;
@@ -392,6 +405,11 @@ void ps_feed_destroy(ps_feed *f)
         free(f->marks[k]);
         ps_path_store_free(&f->paths[k]);
         free(f->pending[k]);
+        if (f->prepared[k]) {
+            ps_photon_map_free(&f->merged[k]);
+            free(f->merged_marks[k]);
+            free(f->merged_thr[k]);
+        }
     }
     pthread_cond_destroy(&f->wake);
     pthread_cond_destroy(&f->idle);
@@ -409,12 +427,13 @@ static bool compact_paths(ps_path_store *p)
     return 2 * used >= p->vcount || ps_path_store_compact(p);
 }
 
-/* Puts map k back in index order: the kept run and the retraced run
- * interleaved by index (pending indices have no photons), then the rest.
- * Under the feed's thread or with it stopped; takes the lock to swap. */
-static ps_status merge_map(ps_feed *f, int k, ps_error *err)
+/* Map k back in index order, made ready beside the map: the kept run and
+ * the retraced run interleaved by index (pending indices have no photons),
+ * then the rest. Under the feed's thread or with it stopped, the map no
+ * longer growing; it reads only. */
+static ps_status prepare_map(ps_feed *f, int k, ps_error *err)
 {
-    if (!f->repairing[k])
+    if (!f->repairing[k] || f->prepared[k])
         return PS_OK;
     ps_photon_map *m = &f->maps[k];
     ps_photon_map out;
@@ -470,21 +489,38 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
     memcpy(out.objects + out.count, m->objects + re, rest * sizeof *m->objects);
     memcpy(thr + out.count, old_thr + re, rest * sizeof *thr);
     out.count += rest;
-    free(f->paths[k].thr);
-    f->paths[k].thr = thr;
-    f->paths[k].tcap = m->count ? m->count : 1;
-    f->paths[k].tcount = m->count;
     out.counters = m->counters;
-    pthread_mutex_lock(&f->lock);
-    ps_photon_map_free(m);
-    *m = out;
     if (nmarks == 0 || marks[nmarks - 1].emitted != m->counters.emitted) /* stopped mid-round */
         marks[nmarks++] = (ps_feed_mark){m->count, m->counters.emitted};
+    f->merged[k] = out;
+    f->merged_marks[k] = marks;
+    f->merged_nmarks[k] = nmarks;
+    f->merged_thr[k] = thr;
+    f->prepared[k] = true;
+    return PS_OK;
+}
+
+/* The prepared map k swapped in (under the lock), its records made plain. */
+static ps_status commit_map(ps_feed *f, int k, ps_error *err)
+{
+    if (!f->prepared[k])
+        return PS_OK;
+    ps_photon_map *m = &f->maps[k];
+    free(f->paths[k].thr);
+    f->paths[k].thr = f->merged_thr[k];
+    f->paths[k].tcap = f->merged[k].count ? f->merged[k].count : 1;
+    f->paths[k].tcount = f->merged[k].count;
+    pthread_mutex_lock(&f->lock);
+    ps_photon_map_free(m);
+    *m = f->merged[k];
     free(f->marks[k]);
-    f->marks[k] = marks;
-    f->mark_count[k] = f->mark_cap[k] = nmarks;
+    f->marks[k] = f->merged_marks[k];
+    f->mark_count[k] = f->mark_cap[k] = f->merged_nmarks[k];
     f->generation++;
     pthread_mutex_unlock(&f->lock);
+    f->prepared[k] = false;
+    f->merged_marks[k] = NULL;
+    f->merged_thr[k] = NULL;
     for (uint64_t i = 0; i < f->repair_end[k]; i++)
         f->paths[k].rec[i].flags &= (uint8_t)~REC_RETRACED;
     if (!compact_paths(&f->paths[k]))
@@ -492,6 +528,13 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
     f->kept_end[k] = m->count;
     f->repairing[k] = false;
     return PS_OK;
+}
+
+/* Puts map k back in index order now. */
+static ps_status merge_map(ps_feed *f, int k, ps_error *err)
+{
+    ps_status st = prepare_map(f, k, err);
+    return st == PS_OK ? commit_map(f, k, err) : st;
 }
 
 static ps_status merge(ps_feed *f, ps_error *err)
