@@ -35,14 +35,21 @@ static ps_scene *load(void)
     return scene;
 }
 
-static ps_session *open_traced(ps_scene *scene)
+/* A repairing session's settings with these caps. */
+static ps_session_settings repair_settings(const ps_scene *scene, uint64_t caustic_cap, uint64_t global_cap)
 {
     ps_session_settings set = ps_session_default_settings(scene);
-    set.caps[PS_MAP_CAUSTIC] = CAUSTIC_CAP;
-    set.caps[PS_MAP_GLOBAL] = GLOBAL_CAP;
+    set.caps[PS_MAP_CAUSTIC] = caustic_cap;
+    set.caps[PS_MAP_GLOBAL] = global_cap;
     set.seed = SEED;
     set.threads = 2;
     set.repair = true;
+    return set;
+}
+
+static ps_session *open_traced(ps_scene *scene)
+{
+    ps_session_settings set = repair_settings(scene, CAUSTIC_CAP, GLOBAL_CAP);
     ps_session *s;
     ps_error err;
     if (ps_session_create(scene, &set, &s, &err) != PS_OK)
@@ -343,12 +350,7 @@ static void marks_after_a_repair_are_a_fresh_feeds(void **state)
 #define SHOWN_GLOBAL_CAP PS_FEED_BATCH
 static ps_session *open_shown(ps_scene *scene, uint64_t retrace_first, ps_camera_frame *cam)
 {
-    ps_session_settings set = ps_session_default_settings(scene);
-    set.caps[PS_MAP_CAUSTIC] = SHOWN_CAUSTIC_CAP;
-    set.caps[PS_MAP_GLOBAL] = SHOWN_GLOBAL_CAP;
-    set.seed = SEED;
-    set.threads = 2;
-    set.repair = true;
+    ps_session_settings set = repair_settings(scene, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
     set.float_buffer = set.incremental = true;
     set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
     set.retrace_first = retrace_first;
