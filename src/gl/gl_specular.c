@@ -61,13 +61,13 @@ struct ps_gl_specular {
     float *xy; /* the per-pixel points' window coordinates */
     size_t xy_cap;
     int first_refreshes; /* the first round over this many refreshes; 0: budgeted */
-    /* ps_gl_specular_set_deadline: faces end by `deadline` (0: none), as each
-     * face's last time predicts, quick (the first round) and full apart: the
-     * faces differ several-fold (one looking down on the caustic, the shadows
-     * of an area light's virtual lights). face_max: the dearest seen, for a
+    /* ps_gl_specular_set_deadline: faces past the first round end by
+     * `deadline` (0: none), as each face's last time predicts: the faces
+     * differ several-fold (one looking down on the caustic, the shadows of
+     * an area light's virtual lights). face_max: the dearest seen, for a
      * face not timed yet. */
     double deadline;
-    float face_time[PS_SPECULAR_MAX_CUBES * 6][2];
+    float face_time[PS_SPECULAR_MAX_CUBES * 6];
     double face_max;
 };
 
@@ -76,9 +76,9 @@ void ps_gl_specular_set_deadline(ps_gl_specular *g, double at) { g->deadline = a
 bool ps_gl_specular_face_fits(double now, double at, double estimate) { return at <= 0.0 || now + estimate <= at; }
 
 /* The face at the cursor's predicted time. */
-static double face_estimate(const ps_gl_specular *g, bool quick)
+static double face_estimate(const ps_gl_specular *g)
 {
-    double t = g->face_time[g->cursor][quick];
+    double t = g->face_time[g->cursor];
     return t > 0.0 ? t : g->face_max;
 }
 
@@ -336,7 +336,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
      * and 2 s against 0.053 and 0.008-0.053 with it drawn), a worse picture
      * at each time for the sake of the time it is shown at. */
     bool timed = faces > 0 && g->deadline > 0.0 && !quick;
-    if (timed && !ps_gl_specular_face_fits(ps_now_seconds(), g->deadline, face_estimate(g, quick)))
+    if (timed && !ps_gl_specular_face_fits(ps_now_seconds(), g->deadline, face_estimate(g)))
         return PS_OK; /* before the budget's credit is spent on it */
     if (faces > 0 && !settled && !first_round) {
         /* A face only when the refreshes' share of tau has saved up for one
@@ -367,14 +367,14 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     for (int i = 0; i < n && st == PS_OK; i++) {
         int c = g->cursor / 6;
         double tf = ps_now_seconds();
-        if (timed && i > 0 && !ps_gl_specular_face_fits(tf, g->deadline, face_estimate(g, quick)))
+        if (timed && i > 0 && !ps_gl_specular_face_fits(tf, g->deadline, face_estimate(g)))
             break;
         st = render_face(g, r, s, f, c, g->cursor % 6, quick, err);
         ps_gl_glossy_read_face(g->glossy, c, g->cursor % 6, g->back[c], g->size);
         if (timed) {
             glFinish(); /* llvmpipe draws when flushed */
             double spent = ps_now_seconds() - tf;
-            g->face_time[g->cursor][quick] = (float)spent;
+            g->face_time[g->cursor] = (float)spent;
             g->face_max = fmax(g->face_max, spent);
         }
         drawn++;
