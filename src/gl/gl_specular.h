@@ -73,11 +73,12 @@ void ps_gl_specular_destroy(ps_gl_specular *g); /* accepts NULL */
  * whatever the budget (0, the default: within the budget, as later rounds). */
 void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes);
 
-/* The next refreshes' cube faces past the first round after a change end by
- * `at` (ps_now_seconds' clock; 0: no limit), as each face's last time predicts: a face that would pass it waits
- * for a later refresh (photosplat-snap: the refreshes before a checkpoint
- * leave it on time, pace.h). Not for `faces` 0 (all at once). Each face is
- * then finished and timed on its own. */
+/* The next refreshes' cube faces past the first round after a change end
+ * by `at` (ps_now_seconds' clock; 0: no limit), as each face's last time
+ * predicts: a face that would pass it waits for a later refresh
+ * (photosplat-snap: the refreshes before a checkpoint leave it on time,
+ * pace.h). Not for `faces` 0 (all at once). Each face is then finished and
+ * timed on its own. */
 void ps_gl_specular_set_deadline(ps_gl_specular *g, double at);
 /* Whether a face predicted to take `estimate` seconds (0: not timed yet,
  * allowed until the deadline) may start at `now` under deadline `at` (0:
