@@ -31,6 +31,8 @@ static inline ps_vec3 ps_v3_sub(ps_vec3 a, ps_vec3 b) { return ps_v3(a.x - b.x, 
 static inline ps_vec3 ps_v3_mul(ps_vec3 a, ps_vec3 b) { return ps_v3(a.x * b.x, a.y * b.y, a.z * b.z); }
 static inline ps_vec3 ps_v3_scale(ps_vec3 a, double s) { return ps_v3(a.x * s, a.y * s, a.z * s); }
 static inline ps_vec3 ps_v3_neg(ps_vec3 a) { return ps_v3(-a.x, -a.y, -a.z); }
+/* Bit for bit (a cache key, a place drawn from): no tolerance. */
+static inline bool ps_v3_equal(ps_vec3 a, ps_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 /* a + b·s, the most common step along a ray. */
 static inline ps_vec3 ps_v3_madd(ps_vec3 a, ps_vec3 b, double s) { return ps_v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s); }
 static inline double ps_v3_dot(ps_vec3 a, ps_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }

@@ -206,8 +206,6 @@ void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value)
     g->cubes_changed = true;
 }
 
-static bool same_point(ps_vec3 a, ps_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-
 /* Face f of cube c: the preview seen from the cube's centre, mirrors and
  * glass left out, at exposure 1. */
 static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *fr, int c,
@@ -228,7 +226,7 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
         ps_gl_make_shadow_maps(r);
 
     /* Into the back map, whose faces must all be from one centre. */
-    if (g->back_faces[c] != 0 && !same_point(g->back_centre[c], cam.eye))
+    if (g->back_faces[c] != 0 && !ps_v3_equal(g->back_centre[c], cam.eye))
         g->back_faces[c] = 0;
     g->back_centre[c] = cam.eye;
     g->back_faces[c] |= 1u << f;

@@ -545,9 +545,8 @@ static ps_status merge(ps_feed *f, ps_error *err)
     return st;
 }
 
-ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, bool *done, ps_error *err)
+ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, ps_error *err)
 {
-    *done = false;
     uint64_t pending = 0;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         pending += f->pending_count[k] - f->pending_done[k];
@@ -574,7 +573,6 @@ ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, bool *done, ps
     if (st == PS_OK && !left)
         st = merge(f, err);
     f->seconds += ps_now_seconds() - t0;
-    *done = st == PS_OK && !left;
     return st;
 }
 

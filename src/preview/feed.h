@@ -137,10 +137,10 @@ bool ps_feed_merge_pending(const ps_feed *f);
 /* Before run, prime or start of a repaired feed: when its retrace (the
  * pending indices of both maps) is at most max_photons, all of it on the
  * calling thread, as the thread's rounds would, and the maps put in index
- * order at once (*done true); else nothing, the thread's. A count, not a
+ * order at once; else nothing, the thread's. A count, not a
  * time: what the first picture after an edit shows does not depend on the
  * machine's load. */
-ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, bool *done, ps_error *err);
+ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, ps_error *err);
 /* Not under the lock: once the feed has ended, its maps in index order (a
  * no-op when none is in repair order); counts a generation per map
  * reordered. On an error (out of memory) the feed's status is it. */

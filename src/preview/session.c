@@ -360,12 +360,10 @@ bool ps_session_counter_stopped(const ps_session *s, uint64_t *at_photons)
 
 /* ---- refreshing ------------------------------------------------------------------- */
 
-static bool same_vec(ps_vec3 a, ps_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-
 static bool same_camera(const ps_camera_frame *a, const ps_camera_frame *b)
 {
-    return same_vec(a->eye, b->eye) && same_vec(a->forward, b->forward) && same_vec(a->right, b->right) &&
-           same_vec(a->up, b->up) && a->tan_half_fov == b->tan_half_fov && a->aspect == b->aspect &&
+    return ps_v3_equal(a->eye, b->eye) && ps_v3_equal(a->forward, b->forward) && ps_v3_equal(a->right, b->right) &&
+           ps_v3_equal(a->up, b->up) && a->tan_half_fov == b->tan_half_fov && a->aspect == b->aspect &&
            a->width == b->width && a->height == b->height;
 }
 
@@ -940,9 +938,8 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
              * edit near few paths), so that the first picture has no hole
              * where the moved object was and the maps are in index order
              * from the start; else by the thread. */
-            bool done = false;
             if (s->started)
-                st = ps_feed_retrace_first(f, s->set.retrace_first, &done, err);
+                st = ps_feed_retrace_first(f, s->set.retrace_first, err);
             /* A map that has nothing yet gets its first batch before the
              * first picture, as after a restart; one that has photons shows
              * them at once. */
@@ -984,13 +981,7 @@ ps_specular *ps_session_specular(ps_session *s) { return s->spec; }
 
 void ps_session_set_specular_centre(ps_session *s, int cube, ps_vec3 centre)
 {
-    if (cube < 0 || cube >= ps_specular_cube_count(s->spec))
-        return;
-    ps_vec3 was = ps_specular_lookup_centre(s->spec, cube);
-    if (was.x == centre.x && was.y == centre.y && was.z == centre.z)
-        return;
-    ps_specular_set_lookup_centre(s->spec, cube, centre);
-    if (s->have_cam)
+    if (ps_specular_set_lookup_centre(s->spec, cube, centre) && s->have_cam)
         ps_specular_update(s->spec, s->world, s->cam.eye, 0);
 }
 uint64_t ps_session_maps_epoch(const ps_session *s) { return s->maps_epoch; }

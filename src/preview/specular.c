@@ -295,14 +295,13 @@ int ps_specular_cube_count(const ps_specular *sp) { return sp->cube_count; }
 ps_vec3 ps_specular_cube_centre(const ps_specular *sp, int cube) { return sp->centre[cube]; }
 ps_vec3 ps_specular_lookup_centre(const ps_specular *sp, int cube) { return sp->lookup_centre[cube]; }
 
-static bool same_vec(ps_vec3 a, ps_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-
-void ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre)
+bool ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre)
 {
-    if (cube < 0 || cube >= sp->cube_count || same_vec(centre, sp->lookup_centre[cube]))
-        return;
+    if (cube < 0 || cube >= sp->cube_count || ps_v3_equal(centre, sp->lookup_centre[cube]))
+        return false;
     sp->lookup_centre[cube] = centre;
     ps_specular_invalidate(sp);
+    return true;
 }
 const float *ps_specular_dirs(const ps_specular *sp, int k) { return sp->dirs[k]; }
 const float *ps_specular_weights(const ps_specular *sp, int k) { return sp->weights[k]; }
@@ -490,7 +489,6 @@ int ps_specular_trace_point(const ps_world *world, const ps_material *materials,
     return k;
 }
 
-
 /* Which listed range holds lookup vertex k (ranges are in offset order). */
 static size_t range_of(const ps_specular *sp, size_t k)
 {
@@ -507,7 +505,7 @@ static size_t range_of(const ps_specular *sp, size_t k)
 
 size_t ps_specular_update(ps_specular *sp, const ps_world *world, ps_vec3 eye, size_t max_vertices)
 {
-    if (!sp->have_eye || !same_vec(eye, sp->eye)) {
+    if (!sp->have_eye || !ps_v3_equal(eye, sp->eye)) {
         sp->have_eye = true;
         sp->eye = eye;
         sp->next_unique = 0;
@@ -575,8 +573,8 @@ void ps_specular_invalidate(ps_specular *sp)
 
 static bool same_frame(const ps_camera_frame *a, const ps_camera_frame *b)
 {
-    return same_vec(a->eye, b->eye) && same_vec(a->forward, b->forward) && same_vec(a->right, b->right) &&
-           same_vec(a->up, b->up) && a->tan_half_fov == b->tan_half_fov && a->aspect == b->aspect &&
+    return ps_v3_equal(a->eye, b->eye) && ps_v3_equal(a->forward, b->forward) && ps_v3_equal(a->right, b->right) &&
+           ps_v3_equal(a->up, b->up) && a->tan_half_fov == b->tan_half_fov && a->aspect == b->aspect &&
            a->width == b->width && a->height == b->height;
 }
 

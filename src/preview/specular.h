@@ -80,9 +80,11 @@ ps_vec3 ps_specular_cube_centre(const ps_specular *sp, int cube);
  * map it shows until then), so that the lookups find in the old map the
  * very points the eye paths end at, not the same directions from elsewhere
  * (the default scene's mirror moved 10 cm showed its reflections shifted
- * for the seconds a new map took). A new centre traces every lookup again. */
+ * for the seconds a new map took). A new centre traces every lookup again
+ * (those of every cube, and the per-pixel paths). */
 ps_vec3 ps_specular_lookup_centre(const ps_specular *sp, int cube);
-void ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre);
+/* Whether that changed the centre (and so the lookups are to be traced). */
+bool ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre);
 
 /* Traces the lookups for an eye at `eye` through `world` (the session's:
  * the same surfaces as the mesh), at most max_vertices distinct vertices
