@@ -262,8 +262,10 @@ for c in cu ce; do
         --global-photons 400000 >/dev/null
 done
 for r in on off; do
-    printf '%s\n' "0 wait done" "0 screenshot $tmp/before-$r.pfm" "0 move object 6  0.1 0 0" \
-        "0 screenshot $tmp/first-$r.pfm" "1 screenshot $tmp/later-$r.pfm" "1 quit" >"$tmp/rel-$r.txt"
+    # Script times count from the first frame: the edit at 10 s (the maps
+    # are full by then: wait done takes 2-4 s), the later picture 1 s after.
+    printf '%s\n' "0 wait done" "10 screenshot $tmp/before-$r.pfm" "10 move object 6  0.1 0 0" \
+        "10 screenshot $tmp/first-$r.pfm" "11 screenshot $tmp/later-$r.pfm" "11 quit" >"$tmp/rel-$r.txt"
     bin/photosplat-snap "$scene" --script "$tmp/rel-$r.txt" --repair $r "${common[@]}" >/dev/null
 done
 rel() { bin/photosplat-compare "$1" "$2" | sed -n 's/.*relmse=\([^ ]*\).*/\1/p'; }

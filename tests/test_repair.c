@@ -12,6 +12,7 @@
 #include "photon/world.h"
 #include "preview/feed.h"
 #include "preview/session.h"
+#include "preview/specular.h"
 #include "scene/scene.h"
 #include "two_lights.h"
 
@@ -453,6 +454,54 @@ static void a_small_repair_is_done_before_the_first_picture(void **state)
     ps_scene_destroy(scene);
 }
 
+/* The specular layer after the mirror moves, camera still (256^2: its spheres
+ * take some 7*10^4 eye rays): the edit's first refresh traces the per-pixel
+ * paths whole (PS_SESSION_PIXEL_RAYS_WHOLE), where a budget a refresh left
+ * that picture with per-vertex lookups (pixel_rays_whole 0; tau tiny: one
+ * chunk of rays a refresh). */
+static bool first_edit_picture_has_pixel_paths(uint64_t pixel_rays_whole)
+{
+    ps_scene *scene = load();
+    ps_session_settings set = repair_settings(scene, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+    set.float_buffer = set.incremental = true;
+    set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL | PS_LAYER_SPECULAR;
+    set.tau = 1e-9;
+    set.pixel_rays_whole = pixel_rays_whole;
+    ps_session *s;
+    ps_error err;
+    if (ps_session_create(scene, &set, &s, &err) != PS_OK)
+        fail_msg("session: %s", err.msg);
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 256, 256);
+    ps_session_frame f;
+    for (int i = 0; i < 1000 && !ps_specular_pixel_points(ps_session_specular(s)).ready; i++) {
+        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+        ps_session_drawn(s, 1e-4);
+    }
+    assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready);
+    apply(s, MOVE_MIRROR, 0);
+    ps_session_changes ch;
+    assert_int_equal(ps_session_update(s, &ch, &err), PS_OK);
+    assert_true(ch.geometry);
+    assert_false(ps_specular_pixel_points(ps_session_specular(s)).ready);
+    size_t rays = ps_specular_pixel_rays_left(ps_session_specular(s), &cam);
+    assert_true(rays > PS_SPECULAR_PIXEL_RAYS && rays <= PS_SESSION_PIXEL_RAYS_WHOLE);
+    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+    assert_true(f.specular);
+    bool ready = ps_specular_pixel_points(ps_session_specular(s)).ready;
+    assert_int_equal(ps_session_stop(s, &err), PS_OK);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+    return ready;
+}
+
+static void an_edit_picture_has_pixel_paths(void **state)
+{
+    (void)state;
+    assert_true(first_edit_picture_has_pixel_paths(PS_SESSION_PIXEL_RAYS_WHOLE));
+    assert_false(first_edit_picture_has_pixel_paths(0));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -462,6 +511,7 @@ int main(void)
         cmocka_unit_test(marks_after_a_repair_are_a_fresh_feeds),
         cmocka_unit_test(a_background_repair_keeps_the_view),
         cmocka_unit_test(a_small_repair_is_done_before_the_first_picture),
+        cmocka_unit_test(an_edit_picture_has_pixel_paths),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

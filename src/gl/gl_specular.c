@@ -165,8 +165,9 @@ static void ensure_cubes(ps_gl_specular *g, int n)
 }
 
 /* Cube c's back map has all six faces from one centre: shown from now on,
- * its lookups looking from that centre (traced again at once when it
- * moved, so that this refresh's layer is drawn with lookups that match). */
+ * its lookups and per-pixel points looking from that centre (re-aimed at
+ * once when it moved, so that this refresh's layer is drawn with lookups
+ * that match). */
 static void show_back(ps_gl_specular *g, ps_session *s, int c)
 {
     GLuint t = g->cube[c];

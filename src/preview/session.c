@@ -95,6 +95,7 @@ ps_session_settings ps_session_default_settings(const ps_scene *scene)
     set.shadow_size = PS_SHADOW_SIZE_DEFAULT;
     set.repair = true;
     set.retrace_first = PS_SESSION_RETRACE_FIRST;
+    set.pixel_rays_whole = PS_SESSION_PIXEL_RAYS_WHOLE;
     return set;
 }
 
@@ -132,6 +133,9 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
     size_t nm;
     if (st == PS_OK)
         st = ps_specular_create(&s->mesh, ps_scene_materials(s->scene, &nm), &s->spec, err);
+    /* Per-pixel paths on the threads the splats are built on. */
+    if (st == PS_OK)
+        ps_specular_set_threads(s->spec, s->set.threads > 0 ? s->set.threads : ps_online_cores());
     /* The drawing side still shows the maps it had (ps_session_set_specular_centre). */
     if (st == PS_OK && ps_specular_cube_count(s->spec) == old_cubes)
         for (int c = 0; c < old_cubes; c++)
@@ -644,10 +648,13 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     if (out->specular)
         ps_specular_update(s->spec, s->world, cam->eye,
                            !inc ? 0 : s->moving ? PS_SESSION_SPECULAR_VERTICES_MOVING : PS_SESSION_SPECULAR_VERTICES);
-    /* Per-pixel paths once the camera holds still (specular.h). */
-    if (out->specular && !out->moving)
-        ps_specular_update_pixels(s->spec, s->world, cam, inc ? PS_SPECULAR_PIXEL_RAYS : 0,
-                                  inc ? PS_SPECULAR_PIXEL_TIME_SHARE * s->set.tau : 0.0);
+    /* Per-pixel paths once the camera holds still (specular.h): a budget a
+     * refresh, or whole when few are left (PS_SESSION_PIXEL_RAYS_WHOLE). */
+    if (out->specular && !out->moving) {
+        bool at_once = !inc || ps_specular_pixel_rays_left(s->spec, cam) <= s->set.pixel_rays_whole;
+        ps_specular_update_pixels(s->spec, s->world, cam, at_once ? 0 : PS_SPECULAR_PIXEL_RAYS,
+                                  at_once ? 0.0 : PS_SPECULAR_PIXEL_TIME_SHARE * s->set.tau);
+    }
     out->direct_exposure = inc ? 1.0 : exposure(s);
     out->direct_gain = inc ? exposure(s) : 1.0;
     out->splat = s->set.splat;
@@ -981,8 +988,7 @@ ps_specular *ps_session_specular(ps_session *s) { return s->spec; }
 
 void ps_session_set_specular_centre(ps_session *s, int cube, ps_vec3 centre)
 {
-    if (ps_specular_set_lookup_centre(s->spec, cube, centre) && s->have_cam)
-        ps_specular_update(s->spec, s->world, s->cam.eye, 0);
+    ps_specular_set_lookup_centre(s->spec, cube, centre);
 }
 uint64_t ps_session_maps_epoch(const ps_session *s) { return s->maps_epoch; }
 

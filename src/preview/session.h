@@ -88,6 +88,15 @@
  * time bound was met or missed with the machine's load, and the first
  * picture with it. */
 #define PS_SESSION_RETRACE_FIRST 131072
+/* A still camera's per-pixel specular paths (specular.h) are traced whole in
+ * one refresh when at most this many eye rays are left, else
+ * PS_SPECULAR_PIXEL_RAYS a refresh: the default scene's spheres at 256^2
+ * take 6.8*10^4 rays, 0.04 s on 2 cores, so the first picture after an edit
+ * shows them, where per-vertex lookups left the default scene's mirror,
+ * moved 10 cm, at relMSE 0.051 against the converged picture (0.0085 with
+ * its paths; docs/repair.md). At 512^2 (2.6*10^5) the last of them come
+ * whole. A count, as above. */
+#define PS_SESSION_PIXEL_RAYS_WHOLE 131072
 
 typedef struct ps_session_settings {
     /* The photons. */
@@ -133,6 +142,8 @@ typedef struct ps_session_settings {
     uint64_t retrace_first;        /* ... and retrace the others before the first picture
                                     * after an edit when they are at most this many, else in
                                     * the background (PS_SESSION_RETRACE_FIRST) */
+    uint64_t pixel_rays_whole;     /* the per-pixel specular paths whole in a refresh when at
+                                    * most this many rays are left (PS_SESSION_PIXEL_RAYS_WHOLE) */
 } ps_session_settings;
 
 /* Defaults: the scene's photon counts and radii, every layer, triangles, the
@@ -295,9 +306,8 @@ const ps_tracer *ps_session_tracer(const ps_session *s);
 /* The specular layer's lookups over the fine mesh (preview/specular.h). */
 struct ps_specular *ps_session_specular(ps_session *s);
 /* The drawing side shows cube map `cube` rendered from `centre` now: its
- * lookups look from there (ps_specular_set_lookup_centre), traced again at
- * once for the last refresh's eye when that moved them (the per-pixel paths
- * over the next refreshes). Kept across edits that rebuild the lookups,
+ * lookups and per-pixel points look from there (ps_specular_set_lookup_centre:
+ * re-aimed, nothing traced). Kept across edits that rebuild the lookups,
  * while the cubes stay the same in number (the maps shown are the old ones
  * until new ones are whole). */
 void ps_session_set_specular_centre(ps_session *s, int cube, ps_vec3 centre);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/clock.h"
+#include "core/jobs.h"
 #include "preview/specular_glossy.h"
 #include "scene/bsdf.h"
 
@@ -15,46 +16,110 @@
  * interpolated against neighbouring vertices' finite points. */
 #define FAR_DIAGONALS 1000.0
 
-/* Points of the per-pixel layer (specular.h). */
+ps_vec3 ps_specular_term_dir(const ps_specular_term *t, ps_vec3 centre)
+{
+    return t->scale > 0.0 ? ps_v3_scale(ps_v3_sub(t->end, centre), t->scale) : t->end;
+}
+
+static void store_dir(float *out, ps_vec3 d) { out[0] = (float)d.x, out[1] = (float)d.y, out[2] = (float)d.z; }
+
+/* Points of the per-pixel layer (specular.h), each with its path's end and
+ * scale (ps_specular_term) to re-aim it from another centre. */
 typedef struct point_set {
     float *xy, *dirs, *weights;
     int *cube;
+    double *ends, *scales;
     size_t count, cap;
 } point_set;
 
 static void point_set_free(point_set *p)
 {
-    free(p->xy), free(p->dirs), free(p->weights), free(p->cube);
+    free(p->xy), free(p->dirs), free(p->weights), free(p->cube), free(p->ends), free(p->scales);
     memset(p, 0, sizeof *p);
 }
 
-static bool point_set_add(point_set *p, float x, float y, ps_vec3 d, ps_rgb w, int cube)
+static bool point_set_reserve(point_set *p, size_t n)
 {
-    if (p->count == p->cap) {
-        size_t cap = p->cap ? 2 * p->cap : 4096;
-        float *xy = realloc(p->xy, 2 * cap * sizeof *xy);
-        if (xy)
-            p->xy = xy;
-        float *dirs = realloc(p->dirs, 3 * cap * sizeof *dirs);
-        if (dirs)
-            p->dirs = dirs;
-        float *weights = realloc(p->weights, 3 * cap * sizeof *weights);
-        if (weights)
-            p->weights = weights;
-        int *cubes = realloc(p->cube, cap * sizeof *cubes);
-        if (cubes)
-            p->cube = cubes;
-        if (!xy || !dirs || !weights || !cubes)
-            return false;
-        p->cap = cap;
-    }
-    size_t i = p->count++;
-    p->xy[2 * i] = x, p->xy[2 * i + 1] = y;
-    p->dirs[3 * i] = (float)d.x, p->dirs[3 * i + 1] = (float)d.y, p->dirs[3 * i + 2] = (float)d.z;
-    p->weights[3 * i] = (float)w.r, p->weights[3 * i + 1] = (float)w.g, p->weights[3 * i + 2] = (float)w.b;
-    p->cube[i] = cube;
+    if (n <= p->cap)
+        return true;
+    size_t cap = p->cap ? p->cap : 4096;
+    while (cap < n)
+        cap *= 2;
+    float *xy = realloc(p->xy, 2 * cap * sizeof *xy);
+    if (xy)
+        p->xy = xy;
+    float *dirs = realloc(p->dirs, 3 * cap * sizeof *dirs);
+    if (dirs)
+        p->dirs = dirs;
+    float *weights = realloc(p->weights, 3 * cap * sizeof *weights);
+    if (weights)
+        p->weights = weights;
+    int *cubes = realloc(p->cube, cap * sizeof *cubes);
+    if (cubes)
+        p->cube = cubes;
+    double *ends = realloc(p->ends, 3 * cap * sizeof *ends);
+    if (ends)
+        p->ends = ends;
+    double *scales = realloc(p->scales, cap * sizeof *scales);
+    if (scales)
+        p->scales = scales;
+    if (!xy || !dirs || !weights || !cubes || !ends || !scales)
+        return false;
+    p->cap = cap;
     return true;
 }
+
+/* Path term t of pixel (x, y), looked up in `cube` from `lookup`. */
+static bool point_set_add(point_set *p, float x, float y, const ps_specular_term *t, ps_rgb w, int cube,
+                          ps_vec3 lookup)
+{
+    if (!point_set_reserve(p, p->count + 1))
+        return false;
+    size_t i = p->count++;
+    p->xy[2 * i] = x, p->xy[2 * i + 1] = y;
+    store_dir(p->dirs + 3 * i, ps_specular_term_dir(t, lookup));
+    p->weights[3 * i] = (float)w.r, p->weights[3 * i + 1] = (float)w.g, p->weights[3 * i + 2] = (float)w.b;
+    p->cube[i] = cube;
+    p->ends[3 * i] = t->end.x, p->ends[3 * i + 1] = t->end.y, p->ends[3 * i + 2] = t->end.z;
+    p->scales[i] = t->scale;
+    return true;
+}
+
+/* src's points after dst's. */
+static bool point_set_append(point_set *dst, const point_set *src)
+{
+    if (!point_set_reserve(dst, dst->count + src->count))
+        return false;
+    size_t n = src->count, at = dst->count;
+    memcpy(dst->xy + 2 * at, src->xy, 2 * n * sizeof *src->xy);
+    memcpy(dst->dirs + 3 * at, src->dirs, 3 * n * sizeof *src->dirs);
+    memcpy(dst->weights + 3 * at, src->weights, 3 * n * sizeof *src->weights);
+    memcpy(dst->cube + at, src->cube, n * sizeof *src->cube);
+    memcpy(dst->ends + 3 * at, src->ends, 3 * n * sizeof *src->ends);
+    memcpy(dst->scales + at, src->scales, n * sizeof *src->scales);
+    dst->count += n;
+    return true;
+}
+
+/* The points of `cube` looked up from `lookup` instead. */
+static void point_set_reaim(point_set *p, int cube, ps_vec3 lookup)
+{
+    for (size_t i = 0; i < p->count; i++) {
+        if (p->cube[i] != cube)
+            continue;
+        ps_specular_term t;
+        t.end = ps_v3(p->ends[3 * i], p->ends[3 * i + 1], p->ends[3 * i + 2]);
+        t.scale = p->scales[i];
+        store_dir(p->dirs + 3 * i, ps_specular_term_dir(&t, lookup));
+    }
+}
+
+/* A unique vertex's kept paths, to re-aim its lookups (ps_specular_term). */
+typedef struct vertex_ends {
+    ps_vec3 end[PS_SPECULAR_TERMS];
+    double scale[PS_SPECULAR_TERMS];
+    int count;
+} vertex_ends;
 
 struct ps_specular {
     const ps_preview_mesh *mesh;
@@ -76,6 +141,8 @@ struct ps_specular {
     size_t unique_count;
     uint32_t *order;      /* lookup vertices sorted by unique index */
     size_t *order_first;  /* unique u's run in order[]: [order_first[u], order_first[u + 1]) */
+    int *unique_cube;     /* the cube each unique vertex looks up */
+    vertex_ends *ends;    /* each unique vertex's paths (re-aiming) */
     /* Progress for the current eye. */
     bool have_eye, changed;
     ps_vec3 eye;
@@ -93,7 +160,15 @@ struct ps_specular {
     unsigned char *pix_seen;
     size_t pix_seen_cap;
     point_set pix_build, pix_done;
+    /* Tracing them on `threads` threads: the pixels of a chunk and each
+     * job's points (joined in job order). */
+    int threads;
+    int *pix_list;
+    size_t pix_list_cap;
+    point_set job_points[PS_JOBS_MAX_THREADS];
 };
+
+static size_t range_of(const ps_specular *sp, size_t k);
 
 static const ps_material *range_material(const ps_specular *sp, size_t r)
 {
@@ -264,6 +339,16 @@ ps_status ps_specular_create(const ps_preview_mesh *mesh, const ps_material *mat
         ps_specular_destroy(sp);
         return st;
     }
+    size_t nu = sp->unique_count ? sp->unique_count : 1;
+    sp->unique_cube = malloc(nu * sizeof *sp->unique_cube);
+    sp->ends = calloc(nu, sizeof *sp->ends);
+    if (!sp->unique_cube || !sp->ends) {
+        ps_specular_destroy(sp);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the specular layer's %zu vertices", n);
+    }
+    for (size_t u = 0; u < sp->unique_count; u++)
+        sp->unique_cube[u] = sp->ranges[range_of(sp, sp->first_of[u])].cube;
+    sp->threads = 1;
     *out = sp;
     return PS_OK;
 }
@@ -286,6 +371,11 @@ void ps_specular_destroy(ps_specular *sp)
     free(sp->pix_seen);
     point_set_free(&sp->pix_build);
     point_set_free(&sp->pix_done);
+    free(sp->unique_cube);
+    free(sp->ends);
+    free(sp->pix_list);
+    for (int t = 0; t < PS_JOBS_MAX_THREADS; t++)
+        point_set_free(&sp->job_points[t]);
     free(sp);
 }
 
@@ -295,13 +385,42 @@ int ps_specular_cube_count(const ps_specular *sp) { return sp->cube_count; }
 ps_vec3 ps_specular_cube_centre(const ps_specular *sp, int cube) { return sp->centre[cube]; }
 ps_vec3 ps_specular_lookup_centre(const ps_specular *sp, int cube) { return sp->lookup_centre[cube]; }
 
+/* Unique vertex u's lookup directions from its cube's lookup centre (its
+ * weights stay): what tracing it now would write. */
+static void write_dirs(ps_specular *sp, size_t u)
+{
+    const vertex_ends *e = &sp->ends[u];
+    ps_vec3 lookup = sp->lookup_centre[sp->unique_cube[u]];
+    for (int j = 0; j < PS_SPECULAR_TERMS; j++) {
+        float dv[3] = {0, 0, 1};
+        if (j < e->count) {
+            ps_specular_term t;
+            t.end = e->end[j];
+            t.scale = e->scale[j];
+            store_dir(dv, ps_specular_term_dir(&t, lookup));
+        }
+        for (size_t i = sp->order_first[u]; i < sp->order_first[u + 1]; i++)
+            memcpy(sp->dirs[j] + 3 * (size_t)sp->order[i], dv, sizeof dv);
+    }
+}
+
 bool ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre)
 {
     if (cube < 0 || cube >= sp->cube_count || ps_v3_equal(centre, sp->lookup_centre[cube]))
         return false;
     sp->lookup_centre[cube] = centre;
-    ps_specular_invalidate(sp);
+    for (size_t u = 0; u < sp->unique_count; u++)
+        if (sp->unique_cube[u] == cube)
+            write_dirs(sp, u);
+    point_set_reaim(&sp->pix_build, cube, centre);
+    point_set_reaim(&sp->pix_done, cube, centre);
+    sp->changed = true;
     return true;
+}
+
+void ps_specular_set_threads(ps_specular *sp, int threads)
+{
+    sp->threads = threads < 1 ? 1 : threads > PS_JOBS_MAX_THREADS ? PS_JOBS_MAX_THREADS : threads;
 }
 const float *ps_specular_dirs(const ps_specular *sp, int k) { return sp->dirs[k]; }
 const float *ps_specular_weights(const ps_specular *sp, int k) { return sp->weights[k]; }
@@ -328,11 +447,16 @@ typedef struct path_ctx {
 
 static double weight_of(ps_rgb w) { return fmax(w.r, fmax(w.g, w.b)); }
 
-static void add_path(path_ctx *c, ps_vec3 dir, ps_rgb w)
+/* A path ending at `end` with `scale` (ps_specular_term), looked up from
+ * the context's centre. */
+static void add_path(path_ctx *c, ps_vec3 end, double scale, ps_rgb w)
 {
     if (c->count < PS_SPECULAR_MAX_PATHS) {
-        c->paths[c->count].dir = dir;
-        c->paths[c->count].weight = w;
+        ps_specular_term *t = &c->paths[c->count];
+        t->end = end;
+        t->scale = scale;
+        t->dir = ps_specular_term_dir(t, c->centre);
+        t->weight = w;
         c->count++;
     } else {
         c->dropped += weight_of(w);
@@ -383,13 +507,13 @@ static void follow(path_ctx *c, ps_ray r, ps_rgb w, int depth, double length)
     if (!ps_world_intersect(c->world, r, INFINITY, &sp)) {
         if (c->escape_black)
             return;
-        add_path(c, ps_v3_scale(r.d, c->far), w);
+        add_path(c, ps_v3_scale(r.d, c->far), 0.0, w);
         return;
     }
     const ps_material *m = &c->materials[sp.material];
     length += sp.t;
     if (!ps_material_is_specular(m)) {
-        add_path(c, ps_v3_scale(ps_v3_sub(sp.p, c->centre), c->first / length), w);
+        add_path(c, sp.p, c->first / length, w);
         return;
     }
     scatter(c, &sp, m, r.d, w, depth, length);
@@ -525,24 +649,26 @@ size_t ps_specular_update(ps_specular *sp, const ps_world *world, ps_vec3 eye, s
         const ps_specular_range *lr = &sp->ranges[range_of(sp, k)];
         size_t v = sp->mesh->ranges[lr->range].first + (k - lr->offset);
         const float *nn = sp->mesh->normals + 3 * v;
-        c.centre = sp->lookup_centre[lr->cube];
+        /* From the cube's own centre, looked up from the lookup centre. */
+        c.centre = sp->centre[lr->cube];
         ps_specular_term t[PS_SPECULAR_TERMS];
         const ps_material *m = range_material(sp, lr->range);
         int count = ps_glossy_wants(m) /* the lobe's lookup (specular_glossy.h) */
                         ? ps_glossy_trace_point(world, c.materials, m, eye, vertex_pos(sp->mesh, v),
                                                 ps_v3(nn[0], nn[1], nn[2]), c.centre, t, NULL)
                         : trace_point(&c, m, eye, vertex_pos(sp->mesh, v), ps_v3(nn[0], nn[1], nn[2]), t);
+        vertex_ends *e = &sp->ends[u];
+        e->count = count;
         for (int j = 0; j < PS_SPECULAR_TERMS; j++) {
-            float dv[3] = {0, 0, 1}, wv[3] = {0, 0, 0};
+            float wv[3] = {0, 0, 0};
             if (j < count) {
-                dv[0] = (float)t[j].dir.x, dv[1] = (float)t[j].dir.y, dv[2] = (float)t[j].dir.z;
+                e->end[j] = t[j].end, e->scale[j] = t[j].scale;
                 wv[0] = (float)t[j].weight.r, wv[1] = (float)t[j].weight.g, wv[2] = (float)t[j].weight.b;
             }
-            for (size_t i = sp->order_first[u]; i < sp->order_first[u + 1]; i++) {
-                memcpy(sp->dirs[j] + 3 * (size_t)sp->order[i], dv, sizeof dv);
+            for (size_t i = sp->order_first[u]; i < sp->order_first[u + 1]; i++)
                 memcpy(sp->weights[j] + 3 * (size_t)sp->order[i], wv, sizeof wv);
-            }
         }
+        write_dirs(sp, u);
     }
     sp->next_unique = end;
     sp->changed = true;
@@ -617,10 +743,11 @@ static int cube_of_object(const ps_specular *sp, uint32_t object)
     return -1;
 }
 
-/* Pixel (x, y)'s samples: each eye ray that meets an object of the layer
- * first is traced as the vertices' rays are (scatter, follow), from the
- * exact surface point it meets. */
-static bool trace_pixel(ps_specular *sp, path_ctx *c, const ps_camera_frame *cam, int x, int y)
+/* Pixel (x, y)'s samples into `out`: each eye ray that meets an object of
+ * the layer first is traced as the vertices' rays are (scatter, follow),
+ * from the exact surface point it meets and the cube's own centre. */
+static bool trace_pixel(const ps_specular *sp, path_ctx *c, const ps_camera_frame *cam, int x, int y,
+                        point_set *out)
 {
     const int n = PS_SPECULAR_PIXEL_SAMPLES;
     const double share = 1.0 / (n * n);
@@ -636,67 +763,111 @@ static bool trace_pixel(ps_specular *sp, path_ctx *c, const ps_camera_frame *cam
                 continue;
             c->count = 0;
             c->dropped = 0.0;
-            c->centre = sp->lookup_centre[cube];
+            c->centre = sp->centre[cube];
             c->first = hit.t;
             scatter(c, &hit, m, ray.d, ps_rgb_gray(1.0), 0, hit.t);
             ps_specular_term t[PS_SPECULAR_TERMS];
             int k = keep_heaviest(c, t);
             for (int q = 0; q < k; q++)
-                if (!point_set_add(&sp->pix_build, (float)x, (float)y, t[q].dir, ps_rgb_scale(t[q].weight, share),
-                                   cube))
+                if (!point_set_add(out, (float)x, (float)y, &t[q], ps_rgb_scale(t[q].weight, share), cube,
+                                   sp->lookup_centre[cube]))
                     return false;
         }
     }
     return true;
 }
 
-/* Pixels traced between looks at the clock. */
-#define PIXELS_PER_CLOCK 64
+/* Pixels a job traces between looks at the clock. */
+#define PIXELS_PER_JOB 128
 
-size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const ps_camera_frame *cam,
-                                 size_t max_rays, double max_seconds)
+/* A chunk of pixels (sp->pix_list, x y pairs) on the threads: job j traces
+ * pixels [j * PIXELS_PER_JOB, ...) into sp->job_points[j]. */
+typedef struct pixel_chunk {
+    ps_specular *sp;
+    const ps_world *world;
+    const ps_camera_frame *cam;
+    size_t pixels;
+    bool failed[PS_JOBS_MAX_THREADS];
+} pixel_chunk;
+
+static void pixel_job(void *ctx, size_t job)
 {
-    if (sp->range_count == 0 || cam->width <= 0 || cam->height <= 0)
-        return 0;
-    size_t pixels = (size_t)cam->width * (size_t)cam->height;
-    if (!sp->pix_have_cam || !same_frame(cam, &sp->pix_cam)) {
-        if (sp->pix_seen_cap < pixels) {
-            unsigned char *seen = realloc(sp->pix_seen, pixels);
-            if (!seen) {
-                sp->pix_have_cam = sp->pix_ready = false;
-                return 0; /* out of memory: the per-vertex lookups stay */
-            }
-            sp->pix_seen = seen;
-            sp->pix_seen_cap = pixels;
-        }
-        memset(sp->pix_seen, 0, pixels);
-        sp->pix_have_cam = true;
-        sp->pix_ready = false;
-        sp->pix_cam = *cam;
-        sp->pix_range = sp->pix_next = 0;
-        sp->pix_build.count = 0;
-        for (size_t i = 0; i < sp->range_count; i++) {
-            range_rect(&sp->range_box[i], cam, sp->rect[i]);
-            /* Glossy ranges keep their per-vertex lobe lookups (the GL draws
-             * them beside the points): no pixel of theirs is traced. */
-            if (ps_glossy_wants(range_material(sp, sp->ranges[i].range)))
-                sp->rect[i][2] = sp->rect[i][0], sp->rect[i][3] = sp->rect[i][1];
-        }
-    }
-    if (sp->pix_range >= sp->range_count)
-        return 0;
+    pixel_chunk *ch = ctx;
+    ps_specular *sp = ch->sp;
+    point_set *out = &sp->job_points[job];
+    out->count = 0;
     path_ctx c;
-    c.world = world;
-    c.materials = ps_scene_materials(ps_world_scene(world), &(size_t){0});
-    c.far = scene_far(world);
+    c.world = ch->world;
+    c.materials = ps_scene_materials(ps_world_scene(ch->world), &(size_t){0});
+    c.far = scene_far(ch->world);
     c.escape_black = true;
-    const size_t per_pixel = (size_t)PS_SPECULAR_PIXEL_SAMPLES * PS_SPECULAR_PIXEL_SAMPLES;
-    size_t rays = 0, traced = 0;
-    double t0 = max_seconds > 0.0 ? ps_now_seconds() : 0.0;
-    while (sp->pix_range < sp->range_count && (max_rays == 0 || rays < max_rays)) {
-        if (max_seconds > 0.0 && traced > 0 && traced % PIXELS_PER_CLOCK == 0 &&
-            ps_now_seconds() - t0 >= max_seconds)
-            break;
+    size_t end = (job + 1) * PIXELS_PER_JOB < ch->pixels ? (job + 1) * PIXELS_PER_JOB : ch->pixels;
+    for (size_t i = job * PIXELS_PER_JOB; i < end; i++)
+        if (!trace_pixel(sp, &c, ch->cam, sp->pix_list[2 * i], sp->pix_list[2 * i + 1], out)) {
+            ch->failed[job] = true;
+            return;
+        }
+}
+
+/* A new camera frame: its rectangles, nothing traced yet. */
+static bool start_pixels(ps_specular *sp, const ps_camera_frame *cam)
+{
+    if (sp->pix_have_cam && same_frame(cam, &sp->pix_cam))
+        return true;
+    size_t pixels = (size_t)cam->width * (size_t)cam->height;
+    if (sp->pix_seen_cap < pixels) {
+        unsigned char *seen = realloc(sp->pix_seen, pixels);
+        if (!seen) {
+            sp->pix_have_cam = sp->pix_ready = false;
+            return false; /* out of memory: the per-vertex lookups stay */
+        }
+        sp->pix_seen = seen;
+        sp->pix_seen_cap = pixels;
+    }
+    memset(sp->pix_seen, 0, pixels);
+    sp->pix_have_cam = true;
+    sp->pix_ready = false;
+    sp->pix_cam = *cam;
+    sp->pix_range = sp->pix_next = 0;
+    sp->pix_build.count = 0;
+    for (size_t i = 0; i < sp->range_count; i++) {
+        range_rect(&sp->range_box[i], cam, sp->rect[i]);
+        /* Glossy ranges keep their per-vertex lobe lookups (the GL draws
+         * them beside the points): no pixel of theirs is traced. */
+        if (ps_glossy_wants(range_material(sp, sp->ranges[i].range)))
+            sp->rect[i][2] = sp->rect[i][0], sp->rect[i][3] = sp->rect[i][1];
+    }
+    return true;
+}
+
+/* Rays left for the frame: the rest of this rectangle and the whole of the
+ * others (an upper bound; pixels seen in earlier rectangles are skipped). */
+static size_t rays_left(const ps_specular *sp)
+{
+    if (!sp->pix_have_cam || sp->pix_range >= sp->range_count)
+        return 0;
+    size_t left = 0;
+    for (size_t i = sp->pix_range; i < sp->range_count; i++) {
+        const int *r = sp->rect[i];
+        left += (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]);
+    }
+    left -= sp->pix_next;
+    return left * PS_SPECULAR_PIXEL_SAMPLES * PS_SPECULAR_PIXEL_SAMPLES + (left == 0);
+}
+
+size_t ps_specular_pixel_rays_left(ps_specular *sp, const ps_camera_frame *cam)
+{
+    if (sp->range_count == 0 || cam->width <= 0 || cam->height <= 0 || !start_pixels(sp, cam))
+        return 0;
+    return sp->pix_ready ? 0 : rays_left(sp);
+}
+
+/* The next pixels of the frame not seen yet, at most `max` of them, into
+ * sp->pix_list: how many. */
+static size_t next_pixels(ps_specular *sp, size_t max)
+{
+    size_t n = 0;
+    while (n < max && sp->pix_range < sp->range_count) {
         const int *r = sp->rect[sp->pix_range];
         size_t w = (size_t)(r[2] - r[0]), count = w * (size_t)(r[3] - r[1]);
         if (sp->pix_next >= count) {
@@ -705,28 +876,57 @@ size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const p
         }
         int x = r[0] + (int)(sp->pix_next % w), y = r[1] + (int)(sp->pix_next / w);
         sp->pix_next++;
-        size_t at = (size_t)y * (size_t)cam->width + (size_t)x;
+        size_t at = (size_t)y * (size_t)sp->pix_cam.width + (size_t)x;
         if (sp->pix_seen[at])
             continue;
         sp->pix_seen[at] = 1;
-        rays += per_pixel;
-        traced++;
-        if (!trace_pixel(sp, &c, cam, x, y)) {
+        sp->pix_list[2 * n] = x, sp->pix_list[2 * n + 1] = y;
+        n++;
+    }
+    return n;
+}
+
+size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const ps_camera_frame *cam,
+                                 size_t max_rays, double max_seconds)
+{
+    if (sp->range_count == 0 || cam->width <= 0 || cam->height <= 0 || !start_pixels(sp, cam))
+        return 0;
+    if (sp->pix_range >= sp->range_count)
+        return 0;
+    const size_t per_pixel = (size_t)PS_SPECULAR_PIXEL_SAMPLES * PS_SPECULAR_PIXEL_SAMPLES;
+    size_t chunk = (size_t)sp->threads * PIXELS_PER_JOB;
+    if (sp->pix_list_cap < chunk) {
+        int *list = realloc(sp->pix_list, 2 * chunk * sizeof *list);
+        if (!list) {
             sp->pix_have_cam = sp->pix_ready = false; /* out of memory: the per-vertex lookups stay */
             return 0;
         }
+        sp->pix_list = list;
+        sp->pix_list_cap = chunk;
     }
-    if (sp->pix_range < sp->range_count) {
-        /* Left: the rest of this rectangle and the whole of the others (an
-         * upper bound; pixels seen in earlier rectangles are skipped). */
-        size_t left = 0;
-        for (size_t i = sp->pix_range; i < sp->range_count; i++) {
-            const int *r = sp->rect[i];
-            left += (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]);
-        }
-        left -= sp->pix_next;
-        return left * per_pixel + (left == 0);
+    size_t rays = 0;
+    double t0 = max_seconds > 0.0 ? ps_now_seconds() : 0.0;
+    while (sp->pix_range < sp->range_count && (max_rays == 0 || rays < max_rays)) {
+        size_t want = chunk;
+        if (max_rays > 0 && (max_rays - rays + per_pixel - 1) / per_pixel < want)
+            want = (max_rays - rays + per_pixel - 1) / per_pixel;
+        pixel_chunk ch = {.sp = sp, .world = world, .cam = cam};
+        ch.pixels = next_pixels(sp, want);
+        if (ch.pixels == 0)
+            continue; /* the rectangles ended: the loop ends */
+        size_t jobs = (ch.pixels + PIXELS_PER_JOB - 1) / PIXELS_PER_JOB;
+        ps_run_jobs(jobs, sp->threads, pixel_job, &ch);
+        for (size_t j = 0; j < jobs; j++)
+            if (ch.failed[j] || !point_set_append(&sp->pix_build, &sp->job_points[j])) {
+                sp->pix_have_cam = sp->pix_ready = false; /* out of memory: the per-vertex lookups stay */
+                return 0;
+            }
+        rays += ch.pixels * per_pixel;
+        if (max_seconds > 0.0 && ps_now_seconds() - t0 >= max_seconds)
+            break;
     }
+    if (sp->pix_range < sp->range_count)
+        return rays_left(sp);
     point_set t = sp->pix_done;
     sp->pix_done = sp->pix_build;
     sp->pix_build = t;

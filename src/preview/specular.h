@@ -80,11 +80,18 @@ ps_vec3 ps_specular_cube_centre(const ps_specular *sp, int cube);
  * map it shows until then), so that the lookups find in the old map the
  * very points the eye paths end at, not the same directions from elsewhere
  * (the default scene's mirror moved 10 cm showed its reflections shifted
- * for the seconds a new map took). A new centre traces every lookup again
- * (those of every cube, and the per-pixel paths). */
+ * for the seconds a new map took). Paths are traced from the cube's own
+ * centre (which decides how the lightest are merged, below) and keep where
+ * they end, so a new lookup centre re-aims the cube's lookups and per-pixel
+ * points without tracing anything: the same bytes as tracing them afresh
+ * from it (the swap to a new map used to throw the per-pixel paths away,
+ * and the mirror showed per-vertex lookups for another 0.7 s). */
 ps_vec3 ps_specular_lookup_centre(const ps_specular *sp, int cube);
-/* Whether that changed the centre (and so the lookups are to be traced). */
+/* Whether that changed the centre (and so the lookups were re-aimed). */
 bool ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre);
+/* Threads the per-pixel paths are traced on (below; 1 by default, values
+ * below 1 as 1): the same points for any count. */
+void ps_specular_set_threads(ps_specular *sp, int threads);
 
 /* Traces the lookups for an eye at `eye` through `world` (the session's:
  * the same surfaces as the mesh), at most max_vertices distinct vertices
@@ -137,6 +144,9 @@ const float *ps_specular_weights(const ps_specular *sp, int k);
  * points below are this frame's). */
 size_t ps_specular_update_pixels(ps_specular *sp, const ps_world *world, const ps_camera_frame *cam,
                                  size_t max_rays, double max_seconds);
+/* The eye rays left to trace for camera frame cam (starting it over when it
+ * is new): an upper bound, 0 once its points are ready. */
+size_t ps_specular_pixel_rays_left(ps_specular *sp, const ps_camera_frame *cam);
 /* The points of the current camera frame, once traced whole: their count,
  * else 0 and *ready false (draw the per-vertex lookups then). xy: pixel
  * (column, row from the top); dirs: lookup direction from cube[i]'s centre;
@@ -152,11 +162,18 @@ ps_specular_points ps_specular_pixel_points(const ps_specular *sp);
 /* ---- for tests --------------------------------------------------------------- */
 
 /* One path's end: its lookup direction from `centre` (or the direction it
- * leaves in, far away, when it meets nothing) and its weight. */
+ * leaves in, far away, when it meets nothing) and its weight; and what the
+ * direction is made of, so that it can be taken from another centre
+ * (ps_specular_term_dir): where the path ends (or that far direction) and
+ * its scale (0 for a path that meets nothing: then dir is end). */
 typedef struct ps_specular_term {
     ps_vec3 dir;
     ps_rgb weight;
+    ps_vec3 end;
+    double scale;
 } ps_specular_term;
+/* t's lookup direction from `centre`: (end - centre) * scale, or end. */
+ps_vec3 ps_specular_term_dir(const ps_specular_term *t, ps_vec3 centre);
 /* The eye ray from `eye` to surface point p (normal n, on the winding's side)
  * of material m, traced as above: up to PS_SPECULAR_TERMS terms into out,
  * their count returned; *dropped: the weight of the paths cut short by depth

@@ -2,7 +2,6 @@
 #include "preview/splat.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #if defined(__SSE2__)
@@ -10,6 +9,7 @@
 #endif
 
 #include "core/array.h"
+#include "core/jobs.h"
 #include "photon/tracer.h"
 #include "scene/bsdf.h"
 
@@ -283,45 +283,9 @@ static uint32_t z_side(const ps_camera_frame *cam, int *key_bits)
 
 /* Jobs 0..count-1 on up to `threads` threads (0: one a core), dealt
  * round-robin; what a job does never depends on which thread runs it. */
-typedef void (*job_fn)(void *ctx, size_t job);
-typedef struct job_list {
-    job_fn fn;
-    void *ctx;
-    size_t first, step, count;
-} job_list;
-
-#define PS_SPLAT_MAX_THREADS 64
-
-static void *job_thread(void *arg)
+static void run_jobs(size_t count, int threads, ps_job_fn fn, void *ctx)
 {
-    const job_list *l = arg;
-    for (size_t j = l->first; j < l->count; j += l->step)
-        l->fn(l->ctx, j);
-    return NULL;
-}
-
-static void run_jobs(size_t count, int threads, job_fn fn, void *ctx)
-{
-    if (threads <= 0)
-        threads = ps_online_cores();
-    if (threads > PS_SPLAT_MAX_THREADS)
-        threads = PS_SPLAT_MAX_THREADS;
-    if ((size_t)threads > count)
-        threads = (int)count;
-    if (threads < 1)
-        threads = 1;
-    job_list lists[PS_SPLAT_MAX_THREADS];
-    pthread_t tid[PS_SPLAT_MAX_THREADS];
-    int started = 1; /* thread 0's share runs here */
-    for (int t = 0; t < threads; t++)
-        lists[t] = (job_list){fn, ctx, (size_t)t, (size_t)threads, count};
-    while (started < threads && pthread_create(&tid[started], NULL, job_thread, &lists[started]) == 0)
-        started++;
-    for (int t = started; t < threads; t++) /* no threads to be had: their shares here */
-        job_thread(&lists[t]);
-    job_thread(&lists[0]);
-    for (int t = 1; t < started; t++)
-        pthread_join(tid[t], NULL);
+    ps_run_jobs(count, threads <= 0 ? ps_online_cores() : threads, fn, ctx);
 }
 
 /* The diffusion's shared state: the sorted keys go from `a` to `t`, a region
