@@ -81,7 +81,7 @@ expect_match "OBJ message" "$cli_err" 'grid\.scn:2: mesh: .*grid\.obj: 20000 fac
 } >"$cli_tmp/spheres.scn"
 PS_MEMORY_LIMIT=64M expect_success "spheres fit the ray tracer" "$ref" "$cli_tmp/spheres.scn" --photons-only "${small[@]}"
 PS_MEMORY_LIMIT=64M expect_usage_error "spheres' preview mesh" "$snap" "$cli_tmp/spheres.scn" -o "$out/a.png" "${small[@]}"
-expect_match "mesh message" "$cli_err" 'spheres\.scn: the preview mesh of 980000 triangles would need 135 MiB, more than the memory budget of 64 MiB'
+expect_match "mesh message" "$cli_err" 'spheres\.scn: the preview mesh of 980000 triangles would need 146 MiB, more than the memory budget of 64 MiB'
 nothing_left "spheres' preview mesh"
 # 20 area lights are 320 GL lights with shadow maps: refused; without shadows they fit.
 {

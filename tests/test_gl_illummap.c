@@ -3,8 +3,9 @@
  * furnace sphere (albedo 0.5, a point light at its centre) every pixel of the
  * global layer lies between the least and the most of the maps' values, the
  * picture's mean is the closed form's rho^2 Phi / (4 pi^2 R^2 (1 - rho)),
- * through the window's float layers and through snap's single 8-bit frame;
- * and the picture is the same bytes for 1 and 2 tracing threads. */
+ * through the window's float layers (also as a moving camera's level of
+ * detail, scaled up) and through snap's single 8-bit frame; and the picture
+ * is the same bytes for 1 and 2 tracing threads. */
 #include "test.h"
 
 #include <GL/osmesa.h>
@@ -28,8 +29,11 @@ static const char *const FURNACE = "camera eye 0 0.2 0.3 target 0.3 0 -1 fov 70\
                                    "radius caustic 0.02 global 0.3\n";
 
 /* The global layer of the furnace through the maps; *lo, *hi: the least and
- * most of the maps' inside values as drawn (times albedo / pi and exposure). */
-static ps_image draw(bool layers, int threads, double *lo, double *hi)
+ * most of the maps' inside values as drawn (times albedo / pi and exposure).
+ * move: then a refresh with the camera turned a little, the moving camera's
+ * level of detail (PS_SESSION_MOVING_SCALE fewer pixels a side, scaled up
+ * by the composite), which is the picture returned. */
+static ps_image draw_moved(bool layers, int threads, bool move, double *lo, double *hi)
 {
     ps_scene *scene;
     ps_error err;
@@ -83,6 +87,13 @@ static ps_image draw(bool layers, int threads, double *lo, double *hi)
         double v = ps_illummap_irradiance(m, i, 1, NULL, NULL, NULL).g * RHO / PS_PI * scale * gain;
         *lo = fmin(*lo, v), *hi = fmax(*hi, v);
     }
+    if (move) {
+        cam.eye.x += 0.01;
+        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+        assert_true(f.moving && f.new_view);
+        assert_int_equal(f.view.width, (SIDE + PS_SESSION_MOVING_SCALE - 1) / PS_SESSION_MOVING_SCALE);
+        ps_gl_layers_draw(l, gl, &cam, &f);
+    }
     ps_image img;
     if (layers) {
         double gains[PS_MAP_COUNT] = {f.map[0].gain, f.map[1].gain};
@@ -98,6 +109,11 @@ static ps_image draw(bool layers, int threads, double *lo, double *hi)
     ps_session_destroy(s);
     ps_scene_destroy(scene);
     return img;
+}
+
+static ps_image draw(bool layers, int threads, double *lo, double *hi)
+{
+    return draw_moved(layers, threads, false, lo, hi);
 }
 
 static void check(const ps_image *img, double lo, double hi, double tol, const char *what)
@@ -119,6 +135,20 @@ static void layers_show_the_maps(void **state)
     double lo, hi;
     ps_image img = draw(true, 2, &lo, &hi);
     check(&img, lo, hi, 1e-5, "float layers");
+    ps_image_destroy(&img);
+}
+
+/* The moving camera's level of detail, scaled up bilinearly from its
+ * corner of the layers: every pixel still within the maps' values (a read
+ * past the corner, of black or of an older view, would fall below them on
+ * the last rows and columns), the mean the closed form's. */
+static void moving_view_scales_up(void **state)
+{
+    (void)state;
+    double lo, hi;
+    ps_image img = draw_moved(true, 2, true, &lo, &hi);
+    assert_int_equal(img.width, SIDE);
+    check(&img, lo, hi, 1e-5, "moving camera, float layers");
     ps_image_destroy(&img);
 }
 
@@ -145,6 +175,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(layers_show_the_maps),
+        cmocka_unit_test(moving_view_scales_up),
         cmocka_unit_test(whole_frame_shows_the_maps),
         cmocka_unit_test(threads_do_not_matter),
     };

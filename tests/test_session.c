@@ -409,6 +409,12 @@ static void moving_camera_level_of_detail(void **state)
     refresh(s, &cam, &f);
     assert_true(f.moving);
     assert_true(f.new_view);
+    /* Drawn at fewer pixels, the same view. */
+    assert_int_equal(f.view.width, (cam.width + PS_SESSION_MOVING_SCALE - 1) / PS_SESSION_MOVING_SCALE);
+    assert_int_equal(f.view.height, (cam.height + PS_SESSION_MOVING_SCALE - 1) / PS_SESSION_MOVING_SCALE);
+    assert_true(f.view.width < cam.width);
+    assert_memory_equal(&f.view.eye, &cam.eye, sizeof cam.eye);
+    assert_true(f.view.aspect == cam.aspect && f.view.tan_half_fov == cam.tan_half_fov);
     /* One batch of the four that arrived: the radius grown by sqrt(4) = 2. */
     assert_int_equal(f.emitted[PS_MAP_CAUSTIC], PS_FEED_BATCH);
     assert_near(f.map[PS_MAP_CAUSTIC].radius, 2.0 * set.radius[PS_MAP_CAUSTIC], 1e-12);
@@ -417,6 +423,7 @@ static void moving_camera_level_of_detail(void **state)
     refresh(s, &cam, &f);
     assert_false(f.moving);
     assert_true(f.new_view);
+    assert_memory_equal(&f.view, &cam, sizeof cam);
     assert_near(f.map[PS_MAP_CAUSTIC].radius, set.radius[PS_MAP_CAUSTIC], 1e-12);
     ps_session_destroy(s);
     ps_scene_destroy(scene);

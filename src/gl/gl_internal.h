@@ -98,6 +98,8 @@ void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct);
  * one more texture (the specular layer, gl_specular.c) added to the
  * composite times its gain (0: left out). */
 GLuint ps_gl_layers_depth_stencil(const ps_gl_layers *l);
+/* The layers' texture size (the view drawn may be smaller: ps_gl_layers_draw). */
+void ps_gl_layers_size(const ps_gl_layers *l, int *width, int *height);
 void ps_gl_layers_set_extra(ps_gl_layers *l, GLuint texture, double gain);
 
 /* Splats (gl_splat.c). */

@@ -27,6 +27,10 @@ enum {
 
 struct ps_gl_layers {
     int width, height;
+    /* The view the layers hold, in their lower left corner: width x height,
+     * or fewer pixels for a moving camera's level of detail, which the
+     * composite scales up (ps_session_frame.view). */
+    int view_w, view_h;
     bool float_buffers;
     bool imap_drawn; /* LAYER_IMAP_TEX holds maps (else it is black and not composited) */
     GLuint tex[LAYER_TEX_COUNT], fbo[LAYER_TEX_COUNT], depth_stencil;
@@ -36,6 +40,12 @@ struct ps_gl_layers {
 };
 
 GLuint ps_gl_layers_depth_stencil(const ps_gl_layers *l) { return l->depth_stencil; }
+
+void ps_gl_layers_size(const ps_gl_layers *l, int *width, int *height)
+{
+    *width = l->width;
+    *height = l->height;
+}
 
 void ps_gl_layers_set_extra(ps_gl_layers *l, GLuint texture, double gain)
 {
@@ -49,8 +59,8 @@ ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_l
     ps_gl_layers *l = calloc(1, sizeof *l);
     if (!l)
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the GL layers");
-    l->width = width;
-    l->height = height;
+    l->width = l->view_w = width;
+    l->height = l->view_h = height;
     l->float_buffers = float_buffers;
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
@@ -119,7 +129,7 @@ static void draw_imap(ps_gl_layers *l, ps_gl_renderer *r, const ps_session_frame
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_IMAP_TEX]);
-    glViewport(0, 0, l->width, l->height);
+    glViewport(0, 0, l->view_w, l->view_h);
     ps_gl_draw_illummap(r, f->imap_colors);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     l->imap_drawn = true;
@@ -131,6 +141,14 @@ static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *
 {
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    l->view_w = cam->width < l->width ? cam->width : l->width;
+    l->view_h = cam->height < l->height ? cam->height : l->height;
+    /* A level of detail clears only its corner (what the composite reads). */
+    bool corner = l->view_w < l->width || l->view_h < l->height;
+    if (corner) {
+        glScissor(0, 0, l->view_w, l->view_h);
+        glEnable(GL_SCISSOR_TEST);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_DIRECT_TEX]);
     ps_gl_begin_frame_shadows(r, cam, exposure, direct, shadows);
     for (int k = 0; k < PS_MAP_COUNT; k++)
@@ -145,6 +163,8 @@ static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *
         ps_gl_draw_albedo(r);
     }
     clear_imap(l);
+    if (corner)
+        glDisable(GL_SCISSOR_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
 }
 
@@ -170,28 +190,62 @@ void ps_gl_layers_add(ps_gl_layers *l, ps_gl_renderer *r, int map, const ps_spla
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_CAUSTIC_TEX + map]);
-    glViewport(0, 0, l->width, l->height);
+    glViewport(0, 0, l->view_w, l->view_h);
     ps_gl_draw_splats(r, b, mode, radius, point_size);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
 }
 
-/* A screen-filling quad of texture t times gain, added to what is there
- * (times texture unit 1's, the T layer, when that is enabled: both get the
- * same coordinates). */
-static void add_texture(GLuint t, double gain)
+/* The bound texture sampled texel for texel (the view fills the layers),
+ * or bilinearly (a level of detail scaled up). */
+static void set_filter(bool scaled)
 {
+    GLint f = scaled ? GL_LINEAR : GL_NEAREST;
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, f);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, f);
+}
+
+/* Where the composite reads the layers: the view's corner, texel for texel
+ * into a target of its size, or scaled up into a bigger one from its first
+ * texel's centre to its last one's, so that the bilinear filter never
+ * reads past it. */
+typedef struct view_read {
+    bool scaled;
+    float s0, t0, s1, t1;
+} view_read;
+
+static view_read read_view(const ps_gl_layers *l, int target_w, int target_h)
+{
+    view_read v = {false, 0.0f, 0.0f, (float)l->view_w / (float)l->width, (float)l->view_h / (float)l->height};
+    if (target_w != l->view_w || target_h != l->view_h) {
+        v.scaled = true;
+        v.s0 = 0.5f / (float)l->width, v.s1 = ((float)l->view_w - 0.5f) / (float)l->width;
+        v.t0 = 0.5f / (float)l->height, v.t1 = ((float)l->view_h - 0.5f) / (float)l->height;
+    }
+    return v;
+}
+
+/* A quad over the viewport of texture t times gain, added to what is there
+ * (times texture unit 1's, the T layer, when that is enabled: both get the
+ * same coordinates), read as v says. */
+static void add_texture(const view_read *v, GLuint t, double gain)
+{
+    bool scaled = v->scaled;
+    float s0 = v->s0, t0 = v->t0, s1 = v->s1, t1 = v->t1;
     glBindTexture(GL_TEXTURE_2D, t);
+    set_filter(scaled);
     glColor4f((GLfloat)gain, (GLfloat)gain, (GLfloat)gain, 1.0f);
     glBegin(GL_QUADS);
-    glMultiTexCoord2f(GL_TEXTURE1, 0, 0), glTexCoord2f(0, 0), glVertex2f(-1, -1);
-    glMultiTexCoord2f(GL_TEXTURE1, 1, 0), glTexCoord2f(1, 0), glVertex2f(1, -1);
-    glMultiTexCoord2f(GL_TEXTURE1, 1, 1), glTexCoord2f(1, 1), glVertex2f(1, 1);
-    glMultiTexCoord2f(GL_TEXTURE1, 0, 1), glTexCoord2f(0, 1), glVertex2f(-1, 1);
+    glMultiTexCoord2f(GL_TEXTURE1, s0, t0), glTexCoord2f(s0, t0), glVertex2f(-1, -1);
+    glMultiTexCoord2f(GL_TEXTURE1, s1, t0), glTexCoord2f(s1, t0), glVertex2f(1, -1);
+    glMultiTexCoord2f(GL_TEXTURE1, s1, t1), glTexCoord2f(s1, t1), glVertex2f(1, 1);
+    glMultiTexCoord2f(GL_TEXTURE1, s0, t1), glTexCoord2f(s0, t1), glVertex2f(-1, 1);
     glEnd();
 }
 
 void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f)
 {
+    if (f->view.width > 0) /* the refresh's view: the camera's, or its level of detail */
+        cam = &f->view;
     if (f->new_view) {
         /* While the camera moves, the direct layer's level of detail: no
          * shadow passes (one pass a light instead of one a lit cube face,
@@ -217,11 +271,14 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
         draw_imap(l, r, f);
 }
 
-/* direct * direct_gain + sum of map * map_gain into layer `target`. */
-static void composite(ps_gl_layers *l, int target, double direct_gain, const double map_gain[PS_MAP_COUNT])
+/* direct * direct_gain + sum of map * map_gain into layer `target`, its
+ * lower left target_w x target_h pixels. */
+static void composite(ps_gl_layers *l, int target, int target_w, int target_h, double direct_gain,
+                      const double map_gain[PS_MAP_COUNT])
 {
+    view_read v = read_view(l, target_w, target_h);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[target]);
-    glViewport(0, 0, l->width, l->height);
+    glViewport(0, 0, target_w, target_h);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
@@ -249,15 +306,16 @@ static void composite(ps_gl_layers *l, int target, double direct_gain, const dou
         glActiveTexture(GL_TEXTURE1);
         glEnable(GL_TEXTURE_2D);
         glBindTexture(GL_TEXTURE_2D, l->tex[LAYER_ALBEDO_TEX]);
+        set_filter(v.scaled);
         glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
         glActiveTexture(GL_TEXTURE0);
     }
-    add_texture(l->tex[LAYER_DIRECT_TEX], direct_gain);
+    add_texture(&v, l->tex[LAYER_DIRECT_TEX], direct_gain);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (map_gain[k] > 0.0)
-            add_texture(l->tex[LAYER_CAUSTIC_TEX + k], map_gain[k]);
+            add_texture(&v, l->tex[LAYER_CAUSTIC_TEX + k], map_gain[k]);
     if (l->imap_drawn && map_gain[PS_MAP_GLOBAL] > 0.0)
-        add_texture(l->tex[LAYER_IMAP_TEX], map_gain[PS_MAP_GLOBAL]);
+        add_texture(&v, l->tex[LAYER_IMAP_TEX], map_gain[PS_MAP_GLOBAL]);
     if (l->albedo) {
         glActiveTexture(GL_TEXTURE1);
         glBindTexture(GL_TEXTURE_2D, 0);
@@ -265,7 +323,7 @@ static void composite(ps_gl_layers *l, int target, double direct_gain, const dou
         glActiveTexture(GL_TEXTURE0);
     }
     if (l->extra_tex && l->extra_gain > 0.0)
-        add_texture(l->extra_tex, l->extra_gain);
+        add_texture(&v, l->extra_tex, l->extra_gain);
     glDisable(GL_FRAMEBUFFER_SRGB);
     glDisable(GL_BLEND);
     glBindTexture(GL_TEXTURE_2D, 0);
@@ -274,12 +332,17 @@ static void composite(ps_gl_layers *l, int target, double direct_gain, const dou
 
 void ps_gl_layers_show(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT])
 {
-    composite(l, LAYER_SHOWN_TEX, direct_gain, map_gain);
+    /* At the view's size: a level of detail is scaled up by the blit (a
+     * quarter of the composite's fill, which took 20 ms at 512^2). */
+    composite(l, LAYER_SHOWN_TEX, l->view_w, l->view_h, direct_gain, map_gain);
     /* Copied as stored: with GL_FRAMEBUFFER_SRGB off a blit neither decodes
-     * the sRGB source nor encodes again. */
+     * the sRGB source nor encodes again (a scaled one filters the codes:
+     * the moving picture only). */
+    bool scaled = l->view_w != l->width || l->view_h != l->height;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, l->fbo[LAYER_SHOWN_TEX]);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-    glBlitFramebuffer(0, 0, l->width, l->height, 0, 0, l->width, l->height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBlitFramebuffer(0, 0, l->view_w, l->view_h, 0, 0, l->width, l->height, GL_COLOR_BUFFER_BIT,
+                      scaled ? GL_LINEAR : GL_NEAREST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
@@ -288,7 +351,7 @@ ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const doub
 {
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
-    composite(l, LAYER_FINAL_TEX, direct_gain, map_gain);
+    composite(l, LAYER_FINAL_TEX, l->width, l->height, direct_gain, map_gain);
     ps_status st = ps_gl_read_pixels(l->width, l->height, out, err);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     return st;

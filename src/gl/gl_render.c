@@ -113,7 +113,11 @@ void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil)
         }
         if (stencil)
             glStencilFunc(GL_ALWAYS, (GLint)ps_splat_stencil(rg->object), 0xff);
-        glDrawArrays(GL_TRIANGLES, (GLint)rg->first, (GLsizei)rg->count);
+        /* Shared vertices (mesh.h): each lit once, the same triangles. */
+        if (m->shared)
+            glDrawElements(GL_TRIANGLES, (GLsizei)rg->count, GL_UNSIGNED_INT, m->shared + rg->first);
+        else
+            glDrawArrays(GL_TRIANGLES, (GLint)rg->first, (GLsizei)rg->count);
     }
     glDisableClientState(GL_NORMAL_ARRAY);
     glDisableClientState(GL_VERTEX_ARRAY);

@@ -599,13 +599,17 @@ void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, do
 ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_renderer *r, ps_session *s,
                                const ps_session_frame *f, ps_error *err)
 {
+    /* As big as the other layers, drawn at the refresh's view in its corner
+     * (a moving camera's level of detail is smaller: gl_layers.c). */
     GLuint depth = ps_gl_layers_depth_stencil(l);
-    if (!g->layer_tex || g->layer_w != r->width || g->layer_h != r->height || g->layer_depth != depth) {
+    int lw, lh;
+    ps_gl_layers_size(l, &lw, &lh);
+    if (!g->layer_tex || g->layer_w != lw || g->layer_h != lh || g->layer_depth != depth) {
         if (!g->layer_tex)
             glGenTextures(1, &g->layer_tex);
         if (!g->layer_fbo)
             glGenFramebuffers(1, &g->layer_fbo);
-        g->layer_w = r->width, g->layer_h = r->height, g->layer_depth = depth;
+        g->layer_w = lw, g->layer_h = lh, g->layer_depth = depth;
         glBindTexture(GL_TEXTURE_2D, g->layer_tex);
         glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, g->layer_w, g->layer_h, 0, GL_RGBA, GL_FLOAT, NULL);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
@@ -628,7 +632,7 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
         GLint old_fbo = 0;
         glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
         glBindFramebuffer(GL_FRAMEBUFFER, g->layer_fbo);
-        glViewport(0, 0, g->layer_w, g->layer_h);
+        glViewport(0, 0, r->width, r->height);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         glClearColor(0, 0, 0, 0);
         glClear(GL_COLOR_BUFFER_BIT); /* colour only: the depth is the view's prepass */

@@ -166,6 +166,67 @@ static bool add_sphere(builder *b, const ps_object *o, double tolerance, ps_erro
     return ok;
 }
 
+/* Vertex v's position and normal bits. */
+static void vertex_key(const ps_preview_mesh *m, size_t v, uint32_t key[6])
+{
+    memcpy(key, m->positions + 3 * v, 3 * sizeof(float));
+    memcpy(key + 3, m->normals + 3 * v, 3 * sizeof(float));
+}
+
+static uint64_t key_hash(const uint32_t key[6], size_t range)
+{
+    uint64_t h = 1469598103934665603ull ^ range;
+    for (int i = 0; i < 6; i++) {
+        h ^= key[i];
+        h *= 1099511628211ull;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+/* m->shared (mesh.h), range by range, with an open-addressing table of
+ * twice the range's size. */
+static bool share_vertices(ps_preview_mesh *m)
+{
+    m->shared = malloc((m->vertex_count ? m->vertex_count : 1) * sizeof *m->shared);
+    size_t largest = 0;
+    for (size_t r = 0; r < m->range_count; r++)
+        largest = m->ranges[r].count > largest ? m->ranges[r].count : largest;
+    size_t cap = 16;
+    while (cap < 2 * largest)
+        cap *= 2;
+    uint32_t *table = malloc(cap * sizeof *table);
+    if (!m->shared || !table || m->vertex_count > UINT32_MAX) {
+        free(table);
+        return false;
+    }
+    for (size_t r = 0; r < m->range_count; r++) {
+        const ps_mesh_range *rg = &m->ranges[r];
+        memset(table, 0xff, cap * sizeof *table);
+        for (size_t v = rg->first; v < rg->first + rg->count; v++) {
+            uint32_t key[6], other[6];
+            vertex_key(m, v, key);
+            size_t slot = (size_t)key_hash(key, r) & (cap - 1);
+            for (;;) {
+                uint32_t u = table[slot];
+                if (u == UINT32_MAX) {
+                    table[slot] = (uint32_t)v;
+                    m->shared[v] = (uint32_t)v;
+                    break;
+                }
+                vertex_key(m, u, other);
+                if (memcmp(key, other, sizeof key) == 0) {
+                    m->shared[v] = u;
+                    break;
+                }
+                slot = (slot + 1) & (cap - 1);
+            }
+        }
+    }
+    free(table);
+    return true;
+}
+
 ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_preview_mesh *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -217,6 +278,8 @@ ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_
             end_range(&b);
         }
     }
+    if (st == PS_OK && !share_vertices(out))
+        st = PS_ERR_NOMEM;
     if (st != PS_OK) {
         ps_preview_mesh_free(out);
         if (st == PS_ERR_NOMEM)
@@ -233,6 +296,7 @@ void ps_preview_mesh_free(ps_preview_mesh *m)
     free(m->positions);
     free(m->normals);
     free(m->texcoords);
+    free(m->shared);
     free(m->ranges);
     memset(m, 0, sizeof *m);
 }

@@ -133,9 +133,11 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
     size_t nm;
     if (st == PS_OK)
         st = ps_specular_create(&s->mesh, ps_scene_materials(s->scene, &nm), &s->spec, err);
-    /* Per-pixel paths on the threads the splats are built on. */
+    /* Lookups and per-pixel paths on every core: the refresh waits for
+     * them (the window's tracing thread, one core of two, is idle once the
+     * maps are full, when the camera moves over them). */
     if (st == PS_OK)
-        ps_specular_set_threads(s->spec, s->set.threads > 0 ? s->set.threads : ps_online_cores());
+        ps_specular_set_threads(s->spec, ps_online_cores());
     /* The drawing side still shows the maps it had (ps_session_set_specular_centre). */
     if (st == PS_OK && ps_specular_cube_count(s->spec) == old_cubes)
         for (int c = 0; c < old_cubes; c++)
@@ -512,6 +514,16 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         s->view_dirty = true;
     }
     out->moving = s->moving;
+    /* The level of detail's fewer pixels (the camera's view, fewer of them:
+     * the same aspect, so the picture scales up unchanged). The drawing
+     * below is this view's; the camera itself is what is compared. */
+    out->view = *cam;
+    if (s->moving) {
+        out->view.width = (cam->width + PS_SESSION_MOVING_SCALE - 1) / PS_SESSION_MOVING_SCALE;
+        out->view.height = (cam->height + PS_SESSION_MOVING_SCALE - 1) / PS_SESSION_MOVING_SCALE;
+    }
+    const ps_camera_frame *still = cam;
+    cam = &out->view;
     /* A repair's maps back in index order (feed.h) before a view that starts
      * over anyway: it then draws a prefix of index order, as a fresh trace's. */
     if (s->view_dirty) {
@@ -651,8 +663,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     /* Per-pixel paths once the camera holds still (specular.h): a budget a
      * refresh, or whole when few are left (PS_SESSION_PIXEL_RAYS_WHOLE). */
     if (out->specular && !out->moving) {
-        bool at_once = !inc || ps_specular_pixel_rays_left(s->spec, cam) <= s->set.pixel_rays_whole;
-        ps_specular_update_pixels(s->spec, s->world, cam, at_once ? 0 : PS_SPECULAR_PIXEL_RAYS,
+        bool at_once = !inc || ps_specular_pixel_rays_left(s->spec, still) <= s->set.pixel_rays_whole;
+        ps_specular_update_pixels(s->spec, s->world, still, at_once ? 0 : PS_SPECULAR_PIXEL_RAYS,
                                   at_once ? 0.0 : PS_SPECULAR_PIXEL_TIME_SHARE * s->set.tau);
     }
     out->direct_exposure = inc ? 1.0 : exposure(s);

@@ -89,8 +89,8 @@ ps_vec3 ps_specular_cube_centre(const ps_specular *sp, int cube);
 ps_vec3 ps_specular_lookup_centre(const ps_specular *sp, int cube);
 /* Whether that changed the centre (and so the lookups were re-aimed). */
 bool ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre);
-/* Threads the per-pixel paths are traced on (below; 1 by default, values
- * below 1 as 1): the same points for any count. */
+/* Threads the lookups and per-pixel paths are traced on (1 by default,
+ * values below 1 as 1): the same bytes for any count. */
 void ps_specular_set_threads(ps_specular *sp, int threads);
 
 /* Traces the lookups for an eye at `eye` through `world` (the session's:
