@@ -349,9 +349,11 @@ static void marks_after_a_repair_are_a_fresh_feeds(void **state)
  * retraced before its first picture when at most retrace_first. */
 #define SHOWN_CAUSTIC_CAP (4 * PS_FEED_BATCH)
 #define SHOWN_GLOBAL_CAP PS_FEED_BATCH
-static ps_session *open_shown(ps_scene *scene, uint64_t retrace_first, ps_camera_frame *cam)
+static ps_session *open_shown_whole(ps_scene *scene, uint64_t retrace_first, uint64_t edit_splats_whole,
+                                    ps_camera_frame *cam)
 {
     ps_session_settings set = repair_settings(scene, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+    set.edit_splats_whole = edit_splats_whole;
     set.float_buffer = set.incremental = true;
     set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
     set.retrace_first = retrace_first;
@@ -363,6 +365,11 @@ static ps_session *open_shown(ps_scene *scene, uint64_t retrace_first, ps_camera
     assert_int_equal(ps_session_start(s, true, &err), PS_OK);
     *cam = ps_camera_frame_make(ps_scene_camera(scene), 64, 64);
     return s;
+}
+
+static ps_session *open_shown(ps_scene *scene, uint64_t retrace_first, ps_camera_frame *cam)
+{
+    return open_shown_whole(scene, retrace_first, PS_SESSION_EDIT_SPLATS_WHOLE, cam);
 }
 
 /* Refreshes (each said drawn at once) until everything is shown; how many
@@ -404,7 +411,8 @@ static void shown_equals_fresh(ps_session *s, const ps_scene *scene)
 }
 
 /* A repair left to the tracing thread (retrace_first 0: as one of more than
- * PS_SESSION_RETRACE_FIRST photons) while the picture draws a little each
+ * PS_SESSION_RETRACE_FIRST photons, and edit_splats_whole 0: of more than
+ * PS_SESSION_EDIT_SPLATS_WHOLE) while the picture draws a little each
  * refresh: the thread's end used to put the maps back in index order at
  * once, which started the view over from one batch (the picture got worse
  * a quarter of a second after an edit); now the merge waits until every
@@ -415,7 +423,7 @@ static void a_background_repair_keeps_the_view(void **state)
     (void)state;
     ps_scene *scene = load();
     ps_camera_frame cam;
-    ps_session *s = open_shown(scene, 0, &cam);
+    ps_session *s = open_shown_whole(scene, 0, 0, &cam);
     assert_int_equal(refresh_until_settled(s, &cam, false), 0);
     for (int e = 0; e < 3; e++) {
         apply(s, e == 0 ? MOVE_MIRROR : e == 1 ? MOVE_SPOT : MOVE_FLOOR, e);
@@ -452,6 +460,39 @@ static void a_small_repair_is_done_before_the_first_picture(void **state)
     assert_int_equal(ps_session_stop(s, &err), PS_OK);
     ps_session_destroy(s);
     ps_scene_destroy(scene);
+}
+
+/* The first refresh after an edit (the maps full, the least budget: a
+ * batch a refresh) draws every stored photon when they number at most
+ * edit_splats_whole, else (and during a drag) the budget's prefix. */
+static uint64_t first_edit_refresh_draws(uint64_t edit_splats_whole, bool dragging)
+{
+    ps_scene *scene = load();
+    ps_camera_frame cam;
+    ps_session *s = open_shown_whole(scene, PS_SESSION_RETRACE_FIRST, edit_splats_whole, &cam);
+    ps_error err;
+    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
+    ps_session_set_dragging(s, dragging);
+    apply(s, MOVE_MIRROR, 0);
+    uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
+    update_caps(s, kept, retraced, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+    assert_true(f.new_view);
+    uint64_t drawn = f.emitted[PS_MAP_CAUSTIC];
+    ps_session_drawn(s, 1e-4);
+    assert_int_equal(ps_session_stop(s, &err), PS_OK);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+    return drawn;
+}
+
+static void an_edit_picture_draws_every_photon(void **state)
+{
+    (void)state;
+    assert_int_equal(first_edit_refresh_draws(PS_SESSION_EDIT_SPLATS_WHOLE, false), SHOWN_CAUSTIC_CAP);
+    assert_true(first_edit_refresh_draws(0, false) < SHOWN_CAUSTIC_CAP);
+    assert_true(first_edit_refresh_draws(PS_SESSION_EDIT_SPLATS_WHOLE, true) < SHOWN_CAUSTIC_CAP);
 }
 
 /* The specular layer after the mirror moves, camera still (256^2: its spheres
@@ -512,6 +553,7 @@ int main(void)
         cmocka_unit_test(a_background_repair_keeps_the_view),
         cmocka_unit_test(a_small_repair_is_done_before_the_first_picture),
         cmocka_unit_test(an_edit_picture_has_pixel_paths),
+        cmocka_unit_test(an_edit_picture_draws_every_photon),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -860,6 +860,8 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
     glfwGetCursorPos(w, &x, &y);
     if (action == GLFW_RELEASE) {
         a->drag = DRAG_NONE;
+        if (a->session)
+            ps_session_set_dragging(a->session, false);
         return;
     }
     a->drag_x = x;
@@ -872,6 +874,9 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
         pick(a, x, y);
         a->drag_vertical = (mods & GLFW_MOD_CONTROL) != 0;
         a->drag = a->sel_kind != SEL_NONE ? DRAG_MOVE : DRAG_NONE;
+        /* A drag's edits keep the refreshes' budget (session.h). */
+        if (a->session)
+            ps_session_set_dragging(a->session, a->drag == DRAG_MOVE);
     }
 }
 

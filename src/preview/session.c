@@ -38,6 +38,8 @@ struct ps_session {
     double round_off;
     bool have_cam, view_dirty;
     bool moving;           /* the last refresh had a new camera: a level of detail */
+    bool edit_view;        /* the next refresh is an update's first (PS_SESSION_EDIT_SPLATS_WHOLE) */
+    bool dragging;         /* ps_session_set_dragging */
     bool catch_up;         /* still after a move, the view not yet drawn in full */
     ps_camera_frame cam;
     bool edited, geometry_edited;
@@ -96,6 +98,7 @@ ps_session_settings ps_session_default_settings(const ps_scene *scene)
     set.repair = true;
     set.retrace_first = PS_SESSION_RETRACE_FIRST;
     set.pixel_rays_whole = PS_SESSION_PIXEL_RAYS_WHOLE;
+    set.edit_splats_whole = PS_SESSION_EDIT_SPLATS_WHOLE;
     return set;
 }
 
@@ -384,6 +387,11 @@ static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emit
     double budget = s->moving     ? s->budget * PS_SESSION_MOVING_SHARE
                     : s->catch_up ? s->budget * PS_SESSION_CATCH_UP_GAIN
                                   : s->budget;
+    if (s->edit_view && !s->moving && !s->dragging) {
+        const ps_photon_map *maps = ps_feed_maps(s->feed);
+        if ((uint64_t)maps[PS_MAP_CAUSTIC].count + maps[PS_MAP_GLOBAL].count <= s->set.edit_splats_whole)
+            budget = HUGE_VAL;
+    }
     return prefix_within(s, k, from, from_emitted, budget, emitted);
 }
 
@@ -650,6 +658,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     s->last_build = ps_now_seconds() - t0;
     s->splat_seconds += s->last_build;
     s->refreshes++;
+    s->edit_view = false;
     if (st != PS_OK)
         return st;
     out->direct = (s->set.layers & PS_LAYER_DIRECT) != 0;
@@ -912,6 +921,7 @@ ps_status ps_session_restore_scene(ps_session *s, const ps_scene *snapshot, ps_e
 }
 
 bool ps_session_edited(const ps_session *s) { return s->edited; }
+void ps_session_set_dragging(ps_session *s, bool dragging) { s->dragging = dragging; }
 uint64_t ps_session_edits(const ps_session *s) { return s->edits; }
 
 ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error *err)
@@ -980,6 +990,7 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
         st = ps_repair_state_take(s->scene, ps_world_epsilon(s->world), &s->traced, err);
     }
     s->edited = s->geometry_edited = false;
+    s->edit_view = true;
     /* The first batch is traced here and the thread held until the first
      * refresh has drawn it: that refresh then has every core. */
     if (st == PS_OK && s->started)
