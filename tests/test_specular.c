@@ -137,6 +137,36 @@ static void mirror_lookup_is_distance_corrected(void **state)
     rig_free(&r);
 }
 
+/* The default scene, its world, its fine mesh and two lookup sets over it. */
+typedef struct default_rig {
+    ps_scene *scene;
+    ps_world *world;
+    ps_preview_mesh mesh;
+    ps_specular *a, *b;
+} default_rig;
+
+/* In place: the lookup sets keep the mesh's address. */
+static void default_rig_make(default_rig *d)
+{
+    ps_error err;
+    assert_int_equal(ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &d->scene, &err), PS_OK);
+    assert_int_equal(ps_world_create(d->scene, NULL, &d->world, &err), PS_OK);
+    ps_mesh_options mo = ps_mesh_default_options(d->scene);
+    assert_int_equal(ps_preview_mesh_build(d->scene, &mo, &d->mesh, &err), PS_OK);
+    size_t nm;
+    assert_int_equal(ps_specular_create(&d->mesh, ps_scene_materials(d->scene, &nm), &d->a, &err), PS_OK);
+    assert_int_equal(ps_specular_create(&d->mesh, ps_scene_materials(d->scene, &nm), &d->b, &err), PS_OK);
+}
+
+static void default_rig_free(default_rig *d)
+{
+    ps_specular_destroy(d->a);
+    ps_specular_destroy(d->b);
+    ps_preview_mesh_free(&d->mesh);
+    ps_world_destroy(d->world);
+    ps_scene_destroy(d->scene);
+}
+
 /* The default scene's fine mesh: its two spheres, one cube each at their
  * centres; every vertex facing the eye gets lookups whose weights add up to
  * at most 1 (clear glass and a perfect mirror inside a box, nothing leaves
@@ -145,18 +175,12 @@ static void mirror_lookup_is_distance_corrected(void **state)
 static void default_scene_lookups(void **state)
 {
     (void)state;
-    ps_scene *scene;
-    ps_error err;
-    assert_int_equal(ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err), PS_OK);
-    ps_world *world;
-    assert_int_equal(ps_world_create(scene, NULL, &world, &err), PS_OK);
-    ps_mesh_options mo = ps_mesh_default_options(scene);
-    ps_preview_mesh mesh;
-    assert_int_equal(ps_preview_mesh_build(scene, &mo, &mesh, &err), PS_OK);
-    size_t nm;
-    ps_specular *a, *b;
-    assert_int_equal(ps_specular_create(&mesh, ps_scene_materials(scene, &nm), &a, &err), PS_OK);
-    assert_int_equal(ps_specular_create(&mesh, ps_scene_materials(scene, &nm), &b, &err), PS_OK);
+    default_rig d;
+    default_rig_make(&d);
+    ps_scene *scene = d.scene;
+    ps_world *world = d.world;
+    const ps_preview_mesh mesh = d.mesh;
+    ps_specular *a = d.a, *b = d.b;
     assert_int_equal(ps_specular_range_count(a), 2);
     assert_int_equal(ps_specular_cube_count(a), 2);
     ps_vec3 c0 = ps_specular_cube_centre(a, 0), c1 = ps_specular_cube_centre(a, 1);
@@ -193,11 +217,7 @@ static void default_scene_lookups(void **state)
         }
     }
     assert_true(facing > 1000);
-    ps_specular_destroy(a);
-    ps_specular_destroy(b);
-    ps_preview_mesh_free(&mesh);
-    ps_world_destroy(world);
-    ps_scene_destroy(scene);
+    default_rig_free(&d);
 }
 
 static void assert_points_equal(ps_specular_points a, ps_specular_points b)
@@ -220,18 +240,12 @@ static void assert_points_equal(ps_specular_points a, ps_specular_points b)
 static void reaimed_lookups_equal_fresh_ones(void **state)
 {
     (void)state;
-    ps_scene *scene;
-    ps_error err;
-    assert_int_equal(ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err), PS_OK);
-    ps_world *world;
-    assert_int_equal(ps_world_create(scene, NULL, &world, &err), PS_OK);
-    ps_mesh_options mo = ps_mesh_default_options(scene);
-    ps_preview_mesh mesh;
-    assert_int_equal(ps_preview_mesh_build(scene, &mo, &mesh, &err), PS_OK);
-    size_t nm;
-    ps_specular *moved, *fresh;
-    assert_int_equal(ps_specular_create(&mesh, ps_scene_materials(scene, &nm), &moved, &err), PS_OK);
-    assert_int_equal(ps_specular_create(&mesh, ps_scene_materials(scene, &nm), &fresh, &err), PS_OK);
+    default_rig d;
+    default_rig_make(&d);
+    ps_scene *scene = d.scene;
+    ps_world *world = d.world;
+    const ps_preview_mesh mesh = d.mesh;
+    ps_specular *moved = d.a, *fresh = d.b;
     ps_specular_set_threads(fresh, 3);
     ps_vec3 centre = ps_specular_cube_centre(moved, 0), old = ps_v3_add(centre, ps_v3(-0.1, 0.0, 0.0));
     assert_true(ps_specular_set_lookup_centre(moved, 0, old));
@@ -261,11 +275,7 @@ static void reaimed_lookups_equal_fresh_ones(void **state)
         assert_memory_equal(ps_specular_weights(moved, k), ps_specular_weights(fresh, k), 3 * n * sizeof(float));
     }
     assert_points_equal(ps_specular_pixel_points(moved), ps_specular_pixel_points(fresh));
-    ps_specular_destroy(moved);
-    ps_specular_destroy(fresh);
-    ps_preview_mesh_free(&mesh);
-    ps_world_destroy(world);
-    ps_scene_destroy(scene);
+    default_rig_free(&d);
 }
 
 int main(void)

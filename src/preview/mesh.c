@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/array.h"
+#include "core/hash.h"
 #include "core/memory.h"
 #include "scene/tessellate.h"
 
@@ -173,17 +174,6 @@ static void vertex_key(const ps_preview_mesh *m, size_t v, uint32_t key[6])
     memcpy(key + 3, m->normals + 3 * v, 3 * sizeof(float));
 }
 
-static uint64_t key_hash(const uint32_t key[6], size_t range)
-{
-    uint64_t h = 1469598103934665603ull ^ range;
-    for (int i = 0; i < 6; i++) {
-        h ^= key[i];
-        h *= 1099511628211ull;
-        h ^= h >> 29;
-    }
-    return h;
-}
-
 /* m->shared (mesh.h), range by range, with an open-addressing table of
  * twice the range's size. */
 static bool share_vertices(ps_preview_mesh *m)
@@ -206,7 +196,7 @@ static bool share_vertices(ps_preview_mesh *m)
         for (size_t v = rg->first; v < rg->first + rg->count; v++) {
             uint32_t key[6], other[6];
             vertex_key(m, v, key);
-            size_t slot = (size_t)key_hash(key, r) & (cap - 1);
+            size_t slot = (size_t)ps_hash_words(key, 6, r) & (cap - 1);
             for (;;) {
                 uint32_t u = table[slot];
                 if (u == UINT32_MAX) {

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/clock.h"
+#include "core/hash.h"
 #include "core/jobs.h"
 #include "preview/specular_glossy.h"
 #include "scene/bsdf.h"
@@ -38,6 +39,17 @@ static void point_set_free(point_set *p)
     memset(p, 0, sizeof *p);
 }
 
+/* *p grown to n elements of elem bytes; kept as it was when realloc fails. */
+static bool grow(void **p, size_t n, size_t elem)
+{
+    void *q = realloc(*p, n * elem);
+    if (!q)
+        return false;
+    *p = q;
+    return true;
+}
+#define GROW(ptr, n) grow((void **)&(ptr), (n), sizeof *(ptr))
+
 static bool point_set_reserve(point_set *p, size_t n)
 {
     if (n <= p->cap)
@@ -45,28 +57,13 @@ static bool point_set_reserve(point_set *p, size_t n)
     size_t cap = p->cap ? p->cap : 4096;
     while (cap < n)
         cap *= 2;
-    float *xy = realloc(p->xy, 2 * cap * sizeof *xy);
-    if (xy)
-        p->xy = xy;
-    float *dirs = realloc(p->dirs, 3 * cap * sizeof *dirs);
-    if (dirs)
-        p->dirs = dirs;
-    float *weights = realloc(p->weights, 3 * cap * sizeof *weights);
-    if (weights)
-        p->weights = weights;
-    int *cubes = realloc(p->cube, cap * sizeof *cubes);
-    if (cubes)
-        p->cube = cubes;
-    double *ends = realloc(p->ends, 3 * cap * sizeof *ends);
-    if (ends)
-        p->ends = ends;
-    double *scales = realloc(p->scales, cap * sizeof *scales);
-    if (scales)
-        p->scales = scales;
-    if (!xy || !dirs || !weights || !cubes || !ends || !scales)
-        return false;
-    p->cap = cap;
-    return true;
+    /* Every array tried (each kept at its old size or grown): the capacity
+     * moves only when all grew. */
+    bool ok = GROW(p->xy, 2 * cap) & GROW(p->dirs, 3 * cap) & GROW(p->weights, 3 * cap) & GROW(p->cube, cap) &
+              GROW(p->ends, 3 * cap) & GROW(p->scales, cap);
+    if (ok)
+        p->cap = cap;
+    return ok;
 }
 
 /* Path term t of pixel (x, y), looked up in `cube` from `lookup`. */
@@ -88,6 +85,8 @@ static bool point_set_add(point_set *p, float x, float y, const ps_specular_term
 /* src's points after dst's. */
 static bool point_set_append(point_set *dst, const point_set *src)
 {
+    if (src->count == 0) /* its arrays may be NULL, which memcpy may not be given */
+        return true;
     if (!point_set_reserve(dst, dst->count + src->count))
         return false;
     size_t n = src->count, at = dst->count;
@@ -183,17 +182,12 @@ static ps_vec3 vertex_pos(const ps_preview_mesh *m, size_t v)
 
 /* ---- building ------------------------------------------------------------------ */
 
+/* A position's bits, hashed with its object. */
 static uint64_t hash_bits(const float *p, uint32_t object)
 {
     uint32_t b[3];
     memcpy(b, p, sizeof b);
-    uint64_t h = 1469598103934665603ull ^ object;
-    for (int i = 0; i < 3; i++) {
-        h ^= b[i];
-        h *= 1099511628211ull;
-        h ^= h >> 29;
-    }
-    return h;
+    return ps_hash_words(b, 3, object);
 }
 
 /* Unique vertices by exact position within an object (their lookups depend

@@ -133,7 +133,8 @@ const float *ps_specular_weights(const ps_specular *sp, int k);
  * about 2.7 10^5 rays, 65 536 of them 0.33 s on the loaded 2-core machine
  * (several times that in the sanitizer build), so a still view shows
  * per-pixel paths after some 17 refreshes or more (the per-vertex lookups
- * until then). */
+ * until then), or at once where few rays are left (the session's
+ * PS_SESSION_PIXEL_RAYS_WHOLE). */
 #define PS_SPECULAR_PIXEL_RAYS 16384
 #define PS_SPECULAR_PIXEL_TIME_SHARE 2.0
 
