@@ -9,10 +9,12 @@
 #include "test.h"
 
 #include <GL/osmesa.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "gl/gl_render.h"
+#include "image/image.h"
 #include "preview/session.h"
 #include "scene/scene.h"
 
@@ -33,7 +35,9 @@ static const char *const FURNACE = "camera eye 0 0.2 0.3 target 0.3 0 -1 fov 70\
  * move: then a refresh with the camera turned a little, the moving camera's
  * level of detail (PS_SESSION_MOVING_SCALE fewer pixels a side, scaled up
  * by the composite), which is the picture returned. */
-static ps_image draw_moved(bool layers, int threads, bool move, double *lo, double *hi)
+/* shown: where not NULL, the picture ps_gl_layers_show put in the window
+ * (OSMesa's buffer, SIDE^2 RGBA8 codes, bottom row first). */
+static ps_image draw_shown(bool layers, int threads, bool move, double *lo, double *hi, uint8_t *shown)
 {
     ps_scene *scene;
     ps_error err;
@@ -98,6 +102,11 @@ static ps_image draw_moved(bool layers, int threads, bool move, double *lo, doub
     if (layers) {
         double gains[PS_MAP_COUNT] = {f.map[0].gain, f.map[1].gain};
         assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, gains, &img, &err), PS_OK);
+        if (shown) {
+            ps_gl_layers_show(l, f.direct_gain, gains);
+            ps_gl_finish();
+            memcpy(shown, buffer, 4 * SIDE * SIDE);
+        }
         ps_gl_layers_destroy(l);
     } else {
         ps_gl_draw_frame(gl, &cam, &f);
@@ -113,7 +122,7 @@ static ps_image draw_moved(bool layers, int threads, bool move, double *lo, doub
 
 static ps_image draw(bool layers, int threads, double *lo, double *hi)
 {
-    return draw_moved(layers, threads, false, lo, hi);
+    return draw_shown(layers, threads, false, lo, hi, NULL);
 }
 
 static void check(const ps_image *img, double lo, double hi, double tol, const char *what)
@@ -141,14 +150,30 @@ static void layers_show_the_maps(void **state)
 /* The moving camera's level of detail, scaled up bilinearly from its
  * corner of the layers: every pixel still within the maps' values (a read
  * past the corner, of black or of an older view, would fall below them on
- * the last rows and columns), the mean the closed form's. */
+ * the last rows and columns), the mean the closed form's; and the window's
+ * picture (the corner composited, then scaled up by a blit, which filters
+ * the sRGB codes) within 2 codes of that composite's, edges included. */
 static void moving_view_scales_up(void **state)
 {
     (void)state;
     double lo, hi;
-    ps_image img = draw_moved(true, 2, true, &lo, &hi);
+    uint8_t *shown = malloc(4 * SIDE * SIDE);
+    assert_non_null(shown);
+    ps_image img = draw_shown(true, 2, true, &lo, &hi, shown);
     assert_int_equal(img.width, SIDE);
     check(&img, lo, hi, 1e-5, "moving camera, float layers");
+    int worst = 0;
+    for (int y = 0; y < SIDE; y++)
+        for (int x = 0; x < SIDE; x++)
+            for (int c = 0; c < 3; c++) {
+                float v = ps_image_at(&img, x, SIDE - 1 - y)[c];
+                int want = (int)lroundf(255.0f * ps_srgb_encode(fminf(fmaxf(v, 0.0f), 1.0f)));
+                int d = abs((int)shown[4 * (y * SIDE + x) + c] - want);
+                worst = d > worst ? d : worst;
+            }
+    printf("moving camera, the window's picture: %d codes at worst from the composite's\n", worst);
+    assert_true(worst <= 2);
+    free(shown);
     ps_image_destroy(&img);
 }
 

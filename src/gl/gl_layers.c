@@ -281,7 +281,15 @@ static void composite(ps_gl_layers *l, int target, int target_w, int target_h, d
     glViewport(0, 0, target_w, target_h);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClearColor(0, 0, 0, 0);
+    /* Only the corner written (what the blit reads). */
+    bool corner = target_w < l->width || target_h < l->height;
+    if (corner) {
+        glScissor(0, 0, target_w, target_h);
+        glEnable(GL_SCISSOR_TEST);
+    }
     glClear(GL_COLOR_BUFFER_BIT);
+    if (corner)
+        glDisable(GL_SCISSOR_TEST);
     /* Gains above 1 (N/n early on) must not clamp on the way. */
     glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
     glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
@@ -339,6 +347,20 @@ void ps_gl_layers_show(ps_gl_layers *l, double direct_gain, const double map_gai
      * the sRGB source nor encodes again (a scaled one filters the codes:
      * the moving picture only). */
     bool scaled = l->view_w != l->width || l->view_h != l->height;
+    if (scaled) {
+        /* The scaled blit's bilinear filter reads half a texel past the
+         * corner on its last column and row: they are repeated there (the
+         * texture's own edge clamp, moved to the corner's edge), not the
+         * older picture the texture holds beyond it. */
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, l->fbo[LAYER_SHOWN_TEX]);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, l->fbo[LAYER_SHOWN_TEX]);
+        int w = l->view_w, h = l->view_h;
+        if (w < l->width)
+            glBlitFramebuffer(w - 1, 0, w, h, w, 0, w + 1, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        if (h < l->height)
+            glBlitFramebuffer(0, h - 1, w + (w < l->width), h, 0, h, w + (w < l->width), h + 1, GL_COLOR_BUFFER_BIT,
+                              GL_NEAREST);
+    }
     glBindFramebuffer(GL_READ_FRAMEBUFFER, l->fbo[LAYER_SHOWN_TEX]);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glBlitFramebuffer(0, 0, l->view_w, l->view_h, 0, 0, l->width, l->height, GL_COLOR_BUFFER_BIT,
