@@ -168,6 +168,7 @@ typedef struct app {
     int sel_kind;
     size_t sel_index;
     int drag;
+    bool key_repeat; /* a held key's repeats: edits as a drag's */
     double drag_x, drag_y;
     ps_vec3 drag_anchor;
     bool drag_vertical;
@@ -758,10 +759,20 @@ static void scale_radii(app *a, double f)
 
 static app *app_of(GLFWwindow *w) { return glfwGetWindowUserPointer(w); }
 
+/* A mouse drag of the selection, or a held key's repeats, edit a refresh at a
+ * time: their first refreshes keep the budget (session.h). */
+static void sync_dragging(app *a)
+{
+    if (a->session)
+        ps_session_set_dragging(a->session, a->drag == DRAG_MOVE || a->key_repeat);
+}
+
 static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 {
     (void)scancode;
     app *a = app_of(w);
+    a->key_repeat = action == GLFW_REPEAT;
+    sync_dragging(a);
     if (action == GLFW_RELEASE)
         return;
     bool shift = (mods & GLFW_MOD_SHIFT) != 0;
@@ -860,8 +871,7 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
     glfwGetCursorPos(w, &x, &y);
     if (action == GLFW_RELEASE) {
         a->drag = DRAG_NONE;
-        if (a->session)
-            ps_session_set_dragging(a->session, false);
+        sync_dragging(a);
         return;
     }
     a->drag_x = x;
@@ -874,9 +884,7 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
         pick(a, x, y);
         a->drag_vertical = (mods & GLFW_MOD_CONTROL) != 0;
         a->drag = a->sel_kind != SEL_NONE ? DRAG_MOVE : DRAG_NONE;
-        /* A drag's edits keep the refreshes' budget (session.h). */
-        if (a->session)
-            ps_session_set_dragging(a->session, a->drag == DRAG_MOVE);
+        sync_dragging(a);
     }
 }
 

@@ -314,8 +314,9 @@ bool ps_session_edited(const ps_session *s);
 ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error *err);
 uint64_t ps_session_edits(const ps_session *s);
 /* Whether the edits come from a drag (the window's mouse held on a light or
- * an object: an edit a refresh): their first refreshes keep the budget's
- * prefix (PS_SESSION_EDIT_SPLATS_WHOLE), so the drag stays interactive. */
+ * an object, or a held key's repeats: an edit a refresh): their first
+ * refreshes keep the budget's prefix (PS_SESSION_EDIT_SPLATS_WHOLE), so the
+ * drag stays interactive. */
 void ps_session_set_dragging(ps_session *s, bool dragging);
 
 /* ---- what it holds ------------------------------------------------------------ */
