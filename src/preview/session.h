@@ -97,7 +97,7 @@
 /* A still camera's per-pixel specular paths (specular.h) are traced whole in
  * one refresh when at most this many eye rays are left, else
  * PS_SPECULAR_PIXEL_RAYS a refresh: the default scene's spheres at 256^2
- * take 6.8*10^4 rays, 0.04 s on 2 cores, so the first picture after an edit
+ * take 6.8*10^4 rays, 0.06-0.08 s on one core, so the first picture after an edit
  * shows them, where per-vertex lookups left the default scene's mirror,
  * moved 10 cm, at relMSE 0.051 against the converged picture (0.0085 with
  * its paths; docs/repair.md). At 512^2 (2.6*10^5) the last of them come
