@@ -177,35 +177,32 @@ static void default_scene_lookups(void **state)
     (void)state;
     default_rig d;
     default_rig_make(&d);
-    ps_scene *scene = d.scene;
-    ps_world *world = d.world;
-    const ps_preview_mesh mesh = d.mesh;
     ps_specular *a = d.a, *b = d.b;
     assert_int_equal(ps_specular_range_count(a), 2);
     assert_int_equal(ps_specular_cube_count(a), 2);
     ps_vec3 c0 = ps_specular_cube_centre(a, 0), c1 = ps_specular_cube_centre(a, 1);
     assert_true(ps_v3_len(ps_v3_sub(c0, ps_v3(0.35, 0.4, 0.2))) < 1e-3);
     assert_true(ps_v3_len(ps_v3_sub(c1, ps_v3(-0.45, 0.35, -0.4))) < 1e-3);
-    ps_vec3 eye = ps_camera_frame_make(ps_scene_camera(scene), 64, 64).eye;
-    assert_int_equal(ps_specular_update(a, world, eye, 0), 0);
-    size_t left = ps_specular_update(b, world, eye, 1000), calls = 1;
+    ps_vec3 eye = ps_camera_frame_make(ps_scene_camera(d.scene), 64, 64).eye;
+    assert_int_equal(ps_specular_update(a, d.world, eye, 0), 0);
+    size_t left = ps_specular_update(b, d.world, eye, 1000), calls = 1;
     while (left > 0) {
         size_t before = left;
-        left = ps_specular_update(b, world, eye, 1000);
+        left = ps_specular_update(b, d.world, eye, 1000);
         assert_true(left < before);
         calls++;
     }
     assert_true(calls > 2);
     const ps_specular_range *R = ps_specular_ranges(a);
-    size_t n = R[1].offset + mesh.ranges[R[1].range].count, facing = 0;
+    size_t n = R[1].offset + d.mesh.ranges[R[1].range].count, facing = 0;
     for (int k = 0; k < PS_SPECULAR_TERMS; k++) {
         assert_memory_equal(ps_specular_dirs(a, k), ps_specular_dirs(b, k), 3 * n * sizeof(float));
         assert_memory_equal(ps_specular_weights(a, k), ps_specular_weights(b, k), 3 * n * sizeof(float));
     }
     for (size_t i = 0; i < 2; i++) {
-        const ps_mesh_range *rg = &mesh.ranges[R[i].range];
+        const ps_mesh_range *rg = &d.mesh.ranges[R[i].range];
         for (size_t v = 0; v < rg->count; v++) {
-            const float *p = mesh.positions + 3 * (rg->first + v), *nn = mesh.normals + 3 * (rg->first + v);
+            const float *p = d.mesh.positions + 3 * (rg->first + v), *nn = d.mesh.normals + 3 * (rg->first + v);
             ps_vec3 to_eye = ps_v3_sub(eye, ps_v3(p[0], p[1], p[2]));
             if (ps_v3_dot(to_eye, ps_v3(nn[0], nn[1], nn[2])) <= 0.0)
                 continue;
@@ -242,25 +239,22 @@ static void reaimed_lookups_equal_fresh_ones(void **state)
     (void)state;
     default_rig d;
     default_rig_make(&d);
-    ps_scene *scene = d.scene;
-    ps_world *world = d.world;
-    const ps_preview_mesh mesh = d.mesh;
     ps_specular *moved = d.a, *fresh = d.b;
     ps_specular_set_threads(fresh, 3);
     ps_vec3 centre = ps_specular_cube_centre(moved, 0), old = ps_v3_add(centre, ps_v3(-0.1, 0.0, 0.0));
     assert_true(ps_specular_set_lookup_centre(moved, 0, old));
     assert_false(ps_specular_set_lookup_centre(moved, 0, old));
-    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 96, 96);
-    assert_int_equal(ps_specular_update(moved, world, cam.eye, 0), 0);
-    assert_int_equal(ps_specular_update(fresh, world, cam.eye, 0), 0);
-    assert_int_equal(ps_specular_update_pixels(moved, world, &cam, 0, 0.0), 0);
+    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(d.scene), 96, 96);
+    assert_int_equal(ps_specular_update(moved, d.world, cam.eye, 0), 0);
+    assert_int_equal(ps_specular_update(fresh, d.world, cam.eye, 0), 0);
+    assert_int_equal(ps_specular_update_pixels(moved, d.world, &cam, 0, 0.0), 0);
     assert_true(ps_specular_pixel_rays_left(fresh, &cam) > 4096);
-    size_t left = ps_specular_update_pixels(fresh, world, &cam, 4096, 0.0);
+    size_t left = ps_specular_update_pixels(fresh, d.world, &cam, 4096, 0.0);
     while (left > 0)
-        left = ps_specular_update_pixels(fresh, world, &cam, 4096, 0.0);
+        left = ps_specular_update_pixels(fresh, d.world, &cam, 4096, 0.0);
     assert_int_equal(ps_specular_pixel_rays_left(fresh, &cam), 0);
     const ps_specular_range *R = ps_specular_ranges(moved);
-    size_t n = R[1].offset + mesh.ranges[R[1].range].count;
+    size_t n = R[1].offset + d.mesh.ranges[R[1].range].count;
     /* From the other centre the mirror's lookups differ (the test can fail). */
     assert_memory_not_equal(ps_specular_dirs(moved, 0), ps_specular_dirs(fresh, 0), 3 * n * sizeof(float));
     ps_specular_points pm = ps_specular_pixel_points(moved), pf = ps_specular_pixel_points(fresh);
