@@ -33,6 +33,7 @@ struct ps_session {
     uint64_t drawn_emitted[PS_MAP_COUNT];
     double splat_radius[PS_MAP_COUNT];
     double budget;         /* incremental: photons a map per refresh */
+    double splat_rate;     /* incremental: splats a second the last timed refresh drew (0: none yet) */
     size_t last_splats;    /* built by the last refresh ... */
     double last_build;     /* ... in this many seconds */
     double round_off;
@@ -99,6 +100,7 @@ ps_session_settings ps_session_default_settings(const ps_scene *scene)
     set.retrace_first = PS_SESSION_RETRACE_FIRST;
     set.pixel_rays_whole = PS_SESSION_PIXEL_RAYS_WHOLE;
     set.edit_splats_whole = PS_SESSION_EDIT_SPLATS_WHOLE;
+    set.edit_whole_taus = PS_SESSION_EDIT_WHOLE_TAUS;
     return set;
 }
 
@@ -389,7 +391,11 @@ static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emit
                                   : s->budget;
     if (s->edit_view && !s->moving && !s->dragging) {
         const ps_photon_map *maps = ps_feed_maps(s->feed);
-        if ((uint64_t)maps[PS_MAP_CAUSTIC].count + maps[PS_MAP_GLOBAL].count <= s->set.edit_splats_whole)
+        uint64_t all = (uint64_t)maps[PS_MAP_CAUSTIC].count + maps[PS_MAP_GLOBAL].count;
+        /* No rate yet (no refresh timed): the count alone. */
+        bool in_time = s->set.edit_whole_taus <= 0.0 || s->splat_rate <= 0.0 ||
+                       (double)all <= s->splat_rate * s->set.edit_whole_taus * s->set.tau;
+        if (all <= s->set.edit_splats_whole && in_time)
             budget = HUGE_VAL;
     }
     return prefix_within(s, k, from, from_emitted, budget, emitted);
@@ -718,6 +724,7 @@ void ps_session_drawn(ps_session *s, double draw_seconds)
      * direct layer): it would understate the rate the still view draws at. */
     if (incremental(s) && s->last_splats > 0 && !s->moving) {
         double rate = (double)s->last_splats / fmax(s->last_build + draw_seconds, 1e-6);
+        s->splat_rate = rate;
         s->budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * s->set.splat_share / PS_MAP_COUNT);
     }
     /* Thesis 5.1: once a refresh loses this much to round-off, more photons

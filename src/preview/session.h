@@ -105,14 +105,20 @@
 #define PS_SESSION_PIXEL_RAYS_WHOLE 131072
 /* The first refresh after an edit draws every stored photon, not a budget's
  * prefix, when both maps hold at most this many (and the edit is not part of
- * a drag, ps_session_set_dragging): the picture after a single edit is then
- * as full as the one before it (issue 18: "the first frame after an edit
- * shows every kept photon at once"). At the default caps (2.5*10^5) the
- * budget drew 7*10^4 to 2.5*10^5 of them with the refreshes' timing, and the
- * first picture after moving the mirror 10 cm was at relMSE 0.015 to 0.026
- * against the converged edited scene. Past it (the window's 10^6 photons, a
- * second of llvmpipe) the budget's prefix, as a drag's. A count, as above. */
+ * a drag, ps_session_set_dragging) and the splat rate the refreshes have
+ * shown says it takes at most PS_SESSION_EDIT_WHOLE_TAUS taus: the picture
+ * after a single edit is then as full as the one before it (issue 18: "the
+ * first frame after an edit shows every kept photon at once"). At the
+ * default caps (2.5*10^5) the budget drew 7*10^4 to 2.5*10^5 of them with
+ * the refreshes' timing, and the first picture after moving the mirror 10 cm
+ * was at relMSE 0.015 to 0.026 against the converged edited scene. Past it
+ * (the window's 10^6 photons, a second of llvmpipe) the budget's prefix, as
+ * a drag's. A count, as above. */
 #define PS_SESSION_EDIT_SPLATS_WHOLE 262144
+/* ... and the time the whole draw may take, in taus (the count alone let the
+ * area-light scene at 512^2, 2.6*10^5 photons 1 s in, spend 0.9 s drawing
+ * them: its splats fill four times the 256^2 view's pixels). */
+#define PS_SESSION_EDIT_WHOLE_TAUS 2.0
 
 typedef struct ps_session_settings {
     /* The photons. */
@@ -161,7 +167,9 @@ typedef struct ps_session_settings {
     uint64_t pixel_rays_whole;     /* the per-pixel specular paths whole in a refresh when at
                                     * most this many rays are left (PS_SESSION_PIXEL_RAYS_WHOLE) */
     uint64_t edit_splats_whole;    /* an edit's first refresh draws every photon when the maps
-                                    * hold at most this many (PS_SESSION_EDIT_SPLATS_WHOLE) */
+                                    * hold at most this many (PS_SESSION_EDIT_SPLATS_WHOLE) ... */
+    double edit_whole_taus;        /* ... and the refreshes' splat rate draws them in at most
+                                    * this many taus (PS_SESSION_EDIT_WHOLE_TAUS; 0: any time) */
 } ps_session_settings;
 
 /* Defaults: the scene's photon counts and radii, every layer, triangles, the
