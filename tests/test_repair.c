@@ -142,6 +142,19 @@ static void update_caps(ps_session *s, uint64_t kept[PS_MAP_COUNT], uint64_t ret
         assert_int_equal(kept[k] + retraced[k], caps[k]); /* every index: one or the other */
 }
 
+/* An update that repaired; its counts are not asked for (a repair left to
+ * the thread knows them only once it has tested every index). */
+static void update_repaired(ps_session *s)
+{
+    ps_error err;
+    ps_session_changes ch;
+    assert_int_equal(ps_session_update(s, &ch, &err), PS_OK);
+    bool repaired;
+    uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
+    ps_session_repair_counts(s, &repaired, kept, retraced);
+    assert_true(repaired);
+}
+
 static void update(ps_session *s, uint64_t kept[PS_MAP_COUNT], uint64_t retraced[PS_MAP_COUNT])
 {
     update_caps(s, kept, retraced, CAUSTIC_CAP, GLOBAL_CAP);
@@ -433,13 +446,50 @@ static void a_background_repair_keeps_the_view(void **state)
     assert_int_equal(refresh_until_settled(s, &cam, false), 0);
     for (int e = 0; e < 3; e++) {
         apply(s, e == 0 ? MOVE_MIRROR : e == 1 ? MOVE_SPOT : MOVE_FLOOR, e);
+        update_repaired(s);
+        /* Only the first picture's share was tested before it: the counts
+         * come when the thread has tested the rest. */
+        bool repaired;
         uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
-        update_caps(s, kept, retraced, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
-        assert_true(retraced[PS_MAP_CAUSTIC] + retraced[PS_MAP_GLOBAL] > 0);
+        ps_session_repair_counts(s, &repaired, kept, retraced);
+        assert_true(kept[PS_MAP_CAUSTIC] + retraced[PS_MAP_CAUSTIC] < SHOWN_CAUSTIC_CAP);
         assert_int_equal(refresh_until_settled(s, &cam, true), 0);
+        ps_session_repair_counts(s, &repaired, kept, retraced);
+        assert_int_equal(kept[PS_MAP_CAUSTIC] + retraced[PS_MAP_CAUSTIC], SHOWN_CAUSTIC_CAP);
+        assert_int_equal(kept[PS_MAP_GLOBAL] + retraced[PS_MAP_GLOBAL], SHOWN_GLOBAL_CAP);
+        assert_true(retraced[PS_MAP_CAUSTIC] + retraced[PS_MAP_GLOBAL] > 0);
         shown_equals_fresh(s, scene);
     }
     ps_error err;
+    assert_int_equal(ps_session_stop(s, &err), PS_OK);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* Edits that come while a repair left to the thread is still testing
+ * paths (edit_splats_whole 0: only the first picture's share is tested
+ * before it): the next update finishes that repair first, so after every
+ * kind of edit in a row, some with a refresh between them (the thread goes
+ * on for a while), the maps are a fresh trace's. */
+static void edits_mid_background_repair(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_camera_frame cam;
+    ps_session *s = open_shown_whole(scene, 0, 0, 0.0, &cam);
+    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
+    ps_error err;
+    for (int e = 0; e < EDIT_KINDS; e++) {
+        apply(s, (edit_kind)e, e);
+        update_repaired(s);
+        if (e % 2) {
+            ps_session_frame f;
+            assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+            ps_session_drawn(s, 1e-4);
+        }
+    }
+    (void)refresh_until_settled(s, &cam, false);
+    shown_equals_fresh(s, scene);
     assert_int_equal(ps_session_stop(s, &err), PS_OK);
     ps_session_destroy(s);
     ps_scene_destroy(scene);
@@ -483,8 +533,7 @@ static uint64_t first_edit_refresh_draws(uint64_t edit_splats_whole, double edit
     assert_int_equal(refresh_until_settled_at(s, &cam, false, draw_seconds), 0);
     ps_session_set_dragging(s, dragging);
     apply(s, MOVE_MIRROR, 0);
-    uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
-    update_caps(s, kept, retraced, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+    update_repaired(s);
     ps_session_frame f;
     assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
     assert_true(f.new_view);
@@ -566,6 +615,7 @@ int main(void)
         cmocka_unit_test(repair_keeps_what_it_should),
         cmocka_unit_test(marks_after_a_repair_are_a_fresh_feeds),
         cmocka_unit_test(a_background_repair_keeps_the_view),
+        cmocka_unit_test(edits_mid_background_repair),
         cmocka_unit_test(a_small_repair_is_done_before_the_first_picture),
         cmocka_unit_test(an_edit_picture_has_pixel_paths),
         cmocka_unit_test(an_edit_picture_draws_every_photon),

@@ -179,7 +179,7 @@ typedef struct snap_run {
     uint64_t frames, splats; /* refreshes; splats drawn in all (layers) */
     /* --script: edits applied, and over them the photon indices the repairs
      * kept and retraced, per map (repair.h). */
-    uint64_t updates, repairs, kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
+    uint64_t updates;
     double draw_seconds;
     ps_latency lat;     /* --script: each edit's first refresh, phase by phase (app/latency.h) */
     bool awaiting_edit; /* the next refresh is the first after an update */
@@ -689,13 +689,7 @@ static ps_status apply_edits(snap_run *s, ps_error *err)
     }
     ps_latency_add(&s->lat, PS_LAT_UPDATE, ps_now_seconds() - t);
     s->awaiting_edit = true;
-    bool repaired;
-    uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
-    ps_session_repair_counts(s->session, &repaired, kept, retraced);
     s->updates++;
-    s->repairs += repaired ? 1 : 0;
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        s->kept[k] += kept[k], s->retraced[k] += retraced[k];
     return st;
 }
 
@@ -815,17 +809,20 @@ static ps_status write_stats_and_report(snap_run *s, int width, int height, doub
     ps_stats_add(&rs, "global_maps", o->p.global_layer == PS_GLOBAL_MAPS ? 1.0 : 0.0);
     ps_stats_add(&rs, "luminous_flux_lm", ps_scene_total_lumens(ps_session_scene(s->session)));
     if (o->script) {
+        /* The session is stopped: the last repair's counts are whole. */
+        uint64_t repairs, kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
+        ps_session_repair_totals(s->session, &repairs, kept, retraced);
         ps_stats_add(&rs, "edits_applied", (double)s->updates);
-        ps_stats_add(&rs, "repairs", (double)s->repairs);
-        ps_stats_add(&rs, "repair_kept_caustic", (double)s->kept[PS_MAP_CAUSTIC]);
-        ps_stats_add(&rs, "repair_kept_global", (double)s->kept[PS_MAP_GLOBAL]);
-        ps_stats_add(&rs, "repair_retraced_caustic", (double)s->retraced[PS_MAP_CAUSTIC]);
-        ps_stats_add(&rs, "repair_retraced_global", (double)s->retraced[PS_MAP_GLOBAL]);
+        ps_stats_add(&rs, "repairs", (double)repairs);
+        ps_stats_add(&rs, "repair_kept_caustic", (double)kept[PS_MAP_CAUSTIC]);
+        ps_stats_add(&rs, "repair_kept_global", (double)kept[PS_MAP_GLOBAL]);
+        ps_stats_add(&rs, "repair_retraced_caustic", (double)retraced[PS_MAP_CAUSTIC]);
+        ps_stats_add(&rs, "repair_retraced_global", (double)retraced[PS_MAP_GLOBAL]);
         ps_latency_stats(&s->lat, &rs);
         printf("script: %llu updates, %llu repaired; photons kept/retraced: caustic %llu/%llu, global %llu/%llu\n",
-               (unsigned long long)s->updates, (unsigned long long)s->repairs,
-               (unsigned long long)s->kept[PS_MAP_CAUSTIC], (unsigned long long)s->retraced[PS_MAP_CAUSTIC],
-               (unsigned long long)s->kept[PS_MAP_GLOBAL], (unsigned long long)s->retraced[PS_MAP_GLOBAL]);
+               (unsigned long long)s->updates, (unsigned long long)repairs,
+               (unsigned long long)kept[PS_MAP_CAUSTIC], (unsigned long long)retraced[PS_MAP_CAUSTIC],
+               (unsigned long long)kept[PS_MAP_GLOBAL], (unsigned long long)retraced[PS_MAP_GLOBAL]);
     }
     if (o->c.stats) {
         ps_status st = ps_stats_write(o->c.stats, &rs, err);

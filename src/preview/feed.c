@@ -10,6 +10,22 @@
 #include "core/clock.h"
 #include "core/jobs.h"
 
+/* Map k's repair in progress: indices [next, end) are still to be tested
+ * and copied. Under the lock only m->count, the marks and the counts
+ * change; the photons are written past m->count, where nothing reads. */
+typedef struct repair_work {
+    bool active;
+    bool in_place;              /* the kept photons at their own index: the old arrays are the map's */
+    uint64_t next, end;
+    ps_photon_source *src;      /* each index's old photon (ps_tracer_photon_sources) */
+    size_t *off;                /* where each old index's photons start in the old map */
+    uint8_t *kept;              /* the keep tests' answers, an index each */
+    ps_photon_map old_map;      /* not in place: the old photons ... */
+    ps_path_store old_paths;    /* ... and records (their vertex pool is the new store's) */
+    size_t to;                  /* photons the map holds */
+    size_t pending_cap;
+} repair_work;
+
 struct ps_feed {
     ps_tracer *tracer;
     uint64_t cap[PS_MAP_COUNT];
@@ -58,8 +74,23 @@ struct ps_feed {
     size_t merged_nmarks[PS_MAP_COUNT];
     ps_path_thr *merged_thr[PS_MAP_COUNT];
     uint64_t generation;            /* under lock */
-    ps_feed_repair_count repair;    /* what the repair that made this feed kept */
+    ps_feed_repair_count repair;    /* under lock: what the repair that made this feed kept */
+    /* A repair's keep tests and copies still to do (repair_step): only the
+     * indices the first picture draws are repaired before it, the rest by
+     * the thread before it retraces anything. */
+    repair_work work[PS_MAP_COUNT];
+    ps_aabb *moved;                 /* the moved objects' boxes, old and new places */
+    size_t moved_count;
+    ps_path_quant quant;
 };
+
+/* Indices a keep job tests (a few milliseconds of path tests). */
+#define KEEP_JOB_INDICES 65536
+/* Indices the thread repairs between two looks at pause and stop: two keep
+ * jobs, one a core (some 10 ms). */
+#define REPAIR_STEP_INDICES (2 * KEEP_JOB_INDICES)
+
+static void repair_work_free(repair_work *w);
 
 /* Path record flags (ps_path_rec.flags). */
 #define REC_PENDING 1u  /* to retrace: its photons are not in the map */
@@ -88,6 +119,7 @@ ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const 
 
 static ps_status hand_over(ps_feed *f, int k, ps_traced *traced, const uint64_t *idx, ps_error *err);
 static ps_status merge(ps_feed *f, ps_error *err);
+static ps_status repair_all(ps_feed *f, ps_error *err);
 static ps_status prepare_map(ps_feed *f, int k, ps_error *err);
 
 /* Traces photons [first, first + count) of map k outside the lock, then
@@ -212,8 +244,18 @@ static uint64_t round_end(const ps_feed *f, int k, uint64_t r, uint64_t prev_end
 /* One round: each active map up to its share of the next PS_FEED_BATCH
  * photons of the largest cap, so that all maps finish together. False when
  * every map has reached its cap (or on an error, in *st). */
+static bool repair_left(const ps_feed *f);
+static ps_status repair_step(ps_feed *f, int k, uint64_t until, ps_error *err);
+
 static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
 {
+    /* A repair first tests and copies what the first picture did not need. */
+    if (repair_left(f)) {
+        for (int k = 0; k < PS_MAP_COUNT && *st == PS_OK; k++)
+            if (f->work[k].active)
+                *st = repair_step(f, k, f->work[k].next + REPAIR_STEP_INDICES, err);
+        return *st == PS_OK;
+    }
     /* Only this thread appends, so the counts can be read without the lock. */
     if (f->max_stored && f->maps[PS_MAP_CAUSTIC].count + f->maps[PS_MAP_GLOBAL].count >= f->max_stored) {
         pthread_mutex_lock(&f->lock);
@@ -406,12 +448,14 @@ void ps_feed_destroy(ps_feed *f)
         free(f->marks[k]);
         ps_path_store_free(&f->paths[k]);
         free(f->pending[k]);
+        repair_work_free(&f->work[k]);
         if (f->prepared[k]) {
             ps_photon_map_free(&f->merged[k]);
             free(f->merged_marks[k]);
             free(f->merged_thr[k]);
         }
     }
+    free(f->moved);
     pthread_cond_destroy(&f->wake);
     pthread_cond_destroy(&f->idle);
     pthread_mutex_destroy(&f->lock);
@@ -540,7 +584,8 @@ static ps_status merge_map(ps_feed *f, int k, ps_error *err)
 
 static ps_status merge(ps_feed *f, ps_error *err)
 {
-    ps_status st = PS_OK;
+    /* Not on the feed's thread: it has ended, or was stopped, or not started. */
+    ps_status st = repair_all(f, err);
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
         st = merge_map(f, k, err);
     return st;
@@ -548,6 +593,9 @@ static ps_status merge(ps_feed *f, ps_error *err)
 
 ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, ps_error *err)
 {
+    /* The pending count is known once every index is tested. */
+    if (repair_left(f))
+        return PS_OK;
     uint64_t pending = 0;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         pending += f->pending_count[k] - f->pending_done[k];
@@ -608,7 +656,7 @@ ps_status ps_feed_merge(ps_feed *f, ps_error *err)
 
 bool ps_feed_repairable(const ps_feed *f)
 {
-    if (!f->records || f->status != PS_OK || f->store_limited || f->started)
+    if (!f->records || f->status != PS_OK || f->store_limited || f->started || repair_left(f))
         return false;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (f->active[k] && f->paths[k].count != f->next[k])
@@ -620,46 +668,49 @@ bool ps_feed_repairable(const ps_feed *f)
  * boxes: most of an update's time at 10^6 photons), each job over a fixed
  * range of indices: a flag an index, the same whatever the thread count. */
 typedef struct keep_job {
-    const ps_feed_repair_fns *fns;
-    int k;
+    const ps_feed *f;
     const ps_photon_source *src;
-    const ps_path_store *paths;
-    uint64_t end;
+    const ps_path_store *pool;  /* the vertices */
+    const ps_path_rec *rec;     /* the old records */
+    uint64_t from, to, end;
     uint8_t *kept;
 } keep_job;
 
-/* Indices a keep job tests (a few milliseconds of path tests). */
-#define KEEP_JOB_INDICES 65536
 
 static void keep_range(void *arg, size_t job)
 {
     const keep_job *j = arg;
-    const ps_path_rec *rec = j->paths->rec;
-    uint64_t from = (uint64_t)job * KEEP_JOB_INDICES;
-    uint64_t to = from + KEEP_JOB_INDICES < j->end ? from + KEEP_JOB_INDICES : j->end;
+    const ps_feed *f = j->f;
+    uint64_t from = j->from + (uint64_t)job * KEEP_JOB_INDICES;
+    uint64_t to = from + KEEP_JOB_INDICES < j->to ? from + KEEP_JOB_INDICES : j->to;
     for (uint64_t i = from; i < to; i++) {
         uint64_t o = j->src[i].from;
-        j->kept[i] = o < j->end && !(rec[o].flags & REC_PENDING) &&
-                     j->fns->keep(j->fns->ctx, (ps_map_kind)j->k, o, j->paths, &rec[o]);
+        bool keep = o < j->end && !(j->rec[o].flags & REC_PENDING);
+        for (size_t m = 0; keep && m < f->moved_count; m++)
+            keep = !ps_path_meets(j->pool, &j->rec[o], &f->quant, f->moved[m]);
+        j->kept[i] = keep;
     }
 }
 
-/* On every core, not only the tracing threads (the window keeps one core
- * for drawing): the tracing thread is held while an edit is applied, and
- * the first picture after it waits for these tests (0.04-0.05 s for the
- * default scene's 10^6 caustic paths on one core). */
-static void keep_all(const ps_feed_repair_fns *fns, int k, const ps_photon_source *src, const ps_path_store *paths,
-                     uint64_t end, uint8_t *kept)
+
+static void repair_work_free(repair_work *w)
 {
-    keep_job job = {fns, k, src, paths, end, kept};
-    ps_run_jobs((size_t)((end + KEEP_JOB_INDICES - 1) / KEEP_JOB_INDICES), ps_online_cores(), keep_range, &job);
+    free(w->src), free(w->off), free(w->kept);
+    w->src = NULL, w->off = NULL, w->kept = NULL;
+    if (!w->in_place) {
+        ps_photon_map_free(&w->old_map);
+        ps_path_store_free(&w->old_paths);
+    }
+    w->active = false;
 }
 
 /* Map k of the repaired feed f from the old one's (in index order, with
- * complete records): photon i of the edited scene takes the photons and
- * record of the old index its source names, when keep() lets it, with their
- * power set anew; the others' indices go to the pending list. */
-static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repair_fns *fns, ps_error *err)
+ * complete records): photon i of the edited scene will take the photons and
+ * record of the old index its source names, when no segment of that path
+ * meets a moved box, with their power set anew; the others' indices go to
+ * the pending list. Here only the sources and the arrays: repair_step does
+ * the rest, index range by index range. */
+static ps_status repair_begin(ps_feed *f, ps_feed *old, int k, const ps_feed_repair_fns *fns, ps_error *err)
 {
     ps_photon_map *om = &old->maps[k];
     ps_path_store *op = &old->paths[k];
@@ -670,43 +721,113 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
         return PS_OK;
     if (op->tcount != om->count || op->count != end)
         return ps_error_set(err, PS_ERR_NOMEM, "the %s map's path records are incomplete", ps_map_name((ps_map_kind)k));
-    ps_photon_source *src = malloc(end * sizeof *src);
-    size_t *off = malloc((end + 1) * sizeof *off);
-    uint8_t *kept = malloc(end);
-    if (!src || !off || !kept) {
-        free(src), free(off), free(kept);
+    repair_work *w = &f->work[k];
+    w->src = malloc(end * sizeof *w->src);
+    w->off = malloc((end + 1) * sizeof *w->off);
+    w->kept = malloc(end);
+    if (!w->src || !w->off || !w->kept) {
+        free(w->src), free(w->off), free(w->kept);
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
     }
-    ps_status st = fns->sources(fns->ctx, (ps_map_kind)k, end, src, err);
+    w->active = true;
+    w->end = end;
+    ps_status st = fns->sources(fns->ctx, (ps_map_kind)k, end, w->src, err);
     /* Every kept photon at its own index (the plans share every count: an
      * object moved, a power edit of a lone light): compact in place, as
      * the map's kept photons only move down. Else gather into new arrays. */
-    bool in_place = true;
-    for (uint64_t i = 0; i < end && in_place; i++)
-        in_place = src[i].from == PS_SOURCE_NONE || src[i].from == i;
+    w->in_place = true;
+    for (uint64_t i = 0; i < end && w->in_place; i++)
+        w->in_place = w->src[i].from == PS_SOURCE_NONE || w->src[i].from == i;
     ps_photon_map *m = &f->maps[k];
     ps_path_store *np = &f->paths[k];
     size_t room = om->count ? om->count : 1;
-    if (st == PS_OK && in_place) {
+    if (st != PS_OK)
+        return st;
+    if (w->in_place) {
         *m = *om, *np = *op;
-        ps_photon_map_init(om, (ps_map_kind)k), ps_path_store_init(op);
-        om = m, op = np;
-    } else if (st == PS_OK && (!ps_photon_map_reserve_exact(m, room) || !ps_path_store_reserve(np, end) ||
-                               !PS_RESERVE(np->thr, np->tcap, room))) {
-        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
+    } else {
+        w->old_map = *om, w->old_paths = *op;
+        if (!ps_photon_map_reserve_exact(m, room) || !ps_path_store_reserve(np, end) ||
+            !PS_RESERVE(np->thr, np->tcap, room))
+            st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
+        /* The kept records point into the old pool: take it whole; the pool
+         * is rewritten once half of it is garbage, so it stays within twice
+         * what the records use (the soak's memory stays flat over hundreds
+         * of edits). */
+        np->vert = op->vert, np->vcount = op->vcount, np->vcap = op->vcap;
+        w->old_paths.vert = NULL, w->old_paths.vcount = w->old_paths.vcap = 0;
     }
-    ps_path_rec *orec = op->rec;
-    if (st == PS_OK)
-        keep_all(fns, k, src, op, end, kept);
-    off[0] = 0;
+    ps_photon_map_init(om, (ps_map_kind)k), ps_path_store_init(op);
+    if (st != PS_OK)
+        return st;
+    const ps_path_rec *orec = w->in_place ? np->rec : w->old_paths.rec;
+    w->off[0] = 0;
     for (uint64_t i = 0; i < end; i++)
-        off[i + 1] = off[i] + ((orec[i].flags & REC_PENDING) ? 0 : orec[i].stored);
-    size_t at = 0, cap = 0, to = 0;
+        w->off[i + 1] = w->off[i] + ((orec[i].flags & REC_PENDING) ? 0 : orec[i].stored);
+    /* Counters: every index below `end` counts as emitted (the pending
+     * ones are on their way); what the paths did is counted anew. */
+    memset(&m->counters, 0, sizeof m->counters);
+    m->counters.emitted = end;
+    m->count = 0;
+    return PS_OK;
+}
+
+/* The end of map k's repair: its records and counts. */
+static ps_status repair_finish(ps_feed *f, int k, ps_error *err)
+{
+    repair_work *w = &f->work[k];
+    ps_photon_map *m = &f->maps[k];
+    ps_path_store *np = &f->paths[k];
+    uint64_t end = w->end;
+    size_t at = f->pending_count[k];
+    np->count = end;
+    np->tcount = w->to;
+    repair_work_free(w);
+    if (!compact_paths(np))
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for path records");
+    pthread_mutex_lock(&f->lock);
+    bool room = PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1);
+    if (room)
+        f->marks[k][f->mark_count[k]++] = (ps_feed_mark){m->count, end};
+    f->repair.kept[k] = end - at;
+    f->repair.retraced[k] = at;
+    f->repair.kept_photons[k] = m->count;
+    f->kept_end[k] = m->count;
+    f->repairing[k] = at > 0;
+    pthread_mutex_unlock(&f->lock);
+    return room ? PS_OK : ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
+}
+
+/* Map k's repair over indices up to `until` (at most its end): the keep
+ * tests on every core (the window keeps one for drawing, but the first
+ * picture after an edit waits for them: 0.04-0.05 s for the default scene's
+ * 10^6 caustic paths on one core), then the kept photons copied, a mark
+ * every batch of indices, handed over under the lock. */
+static ps_status repair_step(ps_feed *f, int k, uint64_t until, ps_error *err)
+{
+    repair_work *w = &f->work[k];
+    if (!w->active)
+        return PS_OK;
+    if (until > w->end)
+        until = w->end;
+    ps_photon_map *m = &f->maps[k];
+    ps_path_store *np = &f->paths[k];
+    const ps_photon_map *om = w->in_place ? m : &w->old_map;
+    const ps_path_store *op = w->in_place ? np : &w->old_paths;
+    const ps_path_rec *orec = op->rec;
+    uint64_t from = w->next;
+    keep_job job = {f, w->src, np, orec, from, until, w->end, w->kept};
+    ps_run_jobs((size_t)((until - from + KEEP_JOB_INDICES - 1) / KEEP_JOB_INDICES), ps_online_cores(), keep_range,
+                &job);
+    const size_t *off = w->off;
+    size_t to = w->to, at = f->pending_count[k];
     uint64_t every = batch_of(f, k);
-    for (uint64_t i = 0; i < end && st == PS_OK; i++) {
-        uint64_t o = src[i].from;
+    ps_status st = PS_OK;
+    for (uint64_t i = from; i < until && st == PS_OK; i++) {
+        const ps_photon_source *src = &w->src[i];
+        uint64_t o = src->from;
         ps_path_rec *r = &np->rec[i];
-        if (kept[i]) {
+        if (w->kept[i]) {
             size_t n = orec[o].stored;
             /* In place, source and destination may overlap (to <= off[o]). */
             if (n == 1) { /* most paths: plain copies, no calls */
@@ -714,7 +835,7 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
                 m->materials[to] = om->materials[off[o]];
                 m->objects[to] = om->objects[off[o]];
                 np->thr[to] = op->thr[off[o]];
-            } else if (!in_place || to != off[o]) {
+            } else if (!w->in_place || to != off[o]) {
                 memmove(m->photons + to, om->photons + off[o], n * sizeof *m->photons);
                 memmove(m->materials + to, om->materials + off[o], n * sizeof *m->materials);
                 memmove(m->objects + to, om->objects + off[o], n * sizeof *m->objects);
@@ -723,13 +844,13 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
             /* The same path, maybe of a light with another power, maybe one of
              * more or fewer photons of its stratum: its power set anew, as
              * the edited scene's trace sets it. */
-            if (src[i].repower)
-                ps_tracer_repower(f->tracer, (ps_map_kind)k, &src[i], np->thr + to, n, m->photons + to);
+            if (src->repower)
+                ps_tracer_repower(f->tracer, (ps_map_kind)k, src, np->thr + to, n, m->photons + to);
             if (r != &orec[o])
                 *r = orec[o];
             r->flags = 0;
             to += n;
-        } else if (!PS_RESERVE(f->pending[k], cap, at + 1)) {
+        } else if (!PS_RESERVE(f->pending[k], w->pending_cap, at + 1)) {
             st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %zu photons", at);
         } else {
             memset(r, 0, sizeof *r);
@@ -739,51 +860,67 @@ static ps_status repair_map(ps_feed *f, ps_feed *old, int k, const ps_feed_repai
         /* A mark every batch of indices: the kept photons of indices below
          * i + 1 stand for all of them, so a refresh that draws only its
          * budget draws a prefix of the kept ones, scaled right. */
-        if ((i + 1) % every == 0 && i + 1 < end) {
-            if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1)) {
-                st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
-                break;
+        if ((i + 1) % every == 0 && i + 1 < w->end) {
+            pthread_mutex_lock(&f->lock);
+            bool room = PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1);
+            if (room) {
+                m->count = to;
+                m->counters.stored = to;
+                f->marks[k][f->mark_count[k]++] = (ps_feed_mark){to, i + 1};
             }
-            ps_feed_mark mk = {to, i + 1};
-            f->marks[k][f->mark_count[k]++] = mk;
+            pthread_mutex_unlock(&f->lock);
+            if (!room)
+                st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
         }
     }
-    free(src), free(off), free(kept);
-    if (st != PS_OK)
-        return st;
-    np->count = end;
-    np->tcount = to;
-    m->count = to;
-    /* The kept records point into the old pool: take it whole; the pool is
-     * rewritten once half of it is garbage, so it stays within twice what
-     * the records use (the soak's memory stays flat over hundreds of edits). */
-    if (!in_place) {
-        np->vert = op->vert, np->vcount = op->vcount, np->vcap = op->vcap;
-        op->vert = NULL, op->vcount = op->vcap = 0;
-    }
-    if (!compact_paths(np))
-        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for path records");
-    if (!in_place) {
-        ps_photon_map_free(om);
-        ps_path_store_free(op);
-    }
     f->pending_count[k] = at;
-    f->kept_end[k] = to;
-    f->repairing[k] = at > 0;
-    /* Counters: every index below `end` counts as emitted (the pending
-     * ones are on their way); what the paths did is counted anew. */
-    memset(&m->counters, 0, sizeof m->counters);
-    m->counters.emitted = end;
+    w->to = to;
+    w->next = until;
+    pthread_mutex_lock(&f->lock);
+    m->count = to;
     m->counters.stored = to;
-    f->repair.kept[k] = end - at;
-    f->repair.retraced[k] = at;
-    f->repair.kept_photons[k] = to;
-    if (!PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1))
-        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
-    ps_feed_mark mk = {to, end};
-    f->marks[k][f->mark_count[k]++] = mk;
-    return PS_OK;
+    pthread_mutex_unlock(&f->lock);
+    if (st == PS_OK && w->next == w->end)
+        st = repair_finish(f, k, err);
+    return st;
 }
+
+/* Whether a map's repair has indices left to test and copy. */
+static bool repair_left(const ps_feed *f)
+{
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        if (f->work[k].active)
+            return true;
+    return false;
+}
+
+/* Every map's repair done on the calling thread (the thread stopped, or not started). */
+static ps_status repair_all(ps_feed *f, ps_error *err)
+{
+    ps_status st = PS_OK;
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
+        if (f->work[k].active)
+            st = repair_step(f, k, f->work[k].end, err);
+    return st;
+}
+
+ps_status ps_feed_repair_ahead(ps_feed *f, const size_t min_photons[PS_MAP_COUNT], ps_error *err)
+{
+    double t0 = ps_now_seconds();
+    ps_status st = PS_OK;
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
+        repair_work *w = &f->work[k];
+        /* A batch of indices at a time: a mark each, so the kept photons
+         * come in the steps a picture's budget reads. */
+        uint64_t every = batch_of(f, k);
+        while (st == PS_OK && w->active && f->maps[k].count < min_photons[k])
+            st = repair_step(f, k, (w->next / every + 1) * every, err);
+    }
+    f->seconds += ps_now_seconds() - t0;
+    return st;
+}
+
+bool ps_feed_repair_done(const ps_feed *f) { return !repair_left(f); }
 
 ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair_fns *fns, ps_feed **out,
                                 ps_error *err)
@@ -799,8 +936,15 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair
     f->max_stored = old->max_stored;
     f->round = old->round;
     f->seconds = old->seconds;
+    f->quant = fns->quant;
+    f->moved_count = fns->moved_count;
+    f->moved = malloc((fns->moved_count ? fns->moved_count : 1) * sizeof *f->moved);
+    if (!f->moved)
+        st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair");
+    else if (fns->moved_count)
+        memcpy(f->moved, fns->moved, fns->moved_count * sizeof *f->moved);
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
-        st = repair_map(f, old, k, fns, err);
+        st = repair_begin(f, old, k, fns, err);
     if (st != PS_OK) {
         ps_feed_destroy(f);
         return st;
@@ -809,6 +953,12 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair
     return PS_OK;
 }
 
-ps_feed_repair_count ps_feed_repair_counts(const ps_feed *f) { return f->repair; }
+ps_feed_repair_count ps_feed_repair_counts(ps_feed *f)
+{
+    pthread_mutex_lock(&f->lock);
+    ps_feed_repair_count c = f->repair;
+    pthread_mutex_unlock(&f->lock);
+    return c;
+}
 
 uint64_t ps_feed_generation(const ps_feed *f) { return f->generation; }

@@ -101,29 +101,43 @@ bool ps_feed_active(const ps_feed *f, ps_map_kind k);
 typedef struct ps_feed_repair_fns {
     void *ctx;
     /* Which old photon each of map k's indices [0, end) is under the edited
-     * scene's tracer (ps_tracer_photon_sources). */
+     * scene's tracer (ps_tracer_photon_sources). Called by
+     * ps_feed_create_repair only. */
     ps_status (*sources)(void *ctx, ps_map_kind k, uint64_t end, ps_photon_source *out, ps_error *err);
-    /* Whether old photon index i of map k, with record rec (in paths), is
-     * clear of the edit. */
-    bool (*keep)(void *ctx, ps_map_kind k, uint64_t i, const ps_path_store *paths, const ps_path_rec *rec);
+    /* An old photon is kept when no segment of its path meets one of these
+     * boxes (path_record.h, in quant): the moved objects' old and new
+     * places. Copied: the feed tests most paths after the call. */
+    const ps_aabb *moved;
+    size_t moved_count;
+    ps_path_quant quant;
 } ps_feed_repair_fns;
 /* Whether a stopped feed can be repaired: its records are complete, it did
  * not fail or end at the store limit. */
 bool ps_feed_repairable(const ps_feed *f);
 /* The new feed, on tracer t (the edited scene's), from old (stopped and
  * repairable; left empty, to be destroyed): photon i of the edited scene is
- * the old photon its source names when keep() says so (its power set anew,
- * ps_tracer_repower), else retraced. On an error old's maps may be lost:
- * start a new feed from photon 0. */
+ * the old photon its source names when its path is clear of the moved boxes
+ * (its power set anew, ps_tracer_repower), else retraced. The call finds
+ * the sources only: the paths are tested and the kept photons copied by
+ * ps_feed_repair_ahead for what the first picture draws, the rest by the
+ * thread (or run, or a merge) before it retraces anything. On an error
+ * old's maps may be lost: start a new feed from photon 0. */
 ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair_fns *fns, ps_feed **out,
                                 ps_error *err);
+/* Before run, prime or start: map k's repair carried on, a batch of indices
+ * at a time, until the map holds at least min_photons[k] photons or its
+ * repair is done (SIZE_MAX: done). */
+ps_status ps_feed_repair_ahead(ps_feed *f, const size_t min_photons[PS_MAP_COUNT], ps_error *err);
+/* Whether every index of the repair that made f is tested and copied (not
+ * under the lock: before start, or after the feed ended). */
+bool ps_feed_repair_done(const ps_feed *f);
 /* What the repair that made f did, per map: photon indices kept and to
- * retrace, and the stored photons kept. */
+ * retrace, and the stored photons kept (zeros until ps_feed_repair_done). */
 typedef struct ps_feed_repair_count {
     uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
     uint64_t kept_photons[PS_MAP_COUNT];
 } ps_feed_repair_count;
-ps_feed_repair_count ps_feed_repair_counts(const ps_feed *f);
+ps_feed_repair_count ps_feed_repair_counts(ps_feed *f);
 /* Under the lock: how many times a map was reordered (a drawn prefix of it
  * is then not the same photons). */
 uint64_t ps_feed_generation(const ps_feed *f);

@@ -64,16 +64,6 @@ static ps_status sources(void *arg, ps_map_kind k, uint64_t end, ps_photon_sourc
                                     out, err);
 }
 
-static bool keep(void *arg, ps_map_kind k, uint64_t i, const ps_path_store *paths, const ps_path_rec *rec)
-{
-    (void)k, (void)i;
-    keep_ctx *c = arg;
-    for (size_t m = 0; m < c->moved_count; m++)
-        if (ps_path_meets(paths, rec, &c->quant, c->moved[m]))
-            return false;
-    return true;
-}
-
 /* Whether light a emits as b does but for its power: the same kind, place,
  * aim, shape and table (its power and the radiance that follows from it may
  * differ). */
@@ -139,7 +129,7 @@ ps_status ps_repair_feed(ps_feed *old, ps_tracer *old_tracer, ps_tracer *new_tra
             c.resampled[l] = true;
     ps_status st = PS_OK;
     if (fits) {
-        ps_feed_repair_fns fns = {&c, sources, keep};
+        ps_feed_repair_fns fns = {&c, sources, c.moved, c.moved_count, c.quant};
         st = ps_feed_create_repair(new_tracer, old, &fns, out, err);
         *repaired = st == PS_OK;
     }

@@ -68,10 +68,11 @@ struct ps_session {
     ps_repair_state traced;
     ps_aabb record_box;
     bool repaired;         /* the last update repaired the maps (else restarted them) */
+    uint64_t repairs_before; /* repairs before the feed's own, and what they kept and retraced */
+    uint64_t kept_before[PS_MAP_COUNT], retraced_before[PS_MAP_COUNT];
     bool skip_prime;       /* ... and every map kept photons: no first round to prime */
     uint64_t feed_gen;     /* the feed's generation the drawn prefixes belong to */
     uint64_t maps_epoch;   /* ps_session_maps_epoch */
-    ps_feed_repair_count repair;
 };
 
 ps_session_settings ps_session_default_settings(const ps_scene *scene)
@@ -384,18 +385,26 @@ static bool same_camera(const ps_camera_frame *a, const ps_camera_frame *b)
  * emitted for that prefix, which its splats are scaled by. Under the lock. */
 static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t from_emitted, double budget,
                             uint64_t *emitted);
+
+/* Whether an edit's first refresh draws all of `photons` stored photons
+ * (PS_SESSION_EDIT_SPLATS_WHOLE): not during a drag, and not when the splat
+ * rate says it would take more than settings.edit_whole_taus (no rate yet,
+ * no refresh timed: the count alone). */
+static bool edit_draws_whole(const ps_session *s, uint64_t photons)
+{
+    bool in_time = s->set.edit_whole_taus <= 0.0 || s->splat_rate <= 0.0 ||
+                   (double)photons <= s->splat_rate * s->set.edit_whole_taus * s->set.tau;
+    return !s->dragging && photons <= s->set.edit_splats_whole && in_time;
+}
+
 static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emitted, uint64_t *emitted)
 {
     double budget = s->moving     ? s->budget * PS_SESSION_MOVING_SHARE
                     : s->catch_up ? s->budget * PS_SESSION_CATCH_UP_GAIN
                                   : s->budget;
-    if (s->edit_view && !s->moving && !s->dragging) {
+    if (s->edit_view && !s->moving) {
         const ps_photon_map *maps = ps_feed_maps(s->feed);
-        uint64_t all = (uint64_t)maps[PS_MAP_CAUSTIC].count + maps[PS_MAP_GLOBAL].count;
-        /* No rate yet (no refresh timed): the count alone. */
-        bool in_time = s->set.edit_whole_taus <= 0.0 || s->splat_rate <= 0.0 ||
-                       (double)all <= s->splat_rate * s->set.edit_whole_taus * s->set.tau;
-        if (all <= s->set.edit_splats_whole && in_time)
+        if (edit_draws_whole(s, (uint64_t)maps[PS_MAP_CAUSTIC].count + maps[PS_MAP_GLOBAL].count))
             budget = HUGE_VAL;
     }
     return prefix_within(s, k, from, from_emitted, budget, emitted);
@@ -941,6 +950,13 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
     s->feed = NULL;
     s->tracer = NULL;
     ps_feed_stop(old);
+    /* Stopped, the old feed's repair is whole: its counts are final. */
+    if (s->repaired) {
+        ps_feed_repair_count rc = ps_feed_repair_counts(old);
+        s->repairs_before++;
+        for (int k = 0; k < PS_MAP_COUNT; k++)
+            s->kept_before[k] += rc.kept[k], s->retraced_before[k] += rc.retraced[k];
+    }
     ps_status st = PS_OK;
     if (s->geometry_edited) {
         /* The maps' samples are the fine mesh's vertices: made again with it. */
@@ -958,7 +974,10 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
     if (st == PS_OK)
         st = new_tracer(s, err);
     s->repaired = s->skip_prime = false;
-    memset(&s->repair, 0, sizeof s->repair);
+    /* The photons the first picture could draw whole (prefix()). */
+    uint64_t held = 0;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        held += ps_feed_maps(old)[k].count;
     if (st == PS_OK) {
         ps_feed *f = NULL;
         ps_error rerr;
@@ -968,21 +987,33 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
             s->repaired = false;
         if (s->repaired) {
             s->feed = f;
-            s->repair = ps_feed_repair_counts(f);
+            /* The paths are tested and the kept photons copied as far as the
+             * first picture draws (its budget's prefix of each map), the
+             * rest by the thread: at 10^6 photons the whole repair was
+             * 0.11-0.14 s of the first frame's wait. Maps the first picture
+             * draws whole (whole refreshes, PS_SESSION_EDIT_SPLATS_WHOLE) are
+             * repaired whole, so that their retrace can come first too. */
+            bool whole = !incremental(s) || edit_draws_whole(s, held);
+            size_t ahead[PS_MAP_COUNT];
+            for (int k = 0; k < PS_MAP_COUNT; k++)
+                ahead[k] = whole ? SIZE_MAX : (size_t)fmax(1.0, ceil(s->budget));
+            st = ps_feed_repair_ahead(f, ahead, err);
             /* What the edit changed is retraced first: here when it is at
              * most settings.retrace_first photons (the default caps, or an
              * edit near few paths), so that the first picture has no hole
              * where the moved object was and the maps are in index order
              * from the start; else by the thread. */
-            if (s->started)
+            if (st == PS_OK && s->started)
                 st = ps_feed_retrace_first(f, s->set.retrace_first, err);
             /* A map that has nothing yet gets its first batch before the
              * first picture, as after a restart; one that has photons shows
-             * them at once. */
+             * them at once (a map left empty by repair_ahead is repaired
+             * whole, so its counts are known). */
+            ps_feed_repair_count rc = ps_feed_repair_counts(f);
             bool all_maps_have = true;
             ps_feed_lock(f);
             for (int k = 0; k < PS_MAP_COUNT; k++)
-                all_maps_have = all_maps_have && (ps_feed_maps(f)[k].count > 0 || s->repair.retraced[k] == 0);
+                all_maps_have = all_maps_have && (ps_feed_maps(f)[k].count > 0 || rc.retraced[k] == 0);
             ps_feed_unlock(f);
             s->skip_prime = all_maps_have;
             forget_drawn(s);
@@ -1108,9 +1139,24 @@ void ps_session_unlock_maps(ps_session *s) { ps_feed_unlock(s->feed); }
 void ps_session_repair_counts(const ps_session *s, bool *repaired, uint64_t kept[PS_MAP_COUNT],
                               uint64_t retraced[PS_MAP_COUNT])
 {
+    /* The feed the last repair made (zeros while its tests go on). */
+    ps_feed_repair_count rc;
+    memset(&rc, 0, sizeof rc);
+    if (s->repaired)
+        rc = ps_feed_repair_counts(s->feed);
     *repaired = s->repaired;
     for (int k = 0; k < PS_MAP_COUNT; k++) {
-        kept[k] = s->repair.kept[k];
-        retraced[k] = s->repair.retraced[k];
+        kept[k] = rc.kept[k];
+        retraced[k] = rc.retraced[k];
     }
+}
+
+void ps_session_repair_totals(const ps_session *s, uint64_t *repairs, uint64_t kept[PS_MAP_COUNT],
+                              uint64_t retraced[PS_MAP_COUNT])
+{
+    bool now;
+    ps_session_repair_counts(s, &now, kept, retraced);
+    *repairs = s->repairs_before + (now ? 1 : 0);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        kept[k] += s->kept_before[k], retraced[k] += s->retraced_before[k];
 }

@@ -379,8 +379,14 @@ const ps_photon_map *ps_session_maps(const ps_session *s);
 const ps_photon_map *ps_session_lock_maps(ps_session *s);
 void ps_session_unlock_maps(ps_session *s);
 /* What the last ps_session_update did: whether it repaired (else restarted),
- * and per map the photon indices kept and those to retrace. */
+ * and per map the photon indices kept and those to retrace (zeros until the
+ * tracing thread has tested every index: see ps_feed_repair_ahead). */
 void ps_session_repair_counts(const ps_session *s, bool *repaired, uint64_t kept[PS_MAP_COUNT],
+                              uint64_t retraced[PS_MAP_COUNT]);
+/* Every ps_session_update's together: how many repaired, and per map the
+ * photon indices kept and retraced (the last repair's are whole once
+ * ps_session_stop has returned). */
+void ps_session_repair_totals(const ps_session *s, uint64_t *repairs, uint64_t kept[PS_MAP_COUNT],
                               uint64_t retraced[PS_MAP_COUNT]);
 
 #endif
