@@ -363,11 +363,10 @@ static void marks_after_a_repair_are_a_fresh_feeds(void **state)
 #define SHOWN_CAUSTIC_CAP (4 * PS_FEED_BATCH)
 #define SHOWN_GLOBAL_CAP PS_FEED_BATCH
 static ps_session *open_shown_whole(ps_scene *scene, uint64_t retrace_first, uint64_t edit_splats_whole,
-                                    double edit_whole_taus, ps_camera_frame *cam)
+                                    ps_camera_frame *cam)
 {
     ps_session_settings set = repair_settings(scene, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
     set.edit_splats_whole = edit_splats_whole;
-    set.edit_whole_taus = edit_whole_taus;
     set.float_buffer = set.incremental = true;
     set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
     set.retrace_first = retrace_first;
@@ -383,22 +382,26 @@ static ps_session *open_shown_whole(ps_scene *scene, uint64_t retrace_first, uin
 
 static ps_session *open_shown(ps_scene *scene, uint64_t retrace_first, ps_camera_frame *cam)
 {
-    return open_shown_whole(scene, retrace_first, PS_SESSION_EDIT_SPLATS_WHOLE, 0.0, cam);
+    return open_shown_whole(scene, retrace_first, PS_SESSION_EDIT_SPLATS_WHOLE, cam);
 }
 
-/* Refreshes (each said drawn in draw_seconds) until everything is shown;
- * how many of them after the first started the view over. With wait_end,
- * tracing ends after the first (before the picture has drawn everything). */
-static int refresh_until_settled_at(ps_session *s, const ps_camera_frame *cam, bool wait_end, double draw_seconds)
+/* Refreshes (each said drawn at once) until everything is shown; how many
+ * of them after the first started the view over (but for the full view that
+ * follows an edit's level of detail). With wait_end, tracing ends after the
+ * first (before the picture has drawn everything). */
+static int refresh_until_settled(ps_session *s, const ps_camera_frame *cam, bool wait_end)
 {
     int restarts = 0, i = 0;
+    bool lod = false;
     for (; i < 100000 && !ps_session_settled(s); i++) {
         ps_session_frame f;
         ps_error err;
         if (ps_session_refresh(s, cam, &f, &err) != PS_OK)
             fail_msg("refresh: %s", err.msg);
-        restarts += i > 0 && f.new_view;
-        ps_session_drawn(s, draw_seconds);
+        restarts += i > 0 && f.new_view && !(i == 1 && lod);
+        if (i == 0)
+            lod = f.edit_lod;
+        ps_session_drawn(s, 1e-4);
         ps_session_counts c;
         do {
             struct timespec ts = {0, 200000};
@@ -410,11 +413,6 @@ static int refresh_until_settled_at(ps_session *s, const ps_camera_frame *cam, b
     }
     assert_true(ps_session_settled(s));
     return restarts;
-}
-
-static int refresh_until_settled(ps_session *s, const ps_camera_frame *cam, bool wait_end)
-{
-    return refresh_until_settled_at(s, cam, wait_end, 1e-4);
 }
 
 /* The maps a picture may read now (in index order once tracing ended)
@@ -442,7 +440,7 @@ static void a_background_repair_keeps_the_view(void **state)
     (void)state;
     ps_scene *scene = load();
     ps_camera_frame cam;
-    ps_session *s = open_shown_whole(scene, 0, 0, 0.0, &cam);
+    ps_session *s = open_shown_whole(scene, 0, 0, &cam);
     assert_int_equal(refresh_until_settled(s, &cam, false), 0);
     for (int e = 0; e < 3; e++) {
         apply(s, e == 0 ? MOVE_MIRROR : e == 1 ? MOVE_SPOT : MOVE_FLOOR, e);
@@ -476,7 +474,7 @@ static void edits_mid_background_repair(void **state)
     (void)state;
     ps_scene *scene = load();
     ps_camera_frame cam;
-    ps_session *s = open_shown_whole(scene, 0, 0, 0.0, &cam);
+    ps_session *s = open_shown_whole(scene, 0, 0, &cam);
     assert_int_equal(refresh_until_settled(s, &cam, false), 0);
     ps_error err;
     for (int e = 0; e < EDIT_KINDS; e++) {
@@ -519,18 +517,16 @@ static void a_small_repair_is_done_before_the_first_picture(void **state)
 }
 
 /* The first refresh after an edit (the maps full, the least budget: a
- * batch a refresh) draws every stored photon when they number at most
- * edit_splats_whole and the refreshes before it, each said drawn in
- * draw_seconds, give a rate that draws them in edit_whole_taus taus (tau
- * 1e-9 s here; 0: any time), else (and during a drag) the budget's prefix. */
-static uint64_t first_edit_refresh_draws(uint64_t edit_splats_whole, double edit_whole_taus, double draw_seconds,
-                                         bool dragging)
+ * batch a refresh; a 64^2 view) draws every stored photon when they number
+ * at most edit_splats_whole at 256^2, so a sixteenth of that here; else
+ * (and during a drag) the budget's prefix, as the level of detail (*lod). */
+static uint64_t first_edit_refresh_draws_lod(uint64_t edit_splats_whole, bool dragging, bool *lod)
 {
     ps_scene *scene = load();
     ps_camera_frame cam;
-    ps_session *s = open_shown_whole(scene, PS_SESSION_RETRACE_FIRST, edit_splats_whole, edit_whole_taus, &cam);
+    ps_session *s = open_shown_whole(scene, PS_SESSION_RETRACE_FIRST, edit_splats_whole, &cam);
     ps_error err;
-    assert_int_equal(refresh_until_settled_at(s, &cam, false, draw_seconds), 0);
+    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
     ps_session_set_dragging(s, dragging);
     apply(s, MOVE_MIRROR, 0);
     update_repaired(s);
@@ -539,24 +535,54 @@ static uint64_t first_edit_refresh_draws(uint64_t edit_splats_whole, double edit
     assert_true(f.new_view);
     uint64_t drawn = f.emitted[PS_MAP_CAUSTIC];
     ps_session_drawn(s, 1e-4);
+    /* A picture that does not draw every photon is the level of detail (a
+     * moving camera's: half the pixels a side), the full view next. */
+    *lod = f.edit_lod;
+    assert_true(f.moving == f.edit_lod);
+    assert_int_equal(f.view.width, f.edit_lod ? (cam.width + 1) / 2 : cam.width);
+    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+    assert_false(f.moving || f.edit_lod);
+    assert_int_equal(f.view.width, cam.width);
+    assert_true(f.new_view == *lod);
+    ps_session_drawn(s, 1e-4);
     assert_int_equal(ps_session_stop(s, &err), PS_OK);
     ps_session_destroy(s);
     ps_scene_destroy(scene);
     return drawn;
 }
 
+static uint64_t first_edit_refresh_draws(uint64_t edit_splats_whole, bool dragging)
+{
+    bool lod;
+    uint64_t drawn = first_edit_refresh_draws_lod(edit_splats_whole, dragging, &lod);
+    assert_true(lod == (drawn < SHOWN_CAUSTIC_CAP));
+    return drawn;
+}
+
 static void an_edit_picture_draws_every_photon(void **state)
 {
     (void)state;
-    const uint64_t whole = PS_SESSION_EDIT_SPLATS_WHOLE;
-    assert_int_equal(first_edit_refresh_draws(whole, 0.0, 1e-4, false), SHOWN_CAUSTIC_CAP);
-    assert_true(first_edit_refresh_draws(0, 0.0, 1e-4, false) < SHOWN_CAUSTIC_CAP);
-    assert_true(first_edit_refresh_draws(whole, 0.0, 1e-4, true) < SHOWN_CAUSTIC_CAP);
-    /* The time rule: refreshes of a batch said to take 1 s each draw at
-     * most PS_FEED_BATCH splats a second. In 2 taus of 1e-9 s that is
-     * nothing; in 10^12 taus (1000 s) every one of the maps' photons. */
-    assert_true(first_edit_refresh_draws(whole, 2.0, 1.0, false) < SHOWN_CAUSTIC_CAP);
-    assert_int_equal(first_edit_refresh_draws(whole, 1e12, 1.0, false), SHOWN_CAUSTIC_CAP);
+    /* Both maps' stored photons at 64^2 against the count at 256^2: 16
+     * times as many. */
+    ps_scene *scene = load();
+    ps_camera_frame cam;
+    ps_session *s = open_shown(scene, PS_SESSION_RETRACE_FIRST, &cam);
+    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
+    const ps_photon_map *maps = ps_session_lock_maps(s);
+    uint64_t held = maps[PS_MAP_CAUSTIC].count + maps[PS_MAP_GLOBAL].count;
+    ps_session_unlock_maps(s);
+    ps_error err;
+    assert_int_equal(ps_session_stop(s, &err), PS_OK);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+    uint64_t at_256 = held * 64 * 64 / PS_SESSION_EDIT_WHOLE_PIXELS;
+    if (at_256 * PS_SESSION_EDIT_WHOLE_PIXELS < held * 64 * 64)
+        at_256++; /* the least count that draws them whole */
+    assert_int_equal(first_edit_refresh_draws(PS_SESSION_EDIT_SPLATS_WHOLE, false), SHOWN_CAUSTIC_CAP);
+    assert_int_equal(first_edit_refresh_draws(at_256, false), SHOWN_CAUSTIC_CAP);
+    assert_true(first_edit_refresh_draws(at_256 - 1, false) < SHOWN_CAUSTIC_CAP);
+    assert_true(first_edit_refresh_draws(0, false) < SHOWN_CAUSTIC_CAP);
+    assert_true(first_edit_refresh_draws(PS_SESSION_EDIT_SPLATS_WHOLE, true) < SHOWN_CAUSTIC_CAP);
 }
 
 /* The specular layer after the mirror moves, camera still (256^2: its spheres

@@ -524,7 +524,7 @@ static ps_status refresh(app *a, ps_error *err)
         ps_latency_commit(&a->lat, t1);
     }
     a->awaiting_edit_frame = false;
-    if (a->frame.moving) {
+    if (a->frame.moving && !a->frame.edit_lod) {
         a->moving_frames++;
         a->moving_seconds += t1 - t0;
         a->moving_end = t1;

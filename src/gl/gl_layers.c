@@ -250,8 +250,9 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
         /* While the camera moves, the direct layer's level of detail: no
          * shadow passes (one pass a light instead of one a lit cube face,
          * most of a moving frame's time); they come back with the full view
-         * when the camera stops. */
-        new_view(l, r, cam, f->direct_exposure, f->direct, r->opt.shadows && !f->moving);
+         * when the camera stops. An edit's level of detail keeps them: the
+         * edit may be what they show. */
+        new_view(l, r, cam, f->direct_exposure, f->direct, r->opt.shadows && (!f->moving || f->edit_lod));
     } else if (f->lights_changed) {
         /* New lights, the same view: only the direct layer again. Its pass
          * redraws the shared depth prepass too, the same depths, so the map

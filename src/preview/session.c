@@ -33,13 +33,14 @@ struct ps_session {
     uint64_t drawn_emitted[PS_MAP_COUNT];
     double splat_radius[PS_MAP_COUNT];
     double budget;         /* incremental: photons a map per refresh */
-    double splat_rate;     /* incremental: splats a second the last timed refresh drew (0: none yet) */
     size_t last_splats;    /* built by the last refresh ... */
     double last_build;     /* ... in this many seconds */
     double round_off;
     bool have_cam, view_dirty;
     bool moving;           /* the last refresh had a new camera: a level of detail */
     bool edit_view;        /* the next refresh is an update's first (PS_SESSION_EDIT_SPLATS_WHOLE) */
+    uint64_t edit_held;    /* ... and the maps held this many photons before it (a repair
+                            * left to the thread has not copied them all yet) */
     bool dragging;         /* ps_session_set_dragging */
     bool catch_up;         /* still after a move, the view not yet drawn in full */
     ps_camera_frame cam;
@@ -101,7 +102,6 @@ ps_session_settings ps_session_default_settings(const ps_scene *scene)
     set.retrace_first = PS_SESSION_RETRACE_FIRST;
     set.pixel_rays_whole = PS_SESSION_PIXEL_RAYS_WHOLE;
     set.edit_splats_whole = PS_SESSION_EDIT_SPLATS_WHOLE;
-    set.edit_whole_taus = PS_SESSION_EDIT_WHOLE_TAUS;
     return set;
 }
 
@@ -387,14 +387,13 @@ static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t fr
                             uint64_t *emitted);
 
 /* Whether an edit's first refresh draws all of `photons` stored photons
- * (PS_SESSION_EDIT_SPLATS_WHOLE): not during a drag, and not when the splat
- * rate says it would take more than settings.edit_whole_taus (no rate yet,
- * no refresh timed: the count alone). */
+ * (PS_SESSION_EDIT_SPLATS_WHOLE): not during a drag, and not past the count
+ * for the view's pixels (the last camera's; the count itself before any). */
 static bool edit_draws_whole(const ps_session *s, uint64_t photons)
 {
-    bool in_time = s->set.edit_whole_taus <= 0.0 || s->splat_rate <= 0.0 ||
-                   (double)photons <= s->splat_rate * s->set.edit_whole_taus * s->set.tau;
-    return !s->dragging && photons <= s->set.edit_splats_whole && in_time;
+    double pixels = s->have_cam ? (double)s->cam.width * (double)s->cam.height : PS_SESSION_EDIT_WHOLE_PIXELS;
+    return !s->dragging &&
+           (double)photons * pixels <= (double)s->set.edit_splats_whole * PS_SESSION_EDIT_WHOLE_PIXELS;
 }
 
 static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emitted, uint64_t *emitted)
@@ -402,11 +401,8 @@ static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emit
     double budget = s->moving     ? s->budget * PS_SESSION_MOVING_SHARE
                     : s->catch_up ? s->budget * PS_SESSION_CATCH_UP_GAIN
                                   : s->budget;
-    if (s->edit_view && !s->moving) {
-        const ps_photon_map *maps = ps_feed_maps(s->feed);
-        if (edit_draws_whole(s, (uint64_t)maps[PS_MAP_CAUSTIC].count + maps[PS_MAP_GLOBAL].count))
-            budget = HUGE_VAL;
-    }
+    if (s->edit_view && !s->moving && edit_draws_whole(s, s->edit_held))
+        budget = HUGE_VAL;
     return prefix_within(s, k, from, from_emitted, budget, emitted);
 }
 
@@ -535,6 +531,18 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         s->moving = false;
         s->catch_up = true;
         s->view_dirty = true;
+    }
+    /* An edit's first picture, unless it draws every photon (the edit then
+     * came alone: the picture after it is as full as the one before), is
+     * the level of detail as a moving camera's, with shadows; the full
+     * view follows at the next refresh, as after a camera move. A drag's
+     * edits are all drawn so. */
+    if (s->edit_view && inc && s->have_cam && !s->moving) {
+        if (!edit_draws_whole(s, s->edit_held)) {
+            s->moving = true;
+            s->view_dirty = true;
+            out->edit_lod = true;
+        }
     }
     out->moving = s->moving;
     /* The level of detail's fewer pixels (the camera's view, fewer of them:
@@ -733,7 +741,6 @@ void ps_session_drawn(ps_session *s, double draw_seconds)
      * direct layer): it would understate the rate the still view draws at. */
     if (incremental(s) && s->last_splats > 0 && !s->moving) {
         double rate = (double)s->last_splats / fmax(s->last_build + draw_seconds, 1e-6);
-        s->splat_rate = rate;
         s->budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * s->set.splat_share / PS_MAP_COUNT);
     }
     /* Thesis 5.1: once a refresh loses this much to round-off, more photons
@@ -978,6 +985,7 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
     uint64_t held = 0;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         held += ps_feed_maps(old)[k].count;
+    s->edit_held = held;
     if (st == PS_OK) {
         ps_feed *f = NULL;
         ps_error rerr;

@@ -104,21 +104,21 @@
  * whole. A count, as above. */
 #define PS_SESSION_PIXEL_RAYS_WHOLE 131072
 /* The first refresh after an edit draws every stored photon, not a budget's
- * prefix, when both maps hold at most this many (and the edit is not part of
- * a drag, ps_session_set_dragging) and the splat rate the refreshes have
- * shown says it takes at most PS_SESSION_EDIT_WHOLE_TAUS taus: the picture
- * after a single edit is then as full as the one before it (issue 18: "the
- * first frame after an edit shows every kept photon at once"). At the
- * default caps (2.5*10^5) the budget drew 7*10^4 to 2.5*10^5 of them with
- * the refreshes' timing, and the first picture after moving the mirror 10 cm
- * was at relMSE 0.015 to 0.026 against the converged edited scene. Past it
- * (the window's 10^6 photons, a second of llvmpipe) the budget's prefix, as
- * a drag's. A count, as above. */
+ * prefix, when both maps hold at most this many at a view of
+ * PS_SESSION_EDIT_WHOLE_PIXELS (and in proportion to fewer or more pixels:
+ * a splat fills pixels in proportion to them), unless the edit is part of a
+ * drag (ps_session_set_dragging): the picture after a single edit is then as
+ * full as the one before it (issue 18: "the first frame after an edit shows
+ * every kept photon at once"). At the default caps (2.5*10^5) and 256^2 the
+ * budget drew 7*10^4 to 2.5*10^5 of them with the refreshes' timing, and the
+ * first picture after moving the mirror 10 cm was at relMSE 0.015 to 0.026
+ * against the converged edited scene. Past it the first picture is the
+ * level of detail (ps_session_frame.edit_lod). A count, as above, not a
+ * time: a count by itself let the area-light scene at 512^2 draw 2.6*10^5
+ * photons in 0.9 s, and the refreshes' own splat rates went from 3*10^4 to
+ * 1.5*10^6 a second from one refresh to the next. */
 #define PS_SESSION_EDIT_SPLATS_WHOLE 262144
-/* ... and the time the whole draw may take, in taus (the count alone let the
- * area-light scene at 512^2, 2.6*10^5 photons 1 s in, spend 0.9 s drawing
- * them: its splats fill four times the 256^2 view's pixels). */
-#define PS_SESSION_EDIT_WHOLE_TAUS 2.0
+#define PS_SESSION_EDIT_WHOLE_PIXELS (256 * 256)
 
 typedef struct ps_session_settings {
     /* The photons. */
@@ -167,9 +167,8 @@ typedef struct ps_session_settings {
     uint64_t pixel_rays_whole;     /* the per-pixel specular paths whole in a refresh when at
                                     * most this many rays are left (PS_SESSION_PIXEL_RAYS_WHOLE) */
     uint64_t edit_splats_whole;    /* an edit's first refresh draws every photon when the maps
-                                    * hold at most this many (PS_SESSION_EDIT_SPLATS_WHOLE) ... */
-    double edit_whole_taus;        /* ... and the refreshes' splat rate draws them in at most
-                                    * this many taus (PS_SESSION_EDIT_WHOLE_TAUS; 0: any time) */
+                                    * hold at most this many at 256^2, in proportion to the
+                                    * view's pixels (PS_SESSION_EDIT_SPLATS_WHOLE) */
 } ps_session_settings;
 
 /* Defaults: the scene's photon counts and radii, every layer, triangles, the
@@ -235,6 +234,8 @@ typedef struct ps_session_frame {
     ps_splat_mode splat;
     double point_size;
     bool moving;             /* the camera moved: this picture is the level of detail */
+    bool edit_lod;           /* ... or an edit: its first picture, unless it draws every
+                              * photon, is the level of detail too, with shadows */
     ps_camera_frame view;    /* what this refresh draws at: the camera, or while it moves the
                               * same view at 1/PS_SESSION_MOVING_SCALE of its pixels a side */
     uint64_t emitted[PS_MAP_COUNT]; /* the photons emitted that this picture shows */
