@@ -209,14 +209,16 @@ fi
 # 10^6 + 2.5*10^5 photons, 4 edits at 1 s apart, each undoing the last) and
 # photosplat-snap --script on the same scripts (its own clock, no display).
 # The clock starts before the edit's call (which holds the tracing thread
-# between batches) and stops when the refresh is shown (app/latency.h);
+# between batches) and stops when the refresh is shown (app/latency.h): the
+# first, which at these caps is the level of detail, and the first at full
+# detail ("full view");
 # "shadows" is the shadow-cube faces rendered again (faces a frame, only
 # those an edit can change) and "draw" the rest of the layers' drawing
 # (depth prepass, direct light through the shadow cubes, splats).
 if want latency; then
 echo
-echo "| program | scene | edit | first frame after an edit, mean s | max s | hold | update | session | specular | shadows (faces) | draw | show | other |"
-echo "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+echo "| program | scene | edit | first frame after an edit, mean s | max s | full view, mean s | max s | hold | update | session | specular | shadows (faces) | draw | show | other |"
+echo "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
 lat_kinds=("cornell-caustic|data/scenes/cornell-caustic.scn|move object|move object 6  0.1 0 0|move object 6  -0.1 0 0"
     "cornell-caustic|data/scenes/cornell-caustic.scn|move light|move light 0  0.3 1.9 0|move light 0  0 1.9 0"
     "cornell-caustic|data/scenes/cornell-caustic.scn|power|power light 0  50 50 50|power light 0  100 100 100"
@@ -233,9 +235,10 @@ for k in "${lat_kinds[@]}"; do
         --global-photons 250000 --script "$tmp/lat.txt" --stats "$tmp/lat-s.json" >/dev/null
     for prog in w s; do
         f=$tmp/lat-$prog.json
-        printf '| %s | %s | %s | %.3f | %.3f | %s | %s | %s | %s | %s (%s) | %s | %s | %s |\n' \
+        printf '| %s | %s | %s | %.3f | %.3f | %.3f | %.3f | %s | %s | %s | %s | %s (%s) | %s | %s | %s |\n' \
             "$([ $prog = w ] && echo window || echo snap --script)" "$label" "$kind" \
             "$(stat_of edit_to_frame_seconds_mean "$f")" "$(stat_of edit_to_frame_seconds_max "$f")" \
+            "$(stat_of edit_to_full_frame_seconds_mean "$f")" "$(stat_of edit_to_full_frame_seconds_max "$f")" \
             "$(ph hold "$f")" "$(ph update "$f")" "$(ph session "$f")" "$(ph specular "$f")" "$(ph shadows "$f")" \
             "$(stat_of edit_shadow_faces_mean "$f")" "$(ph draw "$f")" "$(ph show "$f")" "$(ph other "$f")"
     done

@@ -6,8 +6,10 @@
 # scene's mirror sphere lies in the point light's -y face alone), all of a
 # moved light's, none for a power change. A script screenshot ending in .pfm
 # is the picture's linear radiance: after wait done, the same bytes as
-# --hdr's at the end. The window refuses .pfm screenshots (file:line, exit
-# 2), and scripts/bench-window.sh an unknown section.
+# --hdr's at the end. An edit's first picture is the level of detail when
+# the maps are large for the view, the full view after it. The window
+# refuses .pfm screenshots (file:line, exit 2), and scripts/bench-window.sh
+# an unknown section.
 set -u
 cd "$(dirname "$0")/.."
 bin=${1:-bin}
@@ -48,6 +50,30 @@ faces() {
 faces "mirror moved" 1 "move object 6  0.1 0 0" "move object 6  -0.1 0 0"
 faces "light moved" 6 "move light 0  0.3 1.9 0" "move light 0  0 1.9 0"
 faces "power" 0 "power light 0  50 50 50" "power light 0  100 100 100"
+
+# full NAME SIZE PHOTONS LOD: float layers, two mirror moves after the maps
+# are full; an edit's first picture is the level of detail when the maps hold
+# more photons than PS_SESSION_EDIT_SPLATS_WHOLE at 256^2 in proportion to the
+# view's pixels (6.5*10^4 at 512^2), and the full view comes later; else the
+# first picture is the full view.
+full() {
+    local name=$1 size=$2 photons=$3 lod=$4
+    printf '%s
+' "0 wait done" "0 move object 6  0.1 0 0" "0.3 move object 6  -0.1 0 0" "0.6 quit" >"$cli_tmp/$name.txt"
+    if ! "$snap" "$scene" --script "$cli_tmp/$name.txt" --caustic-photons "$photons" \
+        --global-photons $((photons / 4)) --size "$size" --tau 0.02 --color-depth float --stats "$cli_tmp/$name.json" \
+        >"$cli_tmp/out" 2>"$cli_tmp/err"; then
+        bad "$name: snap failed: $(head -3 "$cli_tmp/err")"
+        return
+    fi
+    local f=$cli_tmp/$name.json
+    if awk -v t="$(stat_of edit_to_frame_seconds_mean "$f")" -v u="$(stat_of edit_to_full_frame_seconds_mean "$f")" \
+        -v lod="$lod" 'BEGIN { exit !(t > 0 && (lod ? u > t : u == t)) }'; then ok; else
+        bad "$name: the full view after an edit: $(grep edit_to "$f" | tr -d '\n ')"
+    fi
+}
+full "level of detail" 512x512 80000 1
+full "whole first picture" 48x48 20000 0
 
 # A .pfm screenshot after wait done: the picture's radiance, as --hdr writes
 # the last picture (the same photons, every cube face drawn).

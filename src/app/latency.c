@@ -30,10 +30,13 @@ void ps_latency_add_faces(ps_latency *l, unsigned faces)
         l->shadow_faces_cur += faces;
 }
 
-void ps_latency_commit(ps_latency *l, double now)
+void ps_latency_commit(ps_latency *l, double now, bool lod)
 {
     if (!(l->start > 0.0))
         return;
+    l->full_start = l->start;
+    if (!lod)
+        ps_latency_full(l, now);
     double total = now - l->start, known = 0.0;
     for (int p = 0; p < PS_LAT_COUNT; p++)
         if (p != PS_LAT_OTHER)
@@ -49,6 +52,18 @@ void ps_latency_commit(ps_latency *l, double now)
     l->start = 0.0;
 }
 
+void ps_latency_full(ps_latency *l, double now)
+{
+    if (!(l->full_start > 0.0))
+        return;
+    double total = now - l->full_start;
+    l->full_sum += total;
+    if (total > l->full_max)
+        l->full_max = total;
+    l->full_count++;
+    l->full_start = 0.0;
+}
+
 void ps_latency_stats(const ps_latency *l, ps_run_stats *rs)
 {
     double n = l->count ? (double)l->count : 1.0;
@@ -62,4 +77,6 @@ void ps_latency_stats(const ps_latency *l, ps_run_stats *rs)
     for (int p = 0; p < PS_LAT_COUNT; p++)
         ps_stats_add(rs, keys[p], l->sum[p] / n);
     ps_stats_add(rs, "edit_shadow_faces_mean", l->shadow_faces_sum / n);
+    ps_stats_add(rs, "edit_to_full_frame_seconds_max", l->full_max);
+    ps_stats_add(rs, "edit_to_full_frame_seconds_mean", l->full_sum / (l->full_count ? (double)l->full_count : 1.0));
 }

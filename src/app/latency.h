@@ -34,6 +34,11 @@ typedef struct ps_latency {
     unsigned shadow_faces_sum;   /* shadow-cube faces rendered in the edits' first refreshes */
     unsigned shadow_faces_cur;
     uint64_t count;
+    /* The full view after an edit whose first picture was the level of
+     * detail (ps_session_frame.edit_lod): from the same clock start. */
+    double full_start;           /* the pending full view's clock start, 0: none pending */
+    double full_sum, full_max;
+    uint64_t full_count;
 } ps_latency;
 
 /* The clock starts at `now` unless an edit is already pending. */
@@ -43,10 +48,15 @@ bool ps_latency_pending(const ps_latency *l);
 void ps_latency_add(ps_latency *l, ps_lat_phase p, double seconds);
 void ps_latency_add_faces(ps_latency *l, unsigned faces);
 /* The pending edit's first refresh is done at `now`: its total and phases
- * join the sums (the rest of the total goes to PS_LAT_OTHER). */
-void ps_latency_commit(ps_latency *l, double now);
+ * join the sums (the rest of the total goes to PS_LAT_OTHER). lod: it was
+ * the level of detail, the full view is still to come (ps_latency_full). */
+void ps_latency_commit(ps_latency *l, double now, bool lod);
+/* A refresh at full detail done at `now`: the end of the last edit's wait
+ * for its full view, if it is pending (an edit whose first picture was full
+ * counts that picture). */
+void ps_latency_full(ps_latency *l, double now);
 /* edit_to_frame_seconds_mean/_max and edit_<phase>_seconds_mean,
- * edit_shadow_faces_mean. */
+ * edit_shadow_faces_mean; edit_to_full_frame_seconds_mean/_max. */
 void ps_latency_stats(const ps_latency *l, ps_run_stats *rs);
 const char *ps_lat_phase_name(ps_lat_phase p);
 

@@ -235,7 +235,9 @@ static ps_status refresh(snap_run *s, ps_error *err)
     ps_latency_add_faces(&s->lat, gst.shadow_faces_last);
     ps_latency_add(&s->lat, PS_LAT_DRAW, t1 - t_draw - gst.shadow_seconds_last);
     if (s->awaiting_edit)
-        ps_latency_commit(&s->lat, t1);
+        ps_latency_commit(&s->lat, t1, s->frame.edit_lod);
+    else if (!s->frame.moving)
+        ps_latency_full(&s->lat, t1);
     s->awaiting_edit = false;
     s->splats += s->frame.splats;
     s->draw_seconds += spent;

@@ -521,7 +521,9 @@ static ps_status refresh(app *a, ps_error *err)
         a->t_first_frame = t1;
         a->first_frame_seconds = t1 - a->start_time;
     } else if (a->awaiting_edit_frame) {
-        ps_latency_commit(&a->lat, t1);
+        ps_latency_commit(&a->lat, t1, a->frame.edit_lod);
+    } else if (!a->frame.moving) {
+        ps_latency_full(&a->lat, t1);
     }
     a->awaiting_edit_frame = false;
     if (a->frame.moving && !a->frame.edit_lod) {
