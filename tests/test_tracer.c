@@ -103,6 +103,49 @@ static void photons_per_light(void **state)
     rig_free(&r);
 }
 
+/* The rank table a trace finds photon i's stratum and rank in (made in jobs
+ * of 2048 granules of 256 indices, on every core) against a count from
+ * index 0 (the photon sources' running ranks): 1.5*10^6 indices, three
+ * jobs, three strata, for one thread and two. */
+static void ranks_from_the_table(void **state)
+{
+    (void)state;
+    char text[2048];
+    box_scene(text, sizeof text, 0.5);
+    const uint64_t total = 1500000;
+    for (int threads = 1; threads <= 2; threads++) {
+        ps_tracer_options o = options(threads);
+        rig r = rig_make(text, "", &o, PS_ACCEL_AUTO);
+        ps_photon_source *src = malloc(total * sizeof *src);
+        assert_non_null(src);
+        bool resampled[3] = {false, false, false};
+        ps_error err;
+        assert_int_equal(ps_tracer_photon_sources(r.tracer, r.tracer, PS_MAP_GLOBAL, total, total, resampled, 3, src,
+                                                  &err),
+                         PS_OK);
+        uint64_t checked = 0;
+        /* Every index near the jobs' seams (2048 * 256 = 524288 apart), a
+         * sample elsewhere. */
+        for (uint64_t i = 0; i < total; i += ((i + 2000) % 524288 < 4000 ? 1 : 97)) {
+            uint32_t stratum;
+            uint64_t rank;
+            assert_true(ps_tracer_photon_rank(r.tracer, PS_MAP_GLOBAL, i, total, &stratum, &rank));
+            if (stratum != src[i].stratum || rank != src[i].rank)
+                fail_msg("photon %llu: stratum %u rank %llu from the table, %u %llu counted",
+                         (unsigned long long)i, stratum, (unsigned long long)rank, src[i].stratum,
+                         (unsigned long long)src[i].rank);
+            assert_int_equal(src[i].from, i); /* the same plan: every photon its own */
+            checked++;
+        }
+        assert_true(checked > 20000);
+        uint32_t stratum;
+        uint64_t rank;
+        assert_false(ps_tracer_photon_rank(r.tracer, PS_MAP_GLOBAL, total, total, &stratum, &rank));
+        free(src);
+        rig_free(&r);
+    }
+}
+
 /* A mirror quad above a point light and a wide floor: the caustic is the
  * light of the mirror image of the source (at y = 3), seen through the mirror. */
 static const char mirror_scene[] =
@@ -555,7 +598,8 @@ static void traced_range_and_join(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(furnace_box),    cmocka_unit_test(photons_per_light), cmocka_unit_test(mirror_caustic),
+        cmocka_unit_test(furnace_box),    cmocka_unit_test(photons_per_light), cmocka_unit_test(ranks_from_the_table),
+        cmocka_unit_test(mirror_caustic),
         cmocka_unit_test(overlapping_cones), cmocka_unit_test(no_leaks),      cmocka_unit_test(determinism),
         cmocka_unit_test(scale_invariance), cmocka_unit_test(skips),
         cmocka_unit_test(photon_materials), cmocka_unit_test(cancel_and_cap), cmocka_unit_test(traced_range_and_join),

@@ -759,8 +759,9 @@ static ps_status run_script(snap_run *s, double t_start, double *first_frame, ps
             double at = t0 + delay + ps_script_at(o->script, next)->time;
             due = fmin(due, fmax(at, now));
         }
-        /* An edit: its update and first refresh at once, as the window's. */
-        if ((ps_session_settled(s->session) && waiting) || ps_session_edited(s->session))
+        /* An edit: its update and first refresh at once, as the window's,
+         * and after its level of detail the full view. */
+        if ((ps_session_settled(s->session) && waiting) || ps_session_edited(s->session) || s->frame.edit_lod)
             due = now;
         sleep_until(due);
     }

@@ -1131,7 +1131,8 @@ static ps_status session(app *a, ps_error *err)
             }
             if (st == PS_OK)
                 ps_platform_present(a->platform);
-            next = now + ps_session_get_settings(a->session)->tau;
+            /* An edit's level of detail shown: its full view at once. */
+            next = a->frame.edit_lod ? 0.0 : now + ps_session_get_settings(a->session)->tau;
         }
     }
     if (st == PS_OK && a->session)
