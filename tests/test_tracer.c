@@ -103,10 +103,10 @@ static void photons_per_light(void **state)
     rig_free(&r);
 }
 
-/* The rank table a trace finds photon i's stratum and rank in (made in jobs
- * of 2048 granules of 256 indices, on every core) against a count from
- * index 0 (the photon sources' running ranks): 1.5*10^6 indices, three
- * jobs, three strata, for one thread and two. */
+/* The rank tables (made in jobs of 2048 granules of 256 indices, on every
+ * core), which a trace finds photon i's rank in and the photon sources start
+ * their jobs from, against ranks counted here from index 0: 1.5*10^6
+ * indices, three jobs, three strata, for one thread and two. */
 static void ranks_from_the_table(void **state)
 {
     (void)state;
@@ -123,24 +123,32 @@ static void ranks_from_the_table(void **state)
         assert_int_equal(ps_tracer_photon_sources(r.tracer, r.tracer, PS_MAP_GLOBAL, total, total, resampled, 3, src,
                                                   &err),
                          PS_OK);
-        uint64_t checked = 0;
-        /* Every index near the jobs' seams (2048 * 256 = 524288 apart), a
-         * sample elsewhere. */
-        for (uint64_t i = 0; i < total; i += ((i + 2000) % 524288 < 4000 ? 1 : 97)) {
-            uint32_t stratum;
-            uint64_t rank;
-            assert_true(ps_tracer_photon_rank(r.tracer, PS_MAP_GLOBAL, i, total, &stratum, &rank));
-            if (stratum != src[i].stratum || rank != src[i].rank)
-                fail_msg("photon %llu: stratum %u rank %llu from the table, %u %llu counted",
-                         (unsigned long long)i, stratum, (unsigned long long)rank, src[i].stratum,
-                         (unsigned long long)src[i].rank);
-            assert_int_equal(src[i].from, i); /* the same plan: every photon its own */
-            checked++;
+        uint64_t counted[3] = {0, 0, 0}, checked = 0;
+        for (uint64_t i = 0; i < total; i++) {
+            uint32_t k = src[i].stratum;
+            assert_true(k < 3);
+            uint64_t rank = counted[k]++;
+            if (src[i].rank != rank || src[i].from != i) /* the same plan: every photon its own */
+                fail_msg("photon %llu: source rank %llu from %llu, counted %llu", (unsigned long long)i,
+                         (unsigned long long)src[i].rank, (unsigned long long)src[i].from, (unsigned long long)rank);
+            /* The trace's lookup: every index near the jobs' seams (524288
+             * apart), a sample elsewhere. */
+            if ((i + 2000) % 524288 < 4000 || i % 97 == 0) {
+                uint32_t kt;
+                uint64_t rt;
+                assert_true(ps_tracer_photon_rank(r.tracer, PS_MAP_GLOBAL, i, total, &kt, &rt));
+                if (kt != k || rt != rank)
+                    fail_msg("photon %llu: stratum %u rank %llu from the table, %u %llu counted", (unsigned long long)i,
+                             kt, (unsigned long long)rt, k, (unsigned long long)rank);
+                checked++;
+            }
         }
         assert_true(checked > 20000);
-        uint32_t stratum;
-        uint64_t rank;
-        assert_false(ps_tracer_photon_rank(r.tracer, PS_MAP_GLOBAL, total, total, &stratum, &rank));
+        for (int k = 0; k < 3; k++) /* all three strata, each far past a job */
+            assert_true(counted[k] > 200000);
+        uint32_t kt;
+        uint64_t rt;
+        assert_false(ps_tracer_photon_rank(r.tracer, PS_MAP_GLOBAL, total, total, &kt, &rt));
         free(src);
         rig_free(&r);
     }

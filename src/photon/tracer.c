@@ -950,6 +950,58 @@ static bool same_sampling(const stratum *sa, const stratum *sb)
     return !sa->has_caustic_cone || memcmp(&sa->caustic_cone, &sb->caustic_cone, sizeof sa->caustic_cone) == 0;
 }
 
+/* Photon i's stratum: the kept sequence's, else found again. */
+static size_t stratum_at(const map_plan *p, uint64_t i) { return p->seq ? (size_t)p->seq[i] : stratum_of(p, i); }
+
+/* Indices a job of the photon sources covers: whole granules, so that it
+ * starts from a row of the rank tables (count_strata) as a pass from index
+ * 0 would reach it. */
+#define SOURCE_JOB_INDICES ((uint64_t)2048 * RANK_GRANULE)
+
+typedef struct source_job {
+    const map_plan *pa, *pb;
+    uint64_t end;
+    const size_t *match;  /* b's stratum kb is a's match[kb] (SIZE_MAX: none) */
+    const bool *repower;  /* ... with another power or count */
+    const uint64_t *start;/* a's photons below end: stratum ka's from start[ka] in byrank */
+    uint64_t *byrank;     /* a's indices below end by stratum, then rank */
+    ps_photon_source *out;
+    uint64_t *scratch;    /* a counter per stratum per job */
+    size_t width;
+    bool fill;            /* the pass: byrank (true), out (false) */
+} source_job;
+
+static void source_range(void *arg, size_t job)
+{
+    const source_job *c = arg;
+    uint64_t from = (uint64_t)job * SOURCE_JOB_INDICES;
+    uint64_t to = from + SOURCE_JOB_INDICES < c->end ? from + SOURCE_JOB_INDICES : c->end;
+    size_t g = (size_t)(from / RANK_GRANULE);
+    uint64_t *count = c->scratch + job * c->width;
+    if (c->fill) {
+        const map_plan *pa = c->pa;
+        memcpy(count, pa->prefix + g * pa->count, pa->count * sizeof *count);
+        for (uint64_t i = from; i < to; i++) {
+            size_t ka = stratum_at(pa, i);
+            c->byrank[c->start[ka] + count[ka]++] = i;
+        }
+        return;
+    }
+    const map_plan *pb = c->pb;
+    memcpy(count, pb->prefix + g * pb->count, pb->count * sizeof *count);
+    for (uint64_t i = from; i < to; i++) {
+        size_t kb = stratum_at(pb, i);
+        uint64_t j = count[kb]++;
+        ps_photon_source o = {PS_SOURCE_NONE, j, (uint32_t)kb, false};
+        size_t ka = c->match[kb];
+        if (ka != SIZE_MAX && j < c->start[ka + 1] - c->start[ka]) {
+            o.from = c->byrank[c->start[ka] + j];
+            o.repower = c->repower[kb];
+        }
+        c->out[i] = o;
+    }
+}
+
 ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total, uint64_t end,
                                    const bool *resampled, size_t light_count, ps_photon_source *out,
                                    ps_error *err)
@@ -964,13 +1016,16 @@ ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind,
     if (!count_strata(pb, total, b->opt.records) || (pa->enabled && !count_strata(pa, total, a->opt.records)))
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning %llu photons", path,
                             (unsigned long long)total);
-    /* b's stratum kb is a's match[kb] when both sample the same way. */
+    size_t na = pa->enabled ? pa->count : 0;
+    size_t width = pb->count > na ? pb->count : na;
+    size_t jobs = (size_t)((end + SOURCE_JOB_INDICES - 1) / SOURCE_JOB_INDICES);
     size_t *match = malloc(pb->count * sizeof *match);
-    uint64_t *start = pa->enabled ? calloc(pa->count + 1, sizeof *start) : NULL;
-    uint64_t *byrank = pa->enabled ? malloc((end ? end : 1) * sizeof *byrank) : NULL;
-    uint64_t *rank = calloc(pb->count + (pa->enabled ? pa->count : 0), sizeof *rank);
-    if (!match || !rank || (pa->enabled && (!start || !byrank))) {
-        free(match), free(start), free(byrank), free(rank);
+    bool *repower = calloc(pb->count, sizeof *repower);
+    uint64_t *start = calloc(na + 1, sizeof *start);
+    uint64_t *byrank = malloc((pa->enabled && end ? end : 1) * sizeof *byrank);
+    uint64_t *scratch = malloc((jobs ? jobs : 1) * width * sizeof *scratch);
+    if (!match || !repower || !start || !byrank || !scratch) {
+        free(match), free(repower), free(start), free(byrank), free(scratch);
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory matching %llu photons", path,
                             (unsigned long long)end);
     }
@@ -982,38 +1037,29 @@ ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind,
         for (size_t ka = 0; ka < pa->count; ka++)
             if (same_sampling(&pa->strata[ka], sb))
                 match[kb] = ka;
-    }
-    /* end <= total: the kept sequences cover it. */
-#define STRATUM(p, i) ((p)->seq ? (size_t)(p)->seq[i] : stratum_of(p, i))
-    if (pa->enabled) {
-        /* a's indices below end, by stratum and rank. */
-        for (uint64_t i = 0; i < end; i++)
-            start[STRATUM(pa, i) + 1]++;
-        for (size_t ka = 0; ka < pa->count; ka++)
-            start[ka + 1] += start[ka];
-        uint64_t *fill = rank + pb->count;
-        for (uint64_t i = 0; i < end; i++) {
-            size_t ka = STRATUM(pa, i);
-            byrank[start[ka] + fill[ka]++] = i;
-        }
-    }
-    /* Every field of out written once (a second pass over 24 bytes an index
-     * was a third of an update's time at 10^6 photons). */
-    for (uint64_t i = 0; i < end; i++) {
-        size_t kb = STRATUM(pb, i);
-        uint64_t j = rank[kb]++;
-        out[i] = (ps_photon_source){PS_SOURCE_NONE, j, (uint32_t)kb, false};
+        /* The same light power and count: the stored bytes are already those
+         * of b's trace (the same T, dither and product). */
         size_t ka = match[kb];
-        if (ka != SIZE_MAX && j < start[ka + 1] - start[ka]) {
-            out[i].from = byrank[start[ka] + j];
-            /* The same light power and count: the stored bytes are already
-             * those of b's trace (the same T, dither and product). */
-            out[i].repower = memcmp(&pa->strata[ka].power, &pb->strata[kb].power, sizeof(ps_rgb)) != 0 ||
-                             memcmp(&pa->scale[ka], &pb->scale[kb], sizeof(double)) != 0;
-        }
+        repower[kb] = ka != SIZE_MAX && (memcmp(&pa->strata[ka].power, &sb->power, sizeof(ps_rgb)) != 0 ||
+                                         memcmp(&pa->scale[ka], &pb->scale[kb], sizeof(double)) != 0);
     }
-#undef STRATUM
-    free(match), free(start), free(byrank), free(rank);
+    /* end <= total: the kept sequences and rank tables cover it. Both
+     * passes in jobs on every core (an edit's update waits for them). */
+    source_job c = {pa, pb, end, match, repower, start, byrank, out, scratch, width, true};
+    if (pa->enabled) {
+        /* a's photons below end, per stratum: the table's row, then the rest. */
+        size_t g = (size_t)(end / RANK_GRANULE);
+        for (size_t ka = 0; ka < na; ka++)
+            start[ka + 1] = pa->prefix[g * pa->count + ka];
+        for (uint64_t i = (uint64_t)g * RANK_GRANULE; i < end; i++)
+            start[stratum_at(pa, i) + 1]++;
+        for (size_t ka = 0; ka < na; ka++)
+            start[ka + 1] += start[ka];
+        ps_run_jobs(jobs, ps_online_cores(), source_range, &c);
+    }
+    c.fill = false;
+    ps_run_jobs(jobs, ps_online_cores(), source_range, &c);
+    free(match), free(repower), free(start), free(byrank), free(scratch);
     return PS_OK;
 }
 
