@@ -334,6 +334,40 @@ static void deadline_holds_faces(void **state)
     rig_free(&r);
 }
 
+/* A settled round renders every face of every cube once and stops with
+ * whole cubes: when a refresh that draws them all (faces 0: snap's whole
+ * refreshes) came after one that had drawn three, it drew twelve more, and
+ * the last three began a cube again, which then never became whole (the
+ * window's wait done hung so, its refreshes split by a deadline). Two
+ * cubes: twelve faces, however the refreshes split them. */
+static void a_settled_round_ends_whole(void **state)
+{
+    (void)state;
+    rig r;
+    rig_make(&r, load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
+                           "material mirror mirror reflectance 1 1 1\n"
+                           "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0\n"
+                           "sphere center -0.4 0.5 -0.5 radius 0.3 material mirror\n"
+                           "sphere center 0.4 0.5 -0.5 radius 0.3 material mirror\n"
+                           "light point position 0 1.2 0.3 power 50 50 50\n"),
+             64, 64);
+    ps_error err;
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 1, &err), PS_OK); /* a new view: none */
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
+    /* Settled: a quarter of the round a refresh. */
+    assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 1, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 3);
+    for (int i = 0; i < 4; i++) {
+        assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 0, &err), PS_OK);
+    }
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 12);
+    rig_free(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -342,6 +376,7 @@ int main(void)
         cmocka_unit_test(furnace_glass_sphere),
         cmocka_unit_test(default_scene_against_reference),
         cmocka_unit_test(deadline_holds_faces),
+        cmocka_unit_test(a_settled_round_ends_whole),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

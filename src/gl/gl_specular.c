@@ -164,6 +164,15 @@ static void ensure_cubes(ps_gl_specular *g, int n)
     free(black);
 }
 
+/* Whether a back map holds some faces of a round but not all six. */
+static bool any_partial(const ps_gl_specular *g)
+{
+    for (int c = 0; c < g->cube_count; c++)
+        if (g->back_faces[c] != 0)
+            return true;
+    return false;
+}
+
 /* Cube c's back map has all six faces from one centre: shown from now on,
  * its lookups and per-pixel points looking from that centre (re-aimed at
  * once when it moved, so that this refresh's layer is drawn with lookups
@@ -308,7 +317,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
             memset(g->back_faces, 0, sizeof g->back_faces);
         g->since_settled = 0;
     }
-    if (settled && g->since_settled >= total && g->since_change >= total)
+    if (settled && g->since_settled >= total && g->since_change >= total && !any_partial(g))
         return PS_OK;
     /* Settled but not yet drawn from the last photons: the round is finished
      * over the next PS_GL_SPECULAR_SETTLE_REFRESHES refreshes whatever the
@@ -364,6 +373,11 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     }
     int drawn = 0;
     for (int i = 0; i < n && st == PS_OK; i++) {
+        /* The settled round ends with its whole cubes: a face past it would
+         * leave a back map begun, and the layer never done (a window's wait
+         * done hung so under ASan's timing). */
+        if (settled && g->since_settled + drawn >= total && g->since_change + drawn >= total && !any_partial(g))
+            break;
         int c = g->cursor / 6;
         double tf = ps_now_seconds();
         if (timed && i > 0 && !ps_gl_specular_face_fits(tf, g->deadline, face_estimate(g)))
@@ -385,7 +399,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     n = drawn;
     if (faces <= 0 && ps_gl_glossy_blur(g->glossy, 0)) /* all at once: the levels too */
         g->cubes_changed = true;
-    if (faces > 0) {
+    if (faces > 0 && n > 0) {
         glFinish(); /* llvmpipe draws when flushed: the face's own time */
         g->face_seconds = (ps_now_seconds() - t0) / n;
     }
