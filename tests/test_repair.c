@@ -435,13 +435,22 @@ static void shown_equals_fresh(ps_session *s, const ps_scene *scene)
  * a quarter of a second after an edit); now the merge waits until every
  * photon is drawn, so only the edit's own refresh starts a view, and the
  * maps shown at the end are a fresh trace's. */
+/* The shown session whose repairs are left to the thread (retrace_first 0,
+ * edit_splats_whole 0), its first picture settled. */
+static ps_session *open_background(ps_scene **scene, ps_camera_frame *cam)
+{
+    *scene = load();
+    ps_session *s = open_shown_whole(*scene, 0, 0, cam);
+    assert_int_equal(refresh_until_settled(s, cam, false), 0);
+    return s;
+}
+
 static void a_background_repair_keeps_the_view(void **state)
 {
     (void)state;
-    ps_scene *scene = load();
+    ps_scene *scene;
     ps_camera_frame cam;
-    ps_session *s = open_shown_whole(scene, 0, 0, &cam);
-    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
+    ps_session *s = open_background(&scene, &cam);
     for (int e = 0; e < 3; e++) {
         apply(s, e == 0 ? MOVE_MIRROR : e == 1 ? MOVE_SPOT : MOVE_FLOOR, e);
         update_repaired(s);
@@ -472,10 +481,9 @@ static void a_background_repair_keeps_the_view(void **state)
 static void edits_mid_background_repair(void **state)
 {
     (void)state;
-    ps_scene *scene = load();
+    ps_scene *scene;
     ps_camera_frame cam;
-    ps_session *s = open_shown_whole(scene, 0, 0, &cam);
-    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
+    ps_session *s = open_background(&scene, &cam);
     ps_error err;
     for (int e = 0; e < EDIT_KINDS; e++) {
         apply(s, (edit_kind)e, e);
