@@ -1023,6 +1023,12 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
             for (int k = 0; k < PS_MAP_COUNT; k++)
                 all_maps_have = all_maps_have && (ps_feed_maps(f)[k].count > 0 || rc.retraced[k] == 0);
             ps_feed_unlock(f);
+            /* The priming round retraces only once no map has paths left to
+             * test (feed.c's rounds): the other map's repair whole first. */
+            if (!all_maps_have && st == PS_OK) {
+                const size_t all[PS_MAP_COUNT] = {SIZE_MAX, SIZE_MAX};
+                st = ps_feed_repair_ahead(f, all, err);
+            }
             s->skip_prime = all_maps_have;
             forget_drawn(s);
         }
