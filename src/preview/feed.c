@@ -241,12 +241,12 @@ static uint64_t round_end(const ps_feed *f, int k, uint64_t r, uint64_t prev_end
     return until <= prev_end ? prev_end + 1 : until;
 }
 
-/* One round: each active map up to its share of the next PS_FEED_BATCH
- * photons of the largest cap, so that all maps finish together. False when
- * every map has reached its cap (or on an error, in *st). */
 static bool repair_left(const ps_feed *f);
 static ps_status repair_step(ps_feed *f, int k, uint64_t until, ps_error *err);
 
+/* One round: each active map up to its share of the next PS_FEED_BATCH
+ * photons of the largest cap, so that all maps finish together. False when
+ * every map has reached its cap (or on an error, in *st). */
 static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
 {
     /* A repair first tests and copies what the first picture did not need. */
@@ -676,7 +676,6 @@ typedef struct keep_job {
     uint8_t *kept;
 } keep_job;
 
-
 static void keep_range(void *arg, size_t job)
 {
     const keep_job *j = arg;
@@ -691,7 +690,6 @@ static void keep_range(void *arg, size_t job)
         j->kept[i] = keep;
     }
 }
-
 
 static void repair_work_free(repair_work *w)
 {
@@ -919,8 +917,6 @@ ps_status ps_feed_repair_ahead(ps_feed *f, const size_t min_photons[PS_MAP_COUNT
     f->seconds += ps_now_seconds() - t0;
     return st;
 }
-
-bool ps_feed_repair_done(const ps_feed *f) { return !repair_left(f); }
 
 ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair_fns *fns, ps_feed **out,
                                 ps_error *err)

@@ -128,11 +128,9 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair
  * at a time, until the map holds at least min_photons[k] photons or its
  * repair is done (SIZE_MAX: done). */
 ps_status ps_feed_repair_ahead(ps_feed *f, const size_t min_photons[PS_MAP_COUNT], ps_error *err);
-/* Whether every index of the repair that made f is tested and copied (not
- * under the lock: before start, or after the feed ended). */
-bool ps_feed_repair_done(const ps_feed *f);
 /* What the repair that made f did, per map: photon indices kept and to
- * retrace, and the stored photons kept (zeros until ps_feed_repair_done). */
+ * retrace, and the stored photons kept (zeros until every index is tested
+ * and copied). */
 typedef struct ps_feed_repair_count {
     uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
     uint64_t kept_photons[PS_MAP_COUNT];
