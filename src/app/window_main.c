@@ -292,6 +292,8 @@ static ps_status open_session(app *a, ps_error *err)
     }
     if (st == PS_OK)
         st = ps_gl_layers_create(a->width, a->height, set.float_buffer, &a->layers, err);
+    if (st == PS_OK && a->o.composite)
+        ps_gl_layers_warm_up(a->layers);
     if (st == PS_OK)
         st = ps_gl_specular_create(0, &a->spec, err);
     /* The first batch is traced here, and the thread starts held until the

@@ -144,6 +144,10 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
  * (image.h, ps_tonemap_8bit) but for the GL's own rounding (llvmpipe: up to
  * two codes apart, docs/preview.md). */
 void ps_gl_layers_show(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT]);
+/* Before the first show: the scaled show (a moving camera's or an edit's
+ * level of detail) drawn once into the back buffer, so that its first real
+ * use costs its own time only. */
+void ps_gl_layers_warm_up(ps_gl_layers *l);
 /* The same picture the way the window showed it before the composite moved
  * to GL: read back as floats, encoded on the CPU (ps_tonemap_8bit) and drawn
  * with glDrawPixels. Kept as the baseline scripts/bench-window.sh measures
