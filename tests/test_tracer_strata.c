@@ -175,11 +175,95 @@ static void ranks_are_in_index_order(void **state)
     rig_free(&a);
 }
 
+static void same_source(const ps_photon_source *x, const ps_photon_source *y, uint64_t i)
+{
+    if (x->from != y->from || x->rank != y->rank || x->stratum != y->stratum || x->repower != y->repower)
+        fail_msg("photon %llu: from %llu rank %llu stratum %u repower %d against %llu %llu %u %d",
+                 (unsigned long long)i, (unsigned long long)x->from, (unsigned long long)x->rank, x->stratum,
+                 x->repower, (unsigned long long)y->from, (unsigned long long)y->rank, y->stratum, y->repower);
+}
+
+/* sources in ranges that start and end anywhere (not on the rank table's
+ * rows) against the whole at once */
+static void fill_in_parts(ps_source_map *m, const ps_photon_source *whole, uint64_t n)
+{
+    const uint64_t cuts[] = {0, 1, 255, 256, 257, 1000, 4097, n - 1, n};
+    ps_photon_source *part = malloc(n * sizeof *part);
+    for (size_t c = 0; c + 1 < sizeof cuts / sizeof *cuts; c++) {
+        ps_source_map_fill(m, cuts[c], cuts[c + 1], part);
+        for (uint64_t i = cuts[c]; i < cuts[c + 1]; i++)
+            same_source(&part[i - cuts[c]], &whole[i], i);
+    }
+    free(part);
+}
+
+/* The sources a repair finds a step at a time (ps_source_map) are the
+ * whole table's in any ranges; an edit that keeps the shares (the same
+ * scene on a new tracer) names every photon itself (identity: the repair
+ * keeps them in place) with b's rank table copied from a's, and b then
+ * traces a's photons byte for byte; an edit that changes the shares does
+ * not; one that resamples every light keeps nothing (none: a restart). */
+static void sources_in_parts(void **state)
+{
+    (void)state;
+    char ta[2048], tb[2048];
+    ps_tracer_options o = ps_tracer_default_options();
+    o.seed = 5;
+    o.threads = 2;
+    o.records = true;
+    rig a = rig_make(scene_text(ta, sizeof ta, "60 50 40"), "", &o, PS_ACCEL_AUTO);
+    rig b = rig_make(scene_text(tb, sizeof tb, "120 100 80"), "", &o, PS_ACCEL_AUTO);
+    rig same = rig_make(scene_text(tb, sizeof tb, "60 50 40"), "", &o, PS_ACCEL_AUTO);
+    const uint64_t n = N_CAUSTIC;
+    bool resampled[2] = {false, false};
+    ps_photon_source *whole = malloc(n * sizeof *whole);
+    ps_error err;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        /* the shares changed: not in place, some kept */
+        ps_source_map *m;
+        assert_int_equal(ps_tracer_photon_sources(a.tracer, b.tracer, k, n, n, resampled, 2, whole, &err), PS_OK);
+        assert_int_equal(ps_source_map_create(a.tracer, b.tracer, k, n, n, resampled, 2, &m, &err), PS_OK);
+        assert_false(ps_source_map_identity(m));
+        assert_false(ps_source_map_none(m));
+        fill_in_parts(m, whole, n);
+        ps_source_map_destroy(m);
+        /* every light resampled: nothing kept */
+        bool all[2] = {true, true};
+        assert_int_equal(ps_source_map_create(a.tracer, b.tracer, k, n, n, all, 2, &m, &err), PS_OK);
+        assert_true(ps_source_map_none(m));
+        ps_source_map_fill(m, 0, n, whole);
+        for (uint64_t i = 0; i < n; i++)
+            assert_true(whole[i].from == PS_SOURCE_NONE);
+        ps_source_map_destroy(m);
+    }
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        /* the same shares, b not yet counted: copied from a */
+        ps_source_map *m;
+        assert_int_equal(ps_source_map_create(a.tracer, same.tracer, k, n, n, resampled, 2, &m, &err), PS_OK);
+        assert_true(ps_source_map_identity(m));
+        assert_false(ps_source_map_none(m));
+        /* the table of a tracer with itself, counted from index 0 */
+        assert_int_equal(ps_tracer_photon_sources(a.tracer, a.tracer, k, n, n, resampled, 2, whole, &err), PS_OK);
+        fill_in_parts(m, whole, n);
+        ps_source_map_destroy(m);
+        traced x = trace(&a, k, n), y = trace(&same, k, n);
+        assert_int_equal(x.map.count, y.map.count);
+        assert_memory_equal(x.map.photons, y.map.photons, x.map.count * sizeof *x.map.photons);
+        traced_free(&x);
+        traced_free(&y);
+    }
+    free(whole);
+    rig_free(&a);
+    rig_free(&b);
+    rig_free(&same);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(paths_survive_a_share_change),
         cmocka_unit_test(ranks_are_in_index_order),
+        cmocka_unit_test(sources_in_parts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

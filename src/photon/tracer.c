@@ -953,52 +953,238 @@ static bool same_sampling(const stratum *sa, const stratum *sb)
 /* Photon i's stratum: the kept sequence's, else found again. */
 static size_t stratum_at(const map_plan *p, uint64_t i) { return p->seq ? (size_t)p->seq[i] : stratum_of(p, i); }
 
-/* Indices a job of the photon sources covers: whole granules, so that it
- * starts from a row of the rank tables (count_strata) as a pass from index
- * 0 would reach it. */
+/* Indices a job of the photon sources' first pass covers: whole granules,
+ * so that it starts from a row of the rank tables (count_strata) as a pass
+ * from index 0 would reach it. */
 #define SOURCE_JOB_INDICES ((uint64_t)2048 * RANK_GRANULE)
+/* Indices a job of ps_source_map_fill covers, and the jobs one call of it
+ * runs at most (its counters are made once, with the map). */
+#define FILL_JOB_INDICES ((uint64_t)128 * RANK_GRANULE)
+#define FILL_JOBS 16
+
+/* Whether two plans cut the index line into the same strata: the same
+ * stratum at every index (stratum_of reads only these). */
+static bool same_cuts(const map_plan *pa, const map_plan *pb)
+{
+    if (pa->count != pb->count || memcmp(&pa->rotation0, &pb->rotation0, sizeof pa->rotation0) != 0)
+        return false;
+    for (size_t k = 0; k < pa->count; k++)
+        if (memcmp(&pa->strata[k].cdf, &pb->strata[k].cdf, sizeof(double)) != 0)
+            return false;
+    return true;
+}
+
+/* b's counts, rank table and sequence copied from a's (counted for total,
+ * with the same cuts): what count_strata would find, without the pass over
+ * every index (an edit that keeps the shares: a power edit of a lone light,
+ * a diffuse object moved). False when out of memory or a has no sequence b
+ * needs. */
+static bool copy_counts(map_plan *pb, const map_plan *pa, uint64_t total, bool keep_seq)
+{
+    if (keep_seq && !pa->seq)
+        return false;
+    uint64_t *prefix = realloc(pb->prefix, pa->granules * pa->count * sizeof *prefix);
+    if (!prefix)
+        return false;
+    pb->prefix = prefix;
+    memcpy(prefix, pa->prefix, pa->granules * pa->count * sizeof *prefix);
+    pb->granules = pa->granules;
+    free(pb->seq);
+    pb->seq = NULL;
+    if (keep_seq) {
+        pb->seq = malloc(total ? (size_t)total : 1);
+        if (!pb->seq)
+            return false;
+        memcpy(pb->seq, pa->seq, (size_t)total);
+    }
+    memcpy(pb->counts, pa->counts, pa->count * sizeof *pb->counts);
+    for (size_t k = 0; k < pb->count; k++)
+        pb->scale[k] = pb->counts[k] ? 1.0 / (double)pb->counts[k] : 0.0;
+    pb->counted_total = total;
+    pb->counted = true;
+    return true;
+}
+
+struct ps_source_map {
+    const map_plan *pb; /* the edited scene's plan (its tracer outlives the map) */
+    uint64_t end;
+    bool b_enabled;
+    bool identity;      /* every source is its own index or none */
+    bool none;          /* no index has a source */
+    size_t *match;      /* b's stratum kb is a's match[kb] (SIZE_MAX: none) */
+    bool *repower;      /* ... with another power or count */
+    uint64_t *start;    /* a's photons below end: stratum ka's from start[ka] in byrank */
+    uint64_t *byrank;   /* a's indices below end by stratum, then rank (not for identity) */
+    uint64_t *scratch;  /* a counter per stratum per fill job */
+    size_t width;
+};
 
 typedef struct source_job {
-    const map_plan *pa, *pb;
-    uint64_t end;
-    const size_t *match;  /* b's stratum kb is a's match[kb] (SIZE_MAX: none) */
-    const bool *repower;  /* ... with another power or count */
-    const uint64_t *start;/* a's photons below end: stratum ka's from start[ka] in byrank */
-    uint64_t *byrank;     /* a's indices below end by stratum, then rank */
+    const map_plan *pa;
+    const ps_source_map *m;
+    uint64_t *scratch;
+    uint64_t from, to;  /* fill: the range; out[i - from] */
     ps_photon_source *out;
-    uint64_t *scratch;    /* a counter per stratum per job */
-    size_t width;
-    bool fill;            /* the pass: byrank (true), out (false) */
 } source_job;
 
-static void source_range(void *arg, size_t job)
+/* The first pass: a's indices below end by stratum and rank. */
+static void byrank_range(void *arg, size_t job)
 {
     const source_job *c = arg;
+    const map_plan *pa = c->pa;
+    const ps_source_map *m = c->m;
     uint64_t from = (uint64_t)job * SOURCE_JOB_INDICES;
-    uint64_t to = from + SOURCE_JOB_INDICES < c->end ? from + SOURCE_JOB_INDICES : c->end;
+    uint64_t to = from + SOURCE_JOB_INDICES < m->end ? from + SOURCE_JOB_INDICES : m->end;
     size_t g = (size_t)(from / RANK_GRANULE);
-    uint64_t *count = c->scratch + job * c->width;
-    if (c->fill) {
-        const map_plan *pa = c->pa;
-        memcpy(count, pa->prefix + g * pa->count, pa->count * sizeof *count);
-        for (uint64_t i = from; i < to; i++) {
-            size_t ka = stratum_at(pa, i);
-            c->byrank[c->start[ka] + count[ka]++] = i;
-        }
+    uint64_t *count = c->scratch + job * m->width;
+    memcpy(count, pa->prefix + g * pa->count, pa->count * sizeof *count);
+    for (uint64_t i = from; i < to; i++) {
+        size_t ka = stratum_at(pa, i);
+        m->byrank[m->start[ka] + count[ka]++] = i;
+    }
+}
+
+/* The sources of indices [from, to): ranks counted on from the table's row
+ * at or before `from`, so any range gives what a pass from index 0 gives. */
+static void fill_range(const ps_source_map *m, uint64_t from, uint64_t to, ps_photon_source *out,
+                       uint64_t *count)
+{
+    const map_plan *pb = m->pb;
+    if (!m->b_enabled) {
+        for (uint64_t i = from; i < to; i++)
+            out[i - from] = (ps_photon_source){PS_SOURCE_NONE, 0, UINT32_MAX, false};
         return;
     }
-    const map_plan *pb = c->pb;
+    size_t g = (size_t)(from / RANK_GRANULE);
     memcpy(count, pb->prefix + g * pb->count, pb->count * sizeof *count);
+    for (uint64_t i = (uint64_t)g * RANK_GRANULE; i < from; i++)
+        count[stratum_at(pb, i)]++;
     for (uint64_t i = from; i < to; i++) {
         size_t kb = stratum_at(pb, i);
         uint64_t j = count[kb]++;
         ps_photon_source o = {PS_SOURCE_NONE, j, (uint32_t)kb, false};
-        size_t ka = c->match[kb];
-        if (ka != SIZE_MAX && j < c->start[ka + 1] - c->start[ka]) {
-            o.from = c->byrank[c->start[ka] + j];
-            o.repower = c->repower[kb];
+        size_t ka = m->match[kb];
+        if (ka != SIZE_MAX && (m->identity || j < m->start[ka + 1] - m->start[ka])) {
+            /* The same cuts and stratum: a's j-th photon of it is index i. */
+            o.from = m->identity ? i : m->byrank[m->start[ka] + j];
+            o.repower = m->repower[kb];
         }
-        c->out[i] = o;
+        out[i - from] = o;
+    }
+}
+
+static void fill_job(void *arg, size_t job)
+{
+    const source_job *c = arg;
+    uint64_t from = c->from + (uint64_t)job * FILL_JOB_INDICES;
+    uint64_t to = from + FILL_JOB_INDICES < c->to ? from + FILL_JOB_INDICES : c->to;
+    fill_range(c->m, from, to, c->out + (from - c->from), c->m->scratch + job * c->m->width);
+}
+
+void ps_source_map_destroy(ps_source_map *m)
+{
+    if (!m)
+        return;
+    free(m->match), free(m->repower), free(m->start), free(m->byrank), free(m->scratch);
+    free(m);
+}
+
+ps_status ps_source_map_create(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total, uint64_t end,
+                               const bool *resampled, size_t light_count, ps_source_map **out, ps_error *err)
+{
+    *out = NULL;
+    const char *path = ps_scene_path(b->scene);
+    map_plan *pa = &a->plans[kind], *pb = &b->plans[kind];
+    ps_source_map *m = calloc(1, sizeof *m);
+    if (!m)
+        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory matching %llu photons", path,
+                            (unsigned long long)end);
+    m->pb = pb;
+    m->end = end;
+    m->b_enabled = pb->enabled;
+    m->none = true;
+    if (!pb->enabled) {
+        *out = m;
+        return PS_OK;
+    }
+    if (pa->enabled && !count_strata(pa, total, a->opt.records))
+        goto nomem;
+    /* An edit that keeps the cuts keeps the rank table: copied, not counted. */
+    bool copied = pa != pb && pa->enabled && !(pb->counted && pb->counted_total == total) && same_cuts(pa, pb) &&
+                  copy_counts(pb, pa, total, b->opt.records);
+    if (!copied && !count_strata(pb, total, b->opt.records))
+        goto nomem;
+    size_t na = pa->enabled ? pa->count : 0;
+    m->width = pb->count > na ? pb->count : na;
+    m->match = malloc(pb->count * sizeof *m->match);
+    m->repower = calloc(pb->count, sizeof *m->repower);
+    m->scratch = malloc(FILL_JOBS * m->width * sizeof *m->scratch);
+    if (!m->match || !m->repower || !m->scratch)
+        goto nomem;
+    m->identity = pa->enabled && (pa == pb || same_cuts(pa, pb));
+    for (size_t kb = 0; kb < pb->count; kb++) {
+        m->match[kb] = SIZE_MAX;
+        const stratum *sb = &pb->strata[kb];
+        if (!pa->enabled || (sb->light < light_count && resampled[sb->light]))
+            continue;
+        for (size_t ka = 0; ka < pa->count; ka++)
+            if (same_sampling(&pa->strata[ka], sb))
+                m->match[kb] = ka;
+        /* The same light power and count: the stored bytes are already those
+         * of b's trace (the same T, dither and product). */
+        size_t ka = m->match[kb];
+        m->repower[kb] = ka != SIZE_MAX && (memcmp(&pa->strata[ka].power, &sb->power, sizeof(ps_rgb)) != 0 ||
+                                            memcmp(&pa->scale[ka], &pb->scale[kb], sizeof(double)) != 0);
+        m->none = m->none && ka == SIZE_MAX;
+        m->identity = m->identity && (ka == SIZE_MAX || ka == kb);
+    }
+    if (m->none || m->identity || end == 0) {
+        *out = m;
+        return PS_OK;
+    }
+    /* a's photons below end, per stratum: the table's row, then the rest;
+     * then a's indices by rank, in jobs on every core (an edit's update
+     * waits for it; the second pass, fill, is left to the repair's steps). */
+    size_t jobs = (size_t)((end + SOURCE_JOB_INDICES - 1) / SOURCE_JOB_INDICES);
+    m->start = calloc(na + 1, sizeof *m->start);
+    m->byrank = malloc(end * sizeof *m->byrank);
+    uint64_t *scratch = malloc(jobs * m->width * sizeof *scratch);
+    if (!m->start || !m->byrank || !scratch) {
+        free(scratch);
+        goto nomem;
+    }
+    size_t g = (size_t)(end / RANK_GRANULE);
+    for (size_t ka = 0; ka < na; ka++)
+        m->start[ka + 1] = pa->prefix[g * pa->count + ka];
+    for (uint64_t i = (uint64_t)g * RANK_GRANULE; i < end; i++)
+        m->start[stratum_at(pa, i) + 1]++;
+    for (size_t ka = 0; ka < na; ka++)
+        m->start[ka + 1] += m->start[ka];
+    source_job c = {pa, m, scratch, 0, 0, NULL};
+    ps_run_jobs(jobs, ps_online_cores(), byrank_range, &c);
+    free(scratch);
+    *out = m;
+    return PS_OK;
+nomem:
+    ps_source_map_destroy(m);
+    return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory matching %llu photons", path, (unsigned long long)end);
+}
+
+bool ps_source_map_identity(const ps_source_map *m) { return m->identity; }
+bool ps_source_map_none(const ps_source_map *m) { return m->none; }
+
+void ps_source_map_fill(const ps_source_map *m, uint64_t from, uint64_t to, ps_photon_source *out)
+{
+    if (to > m->end)
+        to = m->end;
+    while (from < to) {
+        uint64_t n = to - from;
+        if (n > FILL_JOBS * FILL_JOB_INDICES)
+            n = FILL_JOBS * FILL_JOB_INDICES;
+        source_job c = {NULL, m, NULL, from, from + n, out};
+        ps_run_jobs((size_t)((n + FILL_JOB_INDICES - 1) / FILL_JOB_INDICES), ps_online_cores(), fill_job, &c);
+        from += n;
+        out += n;
     }
 }
 
@@ -1006,60 +1192,12 @@ ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind,
                                    const bool *resampled, size_t light_count, ps_photon_source *out,
                                    ps_error *err)
 {
-    const char *path = ps_scene_path(b->scene);
-    map_plan *pa = &a->plans[kind], *pb = &b->plans[kind];
-    if (!pb->enabled) {
-        for (uint64_t i = 0; i < end; i++)
-            out[i] = (ps_photon_source){PS_SOURCE_NONE, 0, UINT32_MAX, false};
-        return PS_OK;
-    }
-    if (!count_strata(pb, total, b->opt.records) || (pa->enabled && !count_strata(pa, total, a->opt.records)))
-        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory planning %llu photons", path,
-                            (unsigned long long)total);
-    size_t na = pa->enabled ? pa->count : 0;
-    size_t width = pb->count > na ? pb->count : na;
-    size_t jobs = (size_t)((end + SOURCE_JOB_INDICES - 1) / SOURCE_JOB_INDICES);
-    size_t *match = malloc(pb->count * sizeof *match);
-    bool *repower = calloc(pb->count, sizeof *repower);
-    uint64_t *start = calloc(na + 1, sizeof *start);
-    uint64_t *byrank = malloc((pa->enabled && end ? end : 1) * sizeof *byrank);
-    uint64_t *scratch = malloc((jobs ? jobs : 1) * width * sizeof *scratch);
-    if (!match || !repower || !start || !byrank || !scratch) {
-        free(match), free(repower), free(start), free(byrank), free(scratch);
-        return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory matching %llu photons", path,
-                            (unsigned long long)end);
-    }
-    for (size_t kb = 0; kb < pb->count; kb++) {
-        match[kb] = SIZE_MAX;
-        const stratum *sb = &pb->strata[kb];
-        if (!pa->enabled || (sb->light < light_count && resampled[sb->light]))
-            continue;
-        for (size_t ka = 0; ka < pa->count; ka++)
-            if (same_sampling(&pa->strata[ka], sb))
-                match[kb] = ka;
-        /* The same light power and count: the stored bytes are already those
-         * of b's trace (the same T, dither and product). */
-        size_t ka = match[kb];
-        repower[kb] = ka != SIZE_MAX && (memcmp(&pa->strata[ka].power, &sb->power, sizeof(ps_rgb)) != 0 ||
-                                         memcmp(&pa->scale[ka], &pb->scale[kb], sizeof(double)) != 0);
-    }
-    /* end <= total: the kept sequences and rank tables cover it. Both
-     * passes in jobs on every core (an edit's update waits for them). */
-    source_job c = {pa, pb, end, match, repower, start, byrank, out, scratch, width, true};
-    if (pa->enabled) {
-        /* a's photons below end, per stratum: the table's row, then the rest. */
-        size_t g = (size_t)(end / RANK_GRANULE);
-        for (size_t ka = 0; ka < na; ka++)
-            start[ka + 1] = pa->prefix[g * pa->count + ka];
-        for (uint64_t i = (uint64_t)g * RANK_GRANULE; i < end; i++)
-            start[stratum_at(pa, i) + 1]++;
-        for (size_t ka = 0; ka < na; ka++)
-            start[ka + 1] += start[ka];
-        ps_run_jobs(jobs, ps_online_cores(), source_range, &c);
-    }
-    c.fill = false;
-    ps_run_jobs(jobs, ps_online_cores(), source_range, &c);
-    free(match), free(repower), free(start), free(byrank), free(scratch);
+    ps_source_map *m;
+    ps_status st = ps_source_map_create(a, b, kind, total, end, resampled, light_count, &m, err);
+    if (st != PS_OK)
+        return st;
+    ps_source_map_fill(m, 0, end, out);
+    ps_source_map_destroy(m);
     return PS_OK;
 }
 

@@ -166,6 +166,22 @@ typedef struct ps_photon_source {
 ps_status ps_tracer_photon_sources(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total, uint64_t end,
                                    const bool *resampled, size_t light_count, ps_photon_source *out,
                                    ps_error *err);
+/* The same in parts, for a repair that finds the sources of a range of
+ * indices as it gets to them (an edit's first picture waits only for the
+ * ones it draws): create does the tables (the plans' counts, a's indices by
+ * rank; b's counts copied from a's when the edit kept the shares), fill
+ * writes out[i - from] for i in [from, to) (to at most end), as
+ * ps_tracer_photon_sources would, on every core. The map reads b's plan:
+ * tracer b outlives it; a may go once it is made. */
+typedef struct ps_source_map ps_source_map;
+ps_status ps_source_map_create(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uint64_t total, uint64_t end,
+                               const bool *resampled, size_t light_count, ps_source_map **out, ps_error *err);
+void ps_source_map_fill(const ps_source_map *m, uint64_t from, uint64_t to, ps_photon_source *out);
+/* Every source is its own index or none (a kept photon stays where it is). */
+bool ps_source_map_identity(const ps_source_map *m);
+/* No index has a source: nothing of the map can be kept. */
+bool ps_source_map_none(const ps_source_map *m);
+void ps_source_map_destroy(ps_source_map *m);
 /* The n photons a path of source src (from ps_tracer_photon_sources on t as
  * b) stored, with throughputs thr (its path record's), given t's power: their
  * RGBE set exactly as t's trace sets it (the light's power and 1 / the

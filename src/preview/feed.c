@@ -17,9 +17,10 @@ typedef struct repair_work {
     bool active;
     bool in_place;              /* the kept photons at their own index: the old arrays are the map's */
     uint64_t next, end;
-    ps_photon_source *src;      /* each index's old photon (ps_tracer_photon_sources) */
+    ps_source_map *sources;     /* each index's old photon, found a step at a time */
+    ps_photon_source *src;      /* ... for the step's indices (REPAIR_STEP_INDICES) */
     size_t *off;                /* where each old index's photons start in the old map */
-    uint8_t *kept;              /* the keep tests' answers, an index each */
+    uint8_t *kept;              /* the keep tests' answers, an index of the step each */
     ps_photon_map old_map;      /* not in place: the old photons ... */
     ps_path_store old_paths;    /* ... and records (their vertex pool is the new store's) */
     size_t to;                  /* photons the map holds */
@@ -669,11 +670,11 @@ bool ps_feed_repairable(const ps_feed *f)
  * range of indices: a flag an index, the same whatever the thread count. */
 typedef struct keep_job {
     const ps_feed *f;
-    const ps_photon_source *src;
+    const ps_photon_source *src; /* src[i - from] */
     const ps_path_store *pool;  /* the vertices */
     const ps_path_rec *rec;     /* the old records */
     uint64_t from, to, end;
-    uint8_t *kept;
+    uint8_t *kept;              /* kept[i - from] */
 } keep_job;
 
 static void keep_range(void *arg, size_t job)
@@ -683,18 +684,19 @@ static void keep_range(void *arg, size_t job)
     uint64_t from = j->from + (uint64_t)job * KEEP_JOB_INDICES;
     uint64_t to = from + KEEP_JOB_INDICES < j->to ? from + KEEP_JOB_INDICES : j->to;
     for (uint64_t i = from; i < to; i++) {
-        uint64_t o = j->src[i].from;
+        uint64_t o = j->src[i - j->from].from;
         bool keep = o < j->end && !(j->rec[o].flags & REC_PENDING);
         for (size_t m = 0; keep && m < f->moved_count; m++)
             keep = !ps_path_meets(j->pool, &j->rec[o], &f->quant, f->moved[m]);
-        j->kept[i] = keep;
+        j->kept[i - j->from] = keep;
     }
 }
 
 static void repair_work_free(repair_work *w)
 {
+    ps_source_map_destroy(w->sources);
     free(w->src), free(w->off), free(w->kept);
-    w->src = NULL, w->off = NULL, w->kept = NULL;
+    w->sources = NULL, w->src = NULL, w->off = NULL, w->kept = NULL;
     if (!w->in_place) {
         ps_photon_map_free(&w->old_map);
         ps_path_store_free(&w->old_paths);
@@ -720,27 +722,28 @@ static ps_status repair_begin(ps_feed *f, ps_feed *old, int k, const ps_feed_rep
     if (op->tcount != om->count || op->count != end)
         return ps_error_set(err, PS_ERR_NOMEM, "the %s map's path records are incomplete", ps_map_name((ps_map_kind)k));
     repair_work *w = &f->work[k];
-    w->src = malloc(end * sizeof *w->src);
+    size_t step = end < REPAIR_STEP_INDICES ? (size_t)end : REPAIR_STEP_INDICES;
+    w->src = malloc(step * sizeof *w->src);
     w->off = malloc((end + 1) * sizeof *w->off);
-    w->kept = malloc(end);
+    w->kept = malloc(step);
     if (!w->src || !w->off || !w->kept) {
         free(w->src), free(w->off), free(w->kept);
+        w->src = NULL, w->off = NULL, w->kept = NULL;
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %llu photons", (unsigned long long)end);
     }
     w->active = true;
     w->end = end;
-    ps_status st = fns->sources(fns->ctx, (ps_map_kind)k, end, w->src, err);
-    /* Every kept photon at its own index (the plans share every count: an
-     * object moved, a power edit of a lone light): compact in place, as
-     * the map's kept photons only move down. Else gather into new arrays. */
-    w->in_place = true;
-    for (uint64_t i = 0; i < end && w->in_place; i++)
-        w->in_place = w->src[i].from == PS_SOURCE_NONE || w->src[i].from == i;
+    ps_status st = fns->sources(fns->ctx, (ps_map_kind)k, end, &w->sources, err);
+    if (st != PS_OK)
+        return st;
+    /* Every kept photon at its own index (the plans cut the same strata: a
+     * diffuse object moved, a power edit of a lone light): compact in
+     * place, as the map's kept photons only move down. Else gather into
+     * new arrays. */
+    w->in_place = ps_source_map_identity(w->sources);
     ps_photon_map *m = &f->maps[k];
     ps_path_store *np = &f->paths[k];
     size_t room = om->count ? om->count : 1;
-    if (st != PS_OK)
-        return st;
     if (w->in_place) {
         *m = *om, *np = *op;
     } else {
@@ -813,63 +816,68 @@ static ps_status repair_step(ps_feed *f, int k, uint64_t until, ps_error *err)
     const ps_photon_map *om = w->in_place ? m : &w->old_map;
     const ps_path_store *op = w->in_place ? np : &w->old_paths;
     const ps_path_rec *orec = op->rec;
-    uint64_t from = w->next;
-    keep_job job = {f, w->src, np, orec, from, until, w->end, w->kept};
-    ps_run_jobs((size_t)((until - from + KEEP_JOB_INDICES - 1) / KEEP_JOB_INDICES), ps_online_cores(), keep_range,
-                &job);
     const size_t *off = w->off;
     size_t to = w->to, at = f->pending_count[k];
     uint64_t every = batch_of(f, k);
     ps_status st = PS_OK;
-    for (uint64_t i = from; i < until && st == PS_OK; i++) {
-        const ps_photon_source *src = &w->src[i];
-        uint64_t o = src->from;
-        ps_path_rec *r = &np->rec[i];
-        if (w->kept[i]) {
-            size_t n = orec[o].stored;
-            /* In place, source and destination may overlap (to <= off[o]). */
-            if (n == 1) { /* most paths: plain copies, no calls */
-                m->photons[to] = om->photons[off[o]];
-                m->materials[to] = om->materials[off[o]];
-                m->objects[to] = om->objects[off[o]];
-                np->thr[to] = op->thr[off[o]];
-            } else if (!w->in_place || to != off[o]) {
-                memmove(m->photons + to, om->photons + off[o], n * sizeof *m->photons);
-                memmove(m->materials + to, om->materials + off[o], n * sizeof *m->materials);
-                memmove(m->objects + to, om->objects + off[o], n * sizeof *m->objects);
-                memmove(np->thr + to, op->thr + off[o], n * sizeof *np->thr);
+    /* REPAIR_STEP_INDICES at a time: the sources found, the paths tested,
+     * the kept photons copied. */
+    for (uint64_t from = w->next; from < until && st == PS_OK;) {
+        uint64_t part = until - from < REPAIR_STEP_INDICES ? until - from : REPAIR_STEP_INDICES;
+        ps_source_map_fill(w->sources, from, from + part, w->src);
+        keep_job job = {f, w->src, np, orec, from, from + part, w->end, w->kept};
+        ps_run_jobs((size_t)((part + KEEP_JOB_INDICES - 1) / KEEP_JOB_INDICES), ps_online_cores(), keep_range, &job);
+        for (uint64_t i = from; i < from + part && st == PS_OK; i++) {
+            const ps_photon_source *src = &w->src[i - from];
+            uint64_t o = src->from;
+            ps_path_rec *r = &np->rec[i];
+            if (w->kept[i - from]) {
+                size_t n = orec[o].stored;
+                /* In place, source and destination may overlap (to <= off[o]). */
+                if (n == 1) { /* most paths: plain copies, no calls */
+                    m->photons[to] = om->photons[off[o]];
+                    m->materials[to] = om->materials[off[o]];
+                    m->objects[to] = om->objects[off[o]];
+                    np->thr[to] = op->thr[off[o]];
+                } else if (!w->in_place || to != off[o]) {
+                    memmove(m->photons + to, om->photons + off[o], n * sizeof *m->photons);
+                    memmove(m->materials + to, om->materials + off[o], n * sizeof *m->materials);
+                    memmove(m->objects + to, om->objects + off[o], n * sizeof *m->objects);
+                    memmove(np->thr + to, op->thr + off[o], n * sizeof *np->thr);
+                }
+                /* The same path, maybe of a light with another power, maybe one of
+                 * more or fewer photons of its stratum: its power set anew, as
+                 * the edited scene's trace sets it. */
+                if (src->repower)
+                    ps_tracer_repower(f->tracer, (ps_map_kind)k, src, np->thr + to, n, m->photons + to);
+                if (r != &orec[o])
+                    *r = orec[o];
+                r->flags = 0;
+                to += n;
+            } else if (!PS_RESERVE(f->pending[k], w->pending_cap, at + 1)) {
+                st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %zu photons", at);
+            } else {
+                memset(r, 0, sizeof *r);
+                r->flags = REC_PENDING;
+                f->pending[k][at++] = i;
             }
-            /* The same path, maybe of a light with another power, maybe one of
-             * more or fewer photons of its stratum: its power set anew, as
-             * the edited scene's trace sets it. */
-            if (src->repower)
-                ps_tracer_repower(f->tracer, (ps_map_kind)k, src, np->thr + to, n, m->photons + to);
-            if (r != &orec[o])
-                *r = orec[o];
-            r->flags = 0;
-            to += n;
-        } else if (!PS_RESERVE(f->pending[k], w->pending_cap, at + 1)) {
-            st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %zu photons", at);
-        } else {
-            memset(r, 0, sizeof *r);
-            r->flags = REC_PENDING;
-            f->pending[k][at++] = i;
-        }
-        /* A mark every batch of indices: the kept photons of indices below
-         * i + 1 stand for all of them, so a refresh that draws only its
-         * budget draws a prefix of the kept ones, scaled right. */
-        if ((i + 1) % every == 0 && i + 1 < w->end) {
-            pthread_mutex_lock(&f->lock);
-            bool room = PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1);
-            if (room) {
-                m->count = to;
-                m->counters.stored = to;
-                f->marks[k][f->mark_count[k]++] = (ps_feed_mark){to, i + 1};
+            /* A mark every batch of indices: the kept photons of indices below
+             * i + 1 stand for all of them, so a refresh that draws only its
+             * budget draws a prefix of the kept ones, scaled right. */
+            if ((i + 1) % every == 0 && i + 1 < w->end) {
+                pthread_mutex_lock(&f->lock);
+                bool room = PS_RESERVE(f->marks[k], f->mark_cap[k], f->mark_count[k] + 1);
+                if (room) {
+                    m->count = to;
+                    m->counters.stored = to;
+                    f->marks[k][f->mark_count[k]++] = (ps_feed_mark){to, i + 1};
+                }
+                pthread_mutex_unlock(&f->lock);
+                if (!room)
+                    st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
             }
-            pthread_mutex_unlock(&f->lock);
-            if (!room)
-                st = ps_error_set(err, PS_ERR_NOMEM, "out of memory for the photon feed");
         }
+        from += part;
     }
     f->pending_count[k] = at;
     w->to = to;

@@ -101,9 +101,9 @@ bool ps_feed_active(const ps_feed *f, ps_map_kind k);
 typedef struct ps_feed_repair_fns {
     void *ctx;
     /* Which old photon each of map k's indices [0, end) is under the edited
-     * scene's tracer (ps_tracer_photon_sources). Called by
-     * ps_feed_create_repair only. */
-    ps_status (*sources)(void *ctx, ps_map_kind k, uint64_t end, ps_photon_source *out, ps_error *err);
+     * scene's tracer, as a source map the feed fills a step at a time and
+     * destroys (ps_source_map_create). Called by ps_feed_create_repair only. */
+    ps_status (*sources)(void *ctx, ps_map_kind k, uint64_t end, ps_source_map **out, ps_error *err);
     /* An old photon is kept when no segment of its path meets one of these
      * boxes (path_record.h, in quant): the moved objects' old and new
      * places. Copied: the feed tests most paths after the call. */

@@ -57,11 +57,11 @@ typedef struct keep_ctx {
     ps_path_quant quant;
 } keep_ctx;
 
-static ps_status sources(void *arg, ps_map_kind k, uint64_t end, ps_photon_source *out, ps_error *err)
+static ps_status sources(void *arg, ps_map_kind k, uint64_t end, ps_source_map **out, ps_error *err)
 {
     keep_ctx *c = arg;
-    return ps_tracer_photon_sources(c->old_tracer, c->new_tracer, k, c->cap[k], end, c->resampled, c->light_count,
-                                    out, err);
+    return ps_source_map_create(c->old_tracer, c->new_tracer, k, c->cap[k], end, c->resampled, c->light_count, out,
+                                err);
 }
 
 /* Whether light a emits as b does but for its power: the same kind, place,
