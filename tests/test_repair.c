@@ -641,6 +641,67 @@ static void an_edit_picture_has_pixel_paths(void **state)
     assert_false(first_edit_picture_has_pixel_paths(0));
 }
 
+/* The two-light scene without its spot: one light, whose move changes
+ * every photon of both maps. */
+static ps_scene *load_lone_light(void)
+{
+    char text[sizeof SCENE_TEXT];
+    snprintf(text, sizeof text, "%s", SCENE_TEXT);
+    *strstr(text, "light spot") = '\0';
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load_text(text, "lone.scn", ".", NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    return scene;
+}
+
+/* A lone light moved: nothing of either map can be kept, so each starts
+ * over from photon 0 as a fresh feed's, with no paths to test and no list
+ * to retrace: right after the update the maps hold nothing and count
+ * nothing emitted (a repair would count every old index emitted, its
+ * photons on their way), the counts say every index retraced, and the maps
+ * traced on are a fresh trace's; so are they after a move in the middle of
+ * such a restart (the picture's thread traced part of it) and another once
+ * it is shown. */
+static void a_lone_light_move_starts_over(void **state)
+{
+    (void)state;
+    ps_scene *scene = load_lone_light();
+    ps_session *s = open_traced(scene);
+    ps_error err;
+    assert_int_equal(ps_session_move_light(s, 0, ps_v3(0.3, 1.85, -0.2), &err), PS_OK);
+    uint64_t kept[PS_MAP_COUNT], retraced[PS_MAP_COUNT];
+    update(s, kept, retraced);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        assert_int_equal(kept[k], 0);
+        assert_int_equal(ps_session_maps(s)[k].count, 0);
+        assert_int_equal(ps_session_maps(s)[k].counters.emitted, 0);
+    }
+    traced_equals_fresh(s, scene);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+
+    scene = load_lone_light();
+    ps_camera_frame cam;
+    s = open_shown_whole(scene, 0, 0, &cam);
+    assert_int_equal(refresh_until_settled(s, &cam, false), 0);
+    for (int step = 0; step < 3; step++) {
+        assert_int_equal(ps_session_move_light(s, 0, ps_v3(0.1 * step, 1.85, 0.1), &err), PS_OK);
+        update_repaired(s);
+        ps_session_frame f;
+        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+        assert_true(f.emitted[PS_MAP_CAUSTIC] > 0); /* the first picture has photons */
+        ps_session_drawn(s, 1e-4);
+        if (step == 1)
+            (void)refresh_until_settled(s, &cam, false);
+    }
+    (void)refresh_until_settled(s, &cam, false);
+    shown_equals_fresh(s, scene);
+    assert_int_equal(ps_session_stop(s, &err), PS_OK);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -653,6 +714,7 @@ int main(void)
         cmocka_unit_test(a_small_repair_is_done_before_the_first_picture),
         cmocka_unit_test(an_edit_picture_has_pixel_paths),
         cmocka_unit_test(an_edit_picture_draws_every_photon),
+        cmocka_unit_test(a_lone_light_move_starts_over),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

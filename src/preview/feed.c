@@ -46,7 +46,11 @@ struct ps_feed {
      * ps_feed_merge (the drawing side's moment), see feed_main. */
     bool threaded;
     uint64_t next[PS_MAP_COUNT]; /* the feeding thread's: first photon not yet traced */
-    uint64_t round;
+    uint64_t round[PS_MAP_COUNT];   /* map k's rounds traced (round_end) */
+    /* A map a repair could keep nothing of starts over from photon 0 (as a
+     * fresh feed's): its indices below restart_end are traced as a repair
+     * retraces, before the other maps go past theirs. */
+    uint64_t restart_end[PS_MAP_COUNT];
     pthread_t thread;
     ps_status status;
     ps_error err;
@@ -202,6 +206,17 @@ static uint64_t batch_of(const ps_feed *f, int k)
     return n < 1.0 ? 1 : (uint64_t)n;
 }
 
+/* Map k's next round of indices, traced: round_end's share of them. */
+static uint64_t round_end(const ps_feed *f, int k, uint64_t r, uint64_t prev_end);
+static ps_status trace_round(ps_feed *f, int k, ps_error *err)
+{
+    uint64_t until = round_end(f, k, f->round[k], f->next[k]);
+    ps_status st = batch(f, k, f->next[k], until - f->next[k], err);
+    f->next[k] = until;
+    f->round[k]++;
+    return st;
+}
+
 /* The next batch of map k's pending indices, retraced. */
 static ps_status retrace_batch(ps_feed *f, int k, ps_error *err)
 {
@@ -264,11 +279,15 @@ static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
         pthread_mutex_unlock(&f->lock);
         return false;
     }
-    /* A repair first retraces what the edit changed, then goes on. */
+    /* A repair first retraces what the edit changed (a map that starts
+     * over: up to where it was), then goes on. */
     bool repairing = false;
     for (int k = 0; k < PS_MAP_COUNT && *st == PS_OK; k++)
         if (f->pending_done[k] < f->pending_count[k]) {
             *st = retrace_batch(f, k, err);
+            repairing = true;
+        } else if (f->next[k] < f->restart_end[k]) {
+            *st = trace_round(f, k, err);
             repairing = true;
         }
     if (repairing)
@@ -277,12 +296,9 @@ static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
     for (int k = 0; k < PS_MAP_COUNT && *st == PS_OK; k++) {
         if (!f->active[k] || f->next[k] >= f->cap[k])
             continue;
-        uint64_t until = round_end(f, k, f->round, f->next[k]);
-        *st = batch(f, k, f->next[k], until - f->next[k], err);
-        f->next[k] = until;
+        *st = trace_round(f, k, err);
         more = more || f->next[k] < f->cap[k];
     }
-    f->round++;
     /* Only this thread sets it, so it can be read without the lock. */
     return more && *st == PS_OK && !f->store_limited;
 }
@@ -599,7 +615,8 @@ ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, ps_error *err)
         return PS_OK;
     uint64_t pending = 0;
     for (int k = 0; k < PS_MAP_COUNT; k++)
-        pending += f->pending_count[k] - f->pending_done[k];
+        pending += f->pending_count[k] - f->pending_done[k] +
+                   (f->next[k] < f->restart_end[k] ? f->restart_end[k] - f->next[k] : 0);
     /* All or nothing: a part would cost the first picture its time and
      * still leave a hole (and a merge) to the thread. */
     if (pending > max_photons)
@@ -613,11 +630,14 @@ ps_status ps_feed_retrace_first(ps_feed *f, uint64_t max_photons, ps_error *err)
             if (f->pending_done[k] < f->pending_count[k]) {
                 st = retrace_batch(f, k, err);
                 more = true;
+            } else if (f->next[k] < f->restart_end[k]) {
+                st = trace_round(f, k, err);
+                more = true;
             }
     }
     bool left = false;
     for (int k = 0; k < PS_MAP_COUNT; k++)
-        left = left || f->pending_done[k] < f->pending_count[k];
+        left = left || f->pending_done[k] < f->pending_count[k] || f->next[k] < f->restart_end[k];
     /* Nothing left to retrace: in index order at once, so that the
      * picture never needs to start over for it. */
     if (st == PS_OK && !left)
@@ -722,6 +742,22 @@ static ps_status repair_begin(ps_feed *f, ps_feed *old, int k, const ps_feed_rep
     if (op->tcount != om->count || op->count != end)
         return ps_error_set(err, PS_ERR_NOMEM, "the %s map's path records are incomplete", ps_map_name((ps_map_kind)k));
     repair_work *w = &f->work[k];
+    ps_source_map *sources;
+    ps_status st = fns->sources(fns->ctx, (ps_map_kind)k, end, &sources, err);
+    if (st != PS_OK)
+        return st;
+    if (ps_source_map_none(sources)) {
+        /* Nothing to keep (every light of the map moved): the map starts
+         * over from photon 0 as a fresh feed's, with no paths to test and
+         * no list of indices to retrace, and in index order throughout. */
+        ps_source_map_destroy(sources);
+        f->next[k] = f->repair_end[k] = 0;
+        f->restart_end[k] = end;
+        f->round[k] = 0;
+        f->repair.retraced[k] = end;
+        return PS_OK;
+    }
+    w->sources = sources;
     size_t step = end < REPAIR_STEP_INDICES ? (size_t)end : REPAIR_STEP_INDICES;
     w->src = malloc(step * sizeof *w->src);
     w->off = malloc((end + 1) * sizeof *w->off);
@@ -733,9 +769,6 @@ static ps_status repair_begin(ps_feed *f, ps_feed *old, int k, const ps_feed_rep
     }
     w->active = true;
     w->end = end;
-    ps_status st = fns->sources(fns->ctx, (ps_map_kind)k, end, &w->sources, err);
-    if (st != PS_OK)
-        return st;
     /* Every kept photon at its own index (the plans cut the same strata: a
      * diffuse object moved, a power edit of a lone light): compact in
      * place, as the map's kept photons only move down. Else gather into
@@ -938,7 +971,7 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair
     if (st != PS_OK)
         return st;
     f->max_stored = old->max_stored;
-    f->round = old->round;
+    memcpy(f->round, old->round, sizeof f->round);
     f->seconds = old->seconds;
     f->quant = fns->quant;
     f->moved_count = fns->moved_count;
