@@ -11,6 +11,7 @@
 #include "photon/tracer.h"
 #include "photon/world.h"
 #include "preview/feed.h"
+#include "preview/repair.h"
 #include "preview/session.h"
 #include "preview/specular.h"
 #include "scene/scene.h"
@@ -702,6 +703,97 @@ static void a_lone_light_move_starts_over(void **state)
     ps_scene_destroy(scene);
 }
 
+/* One stage of a hand-made session: the scene's world and tracer as the
+ * session makes them (records in the scene's box). */
+typedef struct stage {
+    ps_world *world;
+    ps_tracer *tracer;
+} stage;
+
+static stage stage_make(const ps_scene *scene)
+{
+    stage g;
+    ps_error err;
+    assert_int_equal(ps_world_create(scene, NULL, &g.world, &err), PS_OK);
+    ps_tracer_options o = ps_tracer_default_options();
+    o.seed = SEED;
+    o.threads = 2;
+    o.records = true;
+    o.record_box = ps_repair_record_box(scene);
+    assert_int_equal(ps_tracer_create(g.world, &o, &g.tracer, &err), PS_OK);
+    return g;
+}
+
+static void stage_free(stage *g)
+{
+    ps_tracer_destroy(g->tracer);
+    ps_world_destroy(g->world);
+}
+
+/* The mirror moved on scene, and old (stopped, unmerged) repaired onto the
+ * edited scene's new stage. */
+static ps_feed *edit_and_repair(ps_scene *scene, ps_feed *old, const stage *was_stage, stage *now, ps_vec3 delta)
+{
+    ps_error err;
+    ps_repair_state was;
+    assert_int_equal(ps_repair_state_take(scene, ps_world_epsilon(was_stage->world), &was, &err), PS_OK);
+    assert_int_equal(ps_scene_translate_object(scene, MIRROR, delta, &err), PS_OK);
+    *now = stage_make(scene);
+    ps_feed_stop_unmerged(old);
+    ps_feed *f = NULL;
+    bool repaired = false;
+    assert_int_equal(ps_repair_feed(old, was_stage->tracer, now->tracer, &was, scene, ps_world_epsilon(now->world),
+                                    &f, &repaired, &err),
+                     PS_OK);
+    assert_true(repaired);
+    ps_repair_state_free(&was);
+    return f;
+}
+
+/* An edit while the last repair's map is still in its repair order (kept
+ * run, retraced run, then photons traced past the repair: nothing merged,
+ * as ps_feed_stop_unmerged leaves it for an update): the repair reads each
+ * old photon where it lies, and the maps traced on are a fresh trace's. */
+static void a_repair_reads_the_repair_order(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    stage g0 = stage_make(scene);
+    const uint64_t caps[PS_MAP_COUNT] = {SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP};
+    const bool active[PS_MAP_COUNT] = {true, true};
+    ps_feed *f0;
+    ps_error err;
+    assert_int_equal(ps_feed_create(g0.tracer, caps, active, &f0, &err), PS_OK);
+    for (int r = 0; r < 2; r++) /* half the caps: the repair has indices past it to trace */
+        assert_int_equal(ps_feed_prime(f0, &err), PS_OK);
+    stage g1;
+    ps_feed *f1 = edit_and_repair(scene, f0, &g0, &g1, ps_v3(0.1, 0, 0));
+    ps_feed_destroy(f0);
+    stage_free(&g0);
+    const size_t all[PS_MAP_COUNT] = {SIZE_MAX, SIZE_MAX};
+    assert_int_equal(ps_feed_repair_ahead(f1, all, &err), PS_OK);
+    ps_feed_repair_count rc = ps_feed_repair_counts(f1);
+    assert_true(rc.retraced[PS_MAP_CAUSTIC] > 0 && rc.kept[PS_MAP_CAUSTIC] > 0);
+    /* The retrace (a round each map), then a round past the repair. */
+    size_t before = ps_feed_maps(f1)[PS_MAP_CAUSTIC].count;
+    for (int r = 0; r < 3; r++)
+        assert_int_equal(ps_feed_prime(f1, &err), PS_OK);
+    assert_true(ps_feed_maps(f1)[PS_MAP_CAUSTIC].count > before);
+    stage g2;
+    ps_feed *f2 = edit_and_repair(scene, f1, &g1, &g2, ps_v3(-0.05, 0, 0.05));
+    ps_feed_destroy(f1);
+    stage_free(&g1);
+    assert_int_equal(ps_feed_run(f2, &err), PS_OK);
+    ps_photon_map fresh[PS_MAP_COUNT];
+    fresh_trace(scene, fresh, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+    assert_same_maps(ps_feed_maps(f2), fresh);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_free(&fresh[k]);
+    ps_feed_destroy(f2);
+    stage_free(&g2);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -715,6 +807,7 @@ int main(void)
         cmocka_unit_test(an_edit_picture_has_pixel_paths),
         cmocka_unit_test(an_edit_picture_draws_every_photon),
         cmocka_unit_test(a_lone_light_move_starts_over),
+        cmocka_unit_test(a_repair_reads_the_repair_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

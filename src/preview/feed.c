@@ -413,6 +413,21 @@ void ps_feed_stop(ps_feed *f)
     }
 }
 
+void ps_feed_stop_unmerged(ps_feed *f)
+{
+    stop_thread(f);
+    if (f->status == PS_OK) {
+        ps_error err;
+        ps_status st = repair_all(f, &err);
+        if (st != PS_OK) {
+            pthread_mutex_lock(&f->lock);
+            f->status = st;
+            f->err = err;
+            pthread_mutex_unlock(&f->lock);
+        }
+    }
+}
+
 void ps_feed_pause(ps_feed *f, bool paused)
 {
     pthread_mutex_lock(&f->lock);
@@ -773,7 +788,7 @@ static ps_status repair_begin(ps_feed *f, ps_feed *old, int k, const ps_feed_rep
      * diffuse object moved, a power edit of a lone light): compact in
      * place, as the map's kept photons only move down. Else gather into
      * new arrays. */
-    w->in_place = ps_source_map_identity(w->sources);
+    w->in_place = ps_source_map_identity(w->sources) && !old->repairing[k];
     ps_photon_map *m = &f->maps[k];
     ps_path_store *np = &f->paths[k];
     size_t room = om->count ? om->count : 1;
@@ -795,9 +810,26 @@ static ps_status repair_begin(ps_feed *f, ps_feed *old, int k, const ps_feed_rep
     if (st != PS_OK)
         return st;
     const ps_path_rec *orec = w->in_place ? np->rec : w->old_paths.rec;
-    w->off[0] = 0;
-    for (uint64_t i = 0; i < end; i++)
-        w->off[i + 1] = w->off[i] + ((orec[i].flags & REC_PENDING) ? 0 : orec[i].stored);
+    if (!old->repairing[k]) {
+        w->off[0] = 0;
+        for (uint64_t i = 0; i < end; i++)
+            w->off[i + 1] = w->off[i] + ((orec[i].flags & REC_PENDING) ? 0 : orec[i].stored);
+    } else {
+        /* The old map still in its own repair order (prepare_map's): the
+         * kept run, the retraced run from kept_end, then what was traced
+         * past its repair. Read where it lies, not merged first: the merge
+         * was 0.01-0.03 s of an update at 10^6 photons. */
+        size_t kept = 0, re = old->kept_end[k];
+        for (uint64_t i = 0; i < end; i++) {
+            size_t *at = i >= old->repair_end[k] || (orec[i].flags & REC_RETRACED) ? &re : &kept;
+            w->off[i] = *at;
+            if (!(orec[i].flags & REC_PENDING))
+                *at += orec[i].stored;
+        }
+        if (kept != old->kept_end[k] || re != w->old_map.count)
+            return ps_error_set(err, PS_ERR_NOMEM, "the %s map's path records are incomplete",
+                                ps_map_name((ps_map_kind)k));
+    }
     /* Counters: every index below `end` counts as emitted (the pending
      * ones are on their way); what the paths did is counted anew. */
     memset(&m->counters, 0, sizeof m->counters);
@@ -963,7 +995,12 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair
                                 ps_error *err)
 {
     *out = NULL;
-    ps_status st = merge(old, err);
+    /* Old's own repair done (its records whole); a map the thread made
+     * ready in index order swapped in; one still in repair order is read
+     * as it lies (repair_begin). */
+    ps_status st = repair_all(old, err);
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
+        st = commit_map(old, k, err);
     if (st != PS_OK)
         return st;
     ps_feed *f;

@@ -956,7 +956,7 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
     ps_tracer *old_tracer = s->tracer;
     s->feed = NULL;
     s->tracer = NULL;
-    ps_feed_stop(old);
+    ps_feed_stop_unmerged(old);
     /* Stopped, the old feed's repair is whole: its counts are final. */
     if (s->repaired) {
         ps_feed_repair_count rc = ps_feed_repair_counts(old);
