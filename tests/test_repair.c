@@ -476,7 +476,8 @@ static void a_background_repair_keeps_the_view(void **state)
 
 /* Edits that come while a repair left to the thread is still testing
  * paths (edit_splats_whole 0: only the first picture's share is tested
- * before it): the next update finishes that repair first, so after every
+ * before it): the next update ends that repair where it is, the untested
+ * indices retraced (ps_feed_stop_unmerged), so after every
  * kind of edit in a row, some with a refresh between them (the thread goes
  * on for a while), the maps are a fresh trace's. */
 static void edits_mid_background_repair(void **state)
@@ -794,6 +795,51 @@ static void a_repair_reads_the_repair_order(void **state)
     ps_scene_destroy(scene);
 }
 
+/* A second edit before the thread has tested the first repair's paths (a
+ * drag's edits, 0.05 s apart): the update does not finish those tests, the
+ * indices left go to the list to retrace (ps_feed_stop_unmerged), the
+ * counts say so, and the maps traced on are a fresh trace's. */
+static void an_edit_mid_repair_retraces_the_untested(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    stage g0 = stage_make(scene);
+    const uint64_t caps[PS_MAP_COUNT] = {SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP};
+    const bool active[PS_MAP_COUNT] = {true, true};
+    ps_feed *f0;
+    ps_error err;
+    assert_int_equal(ps_feed_create(g0.tracer, caps, active, &f0, &err), PS_OK);
+    assert_int_equal(ps_feed_run(f0, &err), PS_OK);
+    stage g1;
+    ps_feed *f1 = edit_and_repair(scene, f0, &g0, &g1, ps_v3(0.1, 0, 0));
+    ps_feed_destroy(f0);
+    stage_free(&g0);
+    /* Only the first batch of indices tested, as for a first picture. */
+    const size_t ahead[PS_MAP_COUNT] = {1, 1};
+    assert_int_equal(ps_feed_repair_ahead(f1, ahead, &err), PS_OK);
+    size_t tested_photons = ps_feed_maps(f1)[PS_MAP_CAUSTIC].count;
+    assert_true(tested_photons > 0);
+    stage g2;
+    ps_feed *f2 = edit_and_repair(scene, f1, &g1, &g2, ps_v3(-0.05, 0, 0.05));
+    /* f1's counts: every untested index retraced, its kept photons only
+     * the tested ones'. */
+    ps_feed_repair_count rc = ps_feed_repair_counts(f1);
+    assert_int_equal(rc.kept[PS_MAP_CAUSTIC] + rc.retraced[PS_MAP_CAUSTIC], SHOWN_CAUSTIC_CAP);
+    assert_true(rc.retraced[PS_MAP_CAUSTIC] >= SHOWN_CAUSTIC_CAP - PS_FEED_BATCH);
+    assert_int_equal(rc.kept_photons[PS_MAP_CAUSTIC], tested_photons);
+    ps_feed_destroy(f1);
+    stage_free(&g1);
+    assert_int_equal(ps_feed_run(f2, &err), PS_OK);
+    ps_photon_map fresh[PS_MAP_COUNT];
+    fresh_trace(scene, fresh, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+    assert_same_maps(ps_feed_maps(f2), fresh);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_free(&fresh[k]);
+    ps_feed_destroy(f2);
+    stage_free(&g2);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -808,6 +854,7 @@ int main(void)
         cmocka_unit_test(an_edit_picture_draws_every_photon),
         cmocka_unit_test(a_lone_light_move_starts_over),
         cmocka_unit_test(a_repair_reads_the_repair_order),
+        cmocka_unit_test(an_edit_mid_repair_retraces_the_untested),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

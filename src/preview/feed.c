@@ -413,12 +413,16 @@ void ps_feed_stop(ps_feed *f)
     }
 }
 
+static ps_status repair_abandon(ps_feed *f, int k, ps_error *err);
+
 void ps_feed_stop_unmerged(ps_feed *f)
 {
     stop_thread(f);
     if (f->status == PS_OK) {
         ps_error err;
-        ps_status st = repair_all(f, &err);
+        ps_status st = PS_OK;
+        for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
+            st = repair_abandon(f, k, &err);
         if (st != PS_OK) {
             pthread_mutex_lock(&f->lock);
             f->status = st;
@@ -956,6 +960,29 @@ static ps_status repair_step(ps_feed *f, int k, uint64_t until, ps_error *err)
     return st;
 }
 
+/* Map k's repair ended where it is: the indices not yet tested go to the
+ * list to retrace, their old photons dropped. The next edit's update then
+ * need not finish the tests first: 0.09-0.1 s at 10^6 photons when two
+ * edits came 0.05 s apart (a drag's), where the retrace is the thread's. */
+static ps_status repair_abandon(ps_feed *f, int k, ps_error *err)
+{
+    repair_work *w = &f->work[k];
+    if (!w->active)
+        return PS_OK;
+    ps_path_store *np = &f->paths[k];
+    size_t at = f->pending_count[k];
+    if (!PS_RESERVE(f->pending[k], w->pending_cap, at + (size_t)(w->end - w->next)))
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for a repair of %zu photons", at);
+    for (uint64_t i = w->next; i < w->end; i++) {
+        memset(&np->rec[i], 0, sizeof np->rec[i]);
+        np->rec[i].flags = REC_PENDING;
+        f->pending[k][at++] = i;
+    }
+    f->pending_count[k] = at;
+    w->next = w->end;
+    return repair_finish(f, k, err);
+}
+
 /* Whether a map's repair has indices left to test and copy. */
 static bool repair_left(const ps_feed *f)
 {
@@ -995,9 +1022,9 @@ ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair
                                 ps_error *err)
 {
     *out = NULL;
-    /* Old's own repair done (its records whole); a map the thread made
-     * ready in index order swapped in; one still in repair order is read
-     * as it lies (repair_begin). */
+    /* Old's own repair done (its records whole: ps_feed_stop_unmerged has
+     * ended it); a map the thread made ready in index order swapped in; one
+     * still in repair order is read as it lies (repair_begin). */
     ps_status st = repair_all(old, err);
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
         st = commit_map(old, k, err);

@@ -51,9 +51,10 @@ ps_status ps_feed_prime(ps_feed *f, ps_error *err);
 ps_status ps_feed_start(ps_feed *f, ps_error *err);
 /* Asks the thread to stop after its current batch and waits for it. */
 void ps_feed_stop(ps_feed *f);
-/* The same, but a map in repair order stays so (no merge): for a feed an
- * edit replaces, which ps_feed_create_repair reads as it lies. Its own
- * repair's tests and copies are finished, so its counts are final. */
+/* The same, but a map in repair order stays so (no merge), and a repair
+ * the thread has not finished testing ends there, the indices left joining
+ * those to retrace: for a feed an edit replaces, which
+ * ps_feed_create_repair reads as it lies. Its repair counts are final. */
 void ps_feed_stop_unmerged(ps_feed *f);
 /* Holds the thread between batches (true) or lets it go on. */
 void ps_feed_pause(ps_feed *f, bool paused);
