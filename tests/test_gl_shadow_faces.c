@@ -24,6 +24,7 @@
 #include "preview/splat.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
+#include "two_lights.h"
 
 static const char *const scene_text = "camera eye 0 3 0.01 target 0 0 0 up 0 0 -1 fov 70\n"
                                       "material floor diffuse albedo 0.5 0.5 0.5\n"
@@ -112,7 +113,7 @@ static void edit_renders(edit_kind e, unsigned expect_faces, bool picture_change
     assert_true(OSMesaMakeCurrent(ctx, buffer, GL_FLOAT, W, H));
     ps_kernel_texture kernel;
     assert_int_equal(ps_kernel_texture_make(PS_KERNEL_BOX, PS_KERNEL_TEXTURE_SIZE, &kernel, &err), PS_OK);
-    ps_gl_options go = {true, true, 0};
+    ps_gl_options go = {true, true, 0, false};
 
     inputs before;
     inputs_make(s, &before);
@@ -192,6 +193,58 @@ static void moved_light_renders_its_cube(void **state)
     edit_renders(MOVE_LIGHT, 6, true);
 }
 
+/* The shadowed lit passes leave out the objects outside each cube face's
+ * pyramid (ps_gl_draw_mesh_within): the same picture, float for float, as
+ * passes that draw every object in every face, from fewer vertices: here
+ * and in the two-light box (its spheres lie in one face of the point light,
+ * its walls in two or three). */
+static void culled_faces_draw_the_same(void **state)
+{
+    (void)state;
+    char box[2048];
+    snprintf(box, sizeof box, TWO_LIGHTS_SCENE "60 50 40\n");
+    const char *texts[2] = {scene_text, box};
+    for (int t = 0; t < 2; t++) {
+        ps_error err;
+        ps_scene *s;
+        if (ps_scene_load_text(texts[t], "inline.scn", "", NULL, &s, &err) != PS_OK)
+            fail_msg("scene: %s", err.msg);
+        float *buffer = malloc(sizeof(float) * 4 * W * H);
+        OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+        assert_non_null(ctx);
+        assert_true(OSMesaMakeCurrent(ctx, buffer, GL_FLOAT, W, H));
+        ps_kernel_texture kernel;
+        assert_int_equal(ps_kernel_texture_make(PS_KERNEL_BOX, PS_KERNEL_TEXTURE_SIZE, &kernel, &err), PS_OK);
+        inputs in;
+        inputs_make(s, &in);
+        ps_gl_scene gs = gl_scene(s, &in);
+        ps_image pic[2];
+        uint64_t vertices[2];
+        for (int whole = 0; whole < 2; whole++) {
+            ps_gl_options go = {true, true, 0, whole != 0};
+            ps_gl_renderer *r;
+            assert_int_equal(ps_gl_renderer_create(&gs, &kernel, &go, &r, &err), PS_OK);
+            pic[whole] = draw(r, s);
+            vertices[whole] = ps_gl_get_stats(r).light_vertices;
+            ps_gl_renderer_destroy(r);
+        }
+        printf("scene %d: the lit passes drew %llu vertices culled, %llu whole (%.2f)\n", t,
+               (unsigned long long)vertices[0], (unsigned long long)vertices[1],
+               (double)vertices[0] / (double)vertices[1]);
+        assert_true(same_pixels(&pic[0], &pic[1]));
+        assert_true(vertices[0] < vertices[1]);
+        if (t == 1) /* six faces of the point light, the spot's one or two */
+            assert_true(vertices[0] < vertices[1] / 2);
+        ps_image_destroy(&pic[0]);
+        ps_image_destroy(&pic[1]);
+        inputs_free(&in);
+        ps_kernel_texture_free(&kernel);
+        OSMesaDestroyContext(ctx);
+        free(buffer);
+        ps_scene_destroy(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -199,6 +252,7 @@ int main(void)
         cmocka_unit_test(occluder_moved_aside),
         cmocka_unit_test(power_renders_no_face),
         cmocka_unit_test(moved_light_renders_its_cube),
+        cmocka_unit_test(culled_faces_draw_the_same),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

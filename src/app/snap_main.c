@@ -870,7 +870,7 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
      * 16 shadow cubes; a fixed photon count draws once, with all of them. */
     set.progressive_lights = progressive;
     ps_status st = ps_session_create(scene, &set, &s.session, err);
-    ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0};
+    ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0, false};
     if (st == PS_OK) {
         ps_gl_scene gs = ps_gl_scene_of(s.session);
         st = ps_gl_renderer_create(&gs, ps_session_kernel(s.session), &gopt, &s.gl, err);

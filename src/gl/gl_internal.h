@@ -40,6 +40,11 @@ struct ps_gl_renderer {
     /* Mirrors and glass left out of every mesh pass (the specular layer's
      * cube maps, gl_specular.c, which look from inside them). */
     bool skip_specular;
+    /* Each range of the fine mesh's bounds, for the shadowed lit passes'
+     * culling (ps_gl_draw_mesh_within); made for the positions named
+     * (NULL when out of memory: nothing culled). */
+    ps_aabb *range_bounds;
+    const float *range_bounds_of;
 };
 
 /* Textures (gl_albedo.c). The lit passes and the splats use the materials'
@@ -77,6 +82,12 @@ void ps_gl_box_range(ps_aabb b, ps_vec3 p, double *nearest, double *farthest);
  * coarse one for depth; with `stencil` each object writes its stencil value
  * (ps_splat_stencil). The exposure is in the lights, not here. */
 void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil);
+/* The fine mesh with materials, but the ranges that lie wholly on the
+ * clipped side of one of the planes (world (a, b, c, d), GL keeping
+ * a x + b y + c z + d >= 0, as glClipPlane) left out: they would draw
+ * nothing. A shadowed lit pass draws one cube face's pyramid, which most of
+ * a scene's objects lie outside; GL clips only after it has lit them. */
+void ps_gl_draw_mesh_within(ps_gl_renderer *r, const double (*planes)[4], int plane_count);
 
 /* Lights (gl_lights.c). */
 ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err); /* new lights: shadow slots, maps remade */

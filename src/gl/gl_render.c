@@ -74,9 +74,31 @@ void ps_gl_box_range(ps_aabb b, ps_vec3 p, double *nearest, double *farthest)
 
 /* ---- drawing the mesh ----------------------------------------------------- */
 
-void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil)
+/* A range is culled only when it lies this far (relative to the plane's
+ * terms' sizes) on the clipped side: float positions and GL's float clip
+ * test stay far inside it. */
+#define MESH_CULL_MARGIN 1e-5
+
+/* Whether box b lies wholly where plane p clips (a x + b y + c z + d < 0 at
+ * every corner), by a margin over the float rounding of the positions and
+ * of GL's own evaluation. */
+static bool box_clipped(ps_aabb b, const double p[4])
+{
+    double most = p[3], size = fabs(p[3]);
+    const double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
+    for (int a = 0; a < 3; a++) {
+        most += p[a] * (p[a] > 0.0 ? hi[a] : lo[a]);
+        size += fabs(p[a]) * fmax(fabs(lo[a]), fabs(hi[a]));
+    }
+    return most < -MESH_CULL_MARGIN * size;
+}
+
+static void draw_ranges(const ps_gl_renderer *r, bool with_materials, bool stencil, const double (*planes)[4],
+                        int plane_count, uint64_t *vertices)
 {
     const ps_preview_mesh *m = with_materials ? r->in.mesh : r->in.coarse;
+    bool cull = planes && with_materials && r->range_bounds && r->range_bounds_of == m->positions &&
+                !r->opt.whole_face_passes;
     glEnableClientState(GL_VERTEX_ARRAY);
     glVertexPointer(3, GL_FLOAT, 0, m->positions);
     if (with_materials) {
@@ -87,6 +109,13 @@ void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil)
         const ps_mesh_range *rg = &m->ranges[i];
         if (r->skip_specular && ps_material_is_specular(&r->in.materials[rg->material]))
             continue;
+        bool outside = false;
+        for (int p = 0; cull && p < plane_count && !outside; p++)
+            outside = box_clipped(r->range_bounds[i], planes[p]);
+        if (outside)
+            continue;
+        if (vertices)
+            *vertices += rg->count;
         if (with_materials) {
             const ps_material *mat = &r->in.materials[rg->material];
             GLfloat diffuse[4] = {0, 0, 0, 1}, specular[4] = {0, 0, 0, 1};
@@ -123,6 +152,41 @@ void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil)
     glDisableClientState(GL_VERTEX_ARRAY);
 }
 
+void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil)
+{
+    draw_ranges(r, with_materials, stencil, NULL, 0, NULL);
+}
+
+void ps_gl_draw_mesh_within(ps_gl_renderer *r, const double (*planes)[4], int plane_count)
+{
+    draw_ranges(r, true, false, planes, plane_count, &r->stats.light_vertices);
+}
+
+/* The fine mesh's range bounds, for ps_gl_draw_mesh_within. */
+static void make_range_bounds(ps_gl_renderer *r)
+{
+    const ps_preview_mesh *m = r->in.mesh;
+    free(r->range_bounds);
+    r->range_bounds = NULL;
+    r->range_bounds_of = NULL;
+    if (!m || !m->positions || m->range_count == 0)
+        return;
+    r->range_bounds = malloc(m->range_count * sizeof *r->range_bounds);
+    if (!r->range_bounds)
+        return;
+    for (size_t i = 0; i < m->range_count; i++) {
+        const ps_mesh_range *rg = &m->ranges[i];
+        ps_aabb b = ps_aabb_empty();
+        for (size_t j = rg->first; j < rg->first + rg->count; j++) {
+            size_t v = m->shared ? m->shared[j] : j;
+            const float *q = m->positions + 3 * v;
+            b = ps_aabb_point(b, ps_v3(q[0], q[1], q[2]));
+        }
+        r->range_bounds[i] = b;
+    }
+    r->range_bounds_of = m->positions;
+}
+
 void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
 {
     ps_gl_begin_frame_shadows(r, cam, exposure, direct, r->opt.shadows);
@@ -132,6 +196,7 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
                                bool shadows)
 {
     r->stats.light_passes = 0;
+    r->stats.light_vertices = 0;
     if (direct && shadows && !r->shadows_valid)
         ps_gl_make_shadow_maps(r);
     r->width = cam->width;
@@ -241,6 +306,7 @@ ps_gl_scene ps_gl_scene_of(const ps_session *s)
 static void set_inputs(ps_gl_renderer *r, const ps_gl_scene *in)
 {
     r->in = *in;
+    make_range_bounds(r);
     r->scene_diag = ps_v3_len(ps_aabb_diag(in->bounds));
     if (!(r->scene_diag > 0.0) || !isfinite(r->scene_diag))
         r->scene_diag = 1.0;
@@ -290,6 +356,7 @@ void ps_gl_renderer_destroy(ps_gl_renderer *r)
         return;
     ps_gl_lights_free(r);
     ps_gl_albedo_free(r);
+    free(r->range_bounds);
     if (r->fbo)
         glDeleteFramebuffers(1, &r->fbo);
     if (r->kernel_tex)

@@ -48,6 +48,9 @@ typedef struct ps_gl_options {
     bool shadows;      /* default true */
     bool float_buffer; /* the colour buffer keeps floats: no clamping anywhere */
     int shadow_size;   /* shadow maps' side in texels; 0: PS_GL_SHADOW_SIZE */
+    bool whole_face_passes; /* tests: every object in every shadowed face's lit
+                             * pass (default false: those outside the face's
+                             * pyramid are left out, the same pixels) */
 } ps_gl_options;
 
 /* What the renderer draws, prepared GL-free; everything pointed to must
@@ -168,6 +171,7 @@ ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const doub
  * caller last reset them with ps_gl_clear_shadow_timing). */
 typedef struct ps_gl_stats {
     unsigned shadow_maps, light_passes, virtual_lights;
+    uint64_t light_vertices; /* vertices the lit passes of the last frame drew */
     unsigned shadow_faces_last;
     double shadow_seconds_last;
 } ps_gl_stats;
