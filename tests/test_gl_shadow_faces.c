@@ -99,20 +99,43 @@ static void apply(ps_scene *s, edit_kind e)
     }
 }
 
+/* A scene with a float OSMesa context current and the box kernel. */
+typedef struct gl_rig {
+    ps_scene *s;
+    float *buffer;
+    OSMesaContext ctx;
+    ps_kernel_texture kernel;
+} gl_rig;
+
+static gl_rig gl_rig_open(const char *text)
+{
+    gl_rig g;
+    ps_error err;
+    if (ps_scene_load_text(text, "inline.scn", "", NULL, &g.s, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    g.buffer = malloc(sizeof(float) * 4 * W * H);
+    g.ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    assert_non_null(g.ctx);
+    assert_true(OSMesaMakeCurrent(g.ctx, g.buffer, GL_FLOAT, W, H));
+    assert_int_equal(ps_kernel_texture_make(PS_KERNEL_BOX, PS_KERNEL_TEXTURE_SIZE, &g.kernel, &err), PS_OK);
+    return g;
+}
+
+static void gl_rig_close(gl_rig *g)
+{
+    ps_kernel_texture_free(&g->kernel);
+    OSMesaDestroyContext(g->ctx);
+    free(g->buffer);
+    ps_scene_destroy(g->s);
+}
+
 /* One edit: the faces the renderer rendered again, and its picture against
  * a fresh renderer's of the edited scene. */
 static void edit_renders(edit_kind e, unsigned expect_faces, bool picture_changes)
 {
     ps_error err;
-    ps_scene *s;
-    if (ps_scene_load_text(scene_text, "inline.scn", "", NULL, &s, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    float *buffer = malloc(sizeof(float) * 4 * W * H);
-    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    assert_non_null(ctx);
-    assert_true(OSMesaMakeCurrent(ctx, buffer, GL_FLOAT, W, H));
-    ps_kernel_texture kernel;
-    assert_int_equal(ps_kernel_texture_make(PS_KERNEL_BOX, PS_KERNEL_TEXTURE_SIZE, &kernel, &err), PS_OK);
+    gl_rig g = gl_rig_open(scene_text);
+    ps_scene *s = g.s;
     ps_gl_options go = {true, true, 0, false};
 
     inputs before;
@@ -122,7 +145,7 @@ static void edit_renders(edit_kind e, unsigned expect_faces, bool picture_change
     assert_int_equal(lit, 6); /* a point light: the whole cube */
     ps_gl_scene gs = gl_scene(s, &before);
     ps_gl_renderer *r;
-    assert_int_equal(ps_gl_renderer_create(&gs, &kernel, &go, &r, &err), PS_OK);
+    assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &r, &err), PS_OK);
     ps_gl_clear_shadow_timing(r);
     ps_image old_pic = draw(r, s);
     assert_int_equal(ps_gl_get_stats(r).shadow_faces_last, 6);
@@ -139,7 +162,7 @@ static void edit_renders(edit_kind e, unsigned expect_faces, bool picture_change
     unsigned faces = ps_gl_get_stats(r).shadow_faces_last;
 
     ps_gl_renderer *fresh;
-    assert_int_equal(ps_gl_renderer_create(&gs, &kernel, &go, &fresh, &err), PS_OK);
+    assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &fresh, &err), PS_OK);
     ps_gl_clear_shadow_timing(fresh);
     ps_image fresh_pic = draw(fresh, s);
     assert_int_equal(ps_gl_get_stats(fresh).shadow_faces_last, 6);
@@ -163,10 +186,7 @@ static void edit_renders(edit_kind e, unsigned expect_faces, bool picture_change
     ps_gl_renderer_destroy(fresh);
     ps_gl_renderer_destroy(r);
     inputs_free(&after);
-    ps_kernel_texture_free(&kernel);
-    OSMesaDestroyContext(ctx);
-    free(buffer);
-    ps_scene_destroy(s);
+    gl_rig_close(&g);
 }
 
 static void occluder_moved_a_little(void **state)
@@ -206,15 +226,8 @@ static void culled_faces_draw_the_same(void **state)
     const char *texts[2] = {scene_text, box};
     for (int t = 0; t < 2; t++) {
         ps_error err;
-        ps_scene *s;
-        if (ps_scene_load_text(texts[t], "inline.scn", "", NULL, &s, &err) != PS_OK)
-            fail_msg("scene: %s", err.msg);
-        float *buffer = malloc(sizeof(float) * 4 * W * H);
-        OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-        assert_non_null(ctx);
-        assert_true(OSMesaMakeCurrent(ctx, buffer, GL_FLOAT, W, H));
-        ps_kernel_texture kernel;
-        assert_int_equal(ps_kernel_texture_make(PS_KERNEL_BOX, PS_KERNEL_TEXTURE_SIZE, &kernel, &err), PS_OK);
+        gl_rig g = gl_rig_open(texts[t]);
+        ps_scene *s = g.s;
         inputs in;
         inputs_make(s, &in);
         ps_gl_scene gs = gl_scene(s, &in);
@@ -223,7 +236,7 @@ static void culled_faces_draw_the_same(void **state)
         for (int whole = 0; whole < 2; whole++) {
             ps_gl_options go = {true, true, 0, whole != 0};
             ps_gl_renderer *r;
-            assert_int_equal(ps_gl_renderer_create(&gs, &kernel, &go, &r, &err), PS_OK);
+            assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &r, &err), PS_OK);
             pic[whole] = draw(r, s);
             vertices[whole] = ps_gl_get_stats(r).light_vertices;
             ps_gl_renderer_destroy(r);
@@ -238,10 +251,7 @@ static void culled_faces_draw_the_same(void **state)
         ps_image_destroy(&pic[0]);
         ps_image_destroy(&pic[1]);
         inputs_free(&in);
-        ps_kernel_texture_free(&kernel);
-        OSMesaDestroyContext(ctx);
-        free(buffer);
-        ps_scene_destroy(s);
+        gl_rig_close(&g);
     }
 }
 

@@ -93,17 +93,24 @@ static void assert_same_maps(const ps_photon_map *a, const ps_photon_map *b)
     }
 }
 
+/* maps against a fresh trace of scene to these caps: photon for photon. */
+static void equals_fresh(const ps_photon_map *maps, const ps_scene *scene, uint64_t caustic_cap,
+                         uint64_t global_cap)
+{
+    ps_photon_map fresh[PS_MAP_COUNT];
+    fresh_trace(scene, fresh, caustic_cap, global_cap);
+    assert_same_maps(maps, fresh);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_photon_map_free(&fresh[k]);
+}
+
 /* The session's maps, traced on to their caps, against a fresh trace of the
  * (edited) scene: photon for photon. */
 static void traced_equals_fresh(ps_session *s, const ps_scene *scene)
 {
     ps_error err;
     assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
-    ps_photon_map fresh[PS_MAP_COUNT];
-    fresh_trace(scene, fresh, CAUSTIC_CAP, GLOBAL_CAP);
-    assert_same_maps(ps_session_maps(s), fresh);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_free(&fresh[k]);
+    equals_fresh(ps_session_maps(s), scene, CAUSTIC_CAP, GLOBAL_CAP);
 }
 
 typedef enum edit_kind { MOVE_POINT, MOVE_SPOT, MOVE_MIRROR, MOVE_GLASS, MOVE_FLOOR, POWER, ANGLE, EDIT_KINDS } edit_kind;
@@ -420,12 +427,8 @@ static int refresh_until_settled(ps_session *s, const ps_camera_frame *cam, bool
  * against a fresh trace of scene. */
 static void shown_equals_fresh(ps_session *s, const ps_scene *scene)
 {
-    ps_photon_map fresh[PS_MAP_COUNT];
-    fresh_trace(scene, fresh, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
-    assert_same_maps(ps_session_lock_maps(s), fresh);
+    equals_fresh(ps_session_lock_maps(s), scene, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
     ps_session_unlock_maps(s);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_free(&fresh[k]);
 }
 
 /* A repair left to the tracing thread (retrace_first 0: as one of more than
@@ -751,6 +754,48 @@ static ps_feed *edit_and_repair(ps_scene *scene, ps_feed *old, const stage *was_
     return f;
 }
 
+/* Feed f traced on to its caps against a fresh trace of scene (the shown caps). */
+static void run_equals_fresh(ps_feed *f, const ps_scene *scene)
+{
+    ps_error err;
+    assert_int_equal(ps_feed_run(f, &err), PS_OK);
+    equals_fresh(ps_feed_maps(f), scene, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
+}
+
+/* A feed of the shown caps traced `rounds` rounds (all: -1), then the
+ * mirror moved 10 cm and that feed repaired onto the edited scene's stage g1. */
+static ps_feed *first_repair(ps_scene *scene, int rounds, stage *g1)
+{
+    stage g0 = stage_make(scene);
+    const uint64_t caps[PS_MAP_COUNT] = {SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP};
+    const bool active[PS_MAP_COUNT] = {true, true};
+    ps_feed *f0;
+    ps_error err;
+    assert_int_equal(ps_feed_create(g0.tracer, caps, active, &f0, &err), PS_OK);
+    if (rounds < 0)
+        assert_int_equal(ps_feed_run(f0, &err), PS_OK);
+    for (int r = 0; r < rounds; r++)
+        assert_int_equal(ps_feed_prime(f0, &err), PS_OK);
+    ps_feed *f1 = edit_and_repair(scene, f0, &g0, g1, ps_v3(0.1, 0, 0));
+    ps_feed_destroy(f0);
+    stage_free(&g0);
+    return f1;
+}
+
+/* The mirror moved again and f1 repaired onto it; traced on, a fresh
+ * trace's. Frees everything, the scene too. */
+static void second_repair_equals_fresh(ps_scene *scene, ps_feed *f1, stage *g1)
+{
+    stage g2;
+    ps_feed *f2 = edit_and_repair(scene, f1, g1, &g2, ps_v3(-0.05, 0, 0.05));
+    ps_feed_destroy(f1);
+    stage_free(g1);
+    run_equals_fresh(f2, scene);
+    ps_feed_destroy(f2);
+    stage_free(&g2);
+    ps_scene_destroy(scene);
+}
+
 /* An edit while the last repair's map is still in its repair order (kept
  * run, retraced run, then photons traced past the repair: nothing merged,
  * as ps_feed_stop_unmerged leaves it for an update): the repair reads each
@@ -759,18 +804,9 @@ static void a_repair_reads_the_repair_order(void **state)
 {
     (void)state;
     ps_scene *scene = load();
-    stage g0 = stage_make(scene);
-    const uint64_t caps[PS_MAP_COUNT] = {SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP};
-    const bool active[PS_MAP_COUNT] = {true, true};
-    ps_feed *f0;
-    ps_error err;
-    assert_int_equal(ps_feed_create(g0.tracer, caps, active, &f0, &err), PS_OK);
-    for (int r = 0; r < 2; r++) /* half the caps: the repair has indices past it to trace */
-        assert_int_equal(ps_feed_prime(f0, &err), PS_OK);
     stage g1;
-    ps_feed *f1 = edit_and_repair(scene, f0, &g0, &g1, ps_v3(0.1, 0, 0));
-    ps_feed_destroy(f0);
-    stage_free(&g0);
+    ps_feed *f1 = first_repair(scene, 2, &g1); /* half the caps: the repair has indices past it to trace */
+    ps_error err;
     const size_t all[PS_MAP_COUNT] = {SIZE_MAX, SIZE_MAX};
     assert_int_equal(ps_feed_repair_ahead(f1, all, &err), PS_OK);
     ps_feed_repair_count rc = ps_feed_repair_counts(f1);
@@ -780,19 +816,7 @@ static void a_repair_reads_the_repair_order(void **state)
     for (int r = 0; r < 3; r++)
         assert_int_equal(ps_feed_prime(f1, &err), PS_OK);
     assert_true(ps_feed_maps(f1)[PS_MAP_CAUSTIC].count > before);
-    stage g2;
-    ps_feed *f2 = edit_and_repair(scene, f1, &g1, &g2, ps_v3(-0.05, 0, 0.05));
-    ps_feed_destroy(f1);
-    stage_free(&g1);
-    assert_int_equal(ps_feed_run(f2, &err), PS_OK);
-    ps_photon_map fresh[PS_MAP_COUNT];
-    fresh_trace(scene, fresh, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
-    assert_same_maps(ps_feed_maps(f2), fresh);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_free(&fresh[k]);
-    ps_feed_destroy(f2);
-    stage_free(&g2);
-    ps_scene_destroy(scene);
+    second_repair_equals_fresh(scene, f1, &g1);
 }
 
 /* A second edit before the thread has tested the first repair's paths (a
@@ -803,41 +827,22 @@ static void an_edit_mid_repair_retraces_the_untested(void **state)
 {
     (void)state;
     ps_scene *scene = load();
-    stage g0 = stage_make(scene);
-    const uint64_t caps[PS_MAP_COUNT] = {SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP};
-    const bool active[PS_MAP_COUNT] = {true, true};
-    ps_feed *f0;
-    ps_error err;
-    assert_int_equal(ps_feed_create(g0.tracer, caps, active, &f0, &err), PS_OK);
-    assert_int_equal(ps_feed_run(f0, &err), PS_OK);
     stage g1;
-    ps_feed *f1 = edit_and_repair(scene, f0, &g0, &g1, ps_v3(0.1, 0, 0));
-    ps_feed_destroy(f0);
-    stage_free(&g0);
+    ps_feed *f1 = first_repair(scene, -1, &g1);
+    ps_error err;
     /* Only the first batch of indices tested, as for a first picture. */
     const size_t ahead[PS_MAP_COUNT] = {1, 1};
     assert_int_equal(ps_feed_repair_ahead(f1, ahead, &err), PS_OK);
     size_t tested_photons = ps_feed_maps(f1)[PS_MAP_CAUSTIC].count;
     assert_true(tested_photons > 0);
-    stage g2;
-    ps_feed *f2 = edit_and_repair(scene, f1, &g1, &g2, ps_v3(-0.05, 0, 0.05));
-    /* f1's counts: every untested index retraced, its kept photons only
-     * the tested ones'. */
+    /* Stopped as an update stops it: every untested index retraced, the
+     * kept photons only the tested ones'. */
+    ps_feed_stop_unmerged(f1);
     ps_feed_repair_count rc = ps_feed_repair_counts(f1);
     assert_int_equal(rc.kept[PS_MAP_CAUSTIC] + rc.retraced[PS_MAP_CAUSTIC], SHOWN_CAUSTIC_CAP);
     assert_true(rc.retraced[PS_MAP_CAUSTIC] >= SHOWN_CAUSTIC_CAP - PS_FEED_BATCH);
     assert_int_equal(rc.kept_photons[PS_MAP_CAUSTIC], tested_photons);
-    ps_feed_destroy(f1);
-    stage_free(&g1);
-    assert_int_equal(ps_feed_run(f2, &err), PS_OK);
-    ps_photon_map fresh[PS_MAP_COUNT];
-    fresh_trace(scene, fresh, SHOWN_CAUSTIC_CAP, SHOWN_GLOBAL_CAP);
-    assert_same_maps(ps_feed_maps(f2), fresh);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        ps_photon_map_free(&fresh[k]);
-    ps_feed_destroy(f2);
-    stage_free(&g2);
-    ps_scene_destroy(scene);
+    second_repair_equals_fresh(scene, f1, &g1);
 }
 
 int main(void)

@@ -110,15 +110,22 @@ static void one_map(rig *a, rig *b, ps_map_kind k, uint64_t n, double frac)
     traced_free(&tb);
 }
 
+/* A tracer that records paths, as a repairing session's. */
+static ps_tracer_options record_options(void)
+{
+    ps_tracer_options o = ps_tracer_default_options();
+    o.seed = 5;
+    o.threads = 2;
+    o.records = true;
+    return o;
+}
+
 /* The spot twice as bright: both lights' shares change, no path does. */
 static void paths_survive_a_share_change(void **state)
 {
     (void)state;
     char ta[2048], tb[2048];
-    ps_tracer_options o = ps_tracer_default_options();
-    o.seed = 5;
-    o.threads = 2;
-    o.records = true;
+    ps_tracer_options o = record_options();
     rig a = rig_make(scene_text(ta, sizeof ta, "60 50 40"), "", &o, PS_ACCEL_AUTO);
     ps_aabb box = ps_scene_bounds(a.scene);
     box.lo = ps_v3_sub(box.lo, ps_v3(2, 2, 2));
@@ -207,10 +214,7 @@ static void sources_in_parts(void **state)
 {
     (void)state;
     char ta[2048], tb[2048];
-    ps_tracer_options o = ps_tracer_default_options();
-    o.seed = 5;
-    o.threads = 2;
-    o.records = true;
+    ps_tracer_options o = record_options();
     rig a = rig_make(scene_text(ta, sizeof ta, "60 50 40"), "", &o, PS_ACCEL_AUTO);
     rig b = rig_make(scene_text(tb, sizeof tb, "120 100 80"), "", &o, PS_ACCEL_AUTO);
     rig same = rig_make(scene_text(tb, sizeof tb, "60 50 40"), "", &o, PS_ACCEL_AUTO);
