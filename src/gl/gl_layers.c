@@ -379,7 +379,9 @@ void ps_gl_layers_warm_up(ps_gl_layers *l)
     int w = l->view_w, h = l->view_h;
     l->view_w = l->width > 1 ? l->width / 2 : 1;
     l->view_h = l->height > 1 ? l->height / 2 : 1;
-    const double gains[PS_MAP_COUNT] = {1.0, 1.0};
+    double gains[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        gains[k] = 1.0;
     ps_gl_layers_show(l, 1.0, gains);
     glFinish();
     l->view_w = w, l->view_h = h;

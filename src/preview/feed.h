@@ -120,13 +120,15 @@ typedef struct ps_feed_repair_fns {
  * not fail or end at the store limit. */
 bool ps_feed_repairable(const ps_feed *f);
 /* The new feed, on tracer t (the edited scene's), from old (stopped and
- * repairable; left empty, to be destroyed): photon i of the edited scene is
- * the old photon its source names when its path is clear of the moved boxes
- * (its power set anew, ps_tracer_repower), else retraced. The call finds
- * the sources only: the paths are tested and the kept photons copied by
- * ps_feed_repair_ahead for what the first picture draws, the rest by the
- * thread (or run, or a merge) before it retraces anything. On an error
- * old's maps may be lost: start a new feed from photon 0. */
+ * repairable, its maps in index order or in a repair's order; left empty,
+ * to be destroyed): photon i of the edited scene is the old photon its
+ * source names when its path is clear of the moved boxes (its power set
+ * anew, ps_tracer_repower), else retraced; a map none of whose photons has
+ * a source starts over from photon 0. The call makes the sources' tables
+ * only: the sources are found, the paths tested and the kept photons
+ * copied by ps_feed_repair_ahead for what the first picture draws, the
+ * rest by the thread (or run, or a merge) before it retraces anything. On
+ * an error old's maps may be lost: start a new feed from photon 0. */
 ps_status ps_feed_create_repair(ps_tracer *t, ps_feed *old, const ps_feed_repair_fns *fns, ps_feed **out,
                                 ps_error *err);
 /* Before run, prime or start: map k's repair carried on, a batch of indices
