@@ -16,6 +16,7 @@
 #include "app/pace.h"
 #include "app/stats.h"
 #include "core/fileio.h"
+#include "core/memory.h"
 #include "gl/gl_render.h"
 #include "gl/gl_specular.h"
 #include "image/exr_io.h"
@@ -937,6 +938,7 @@ static ps_status check_prefixed_outputs(const snap_options *o, ps_error *err)
 
 int main(int argc, char **argv)
 {
+    ps_memory_map_large_blocks(); /* a script's session, as the window's (core/memory.h) */
     ps_error err;
     ps_error_clear(&err);
     snap_options o;

@@ -20,6 +20,7 @@
 #include "app/stats.h"
 #include "app/workfile.h"
 #include "core/fileio.h"
+#include "core/memory.h"
 #include "gl/gl_font.h"
 #include "gl/gl_render.h"
 #include "gl/gl_specular.h"
@@ -1193,6 +1194,7 @@ static ps_status write_stats(app *a, ps_error *err)
 int main(int argc, char **argv)
 {
     static app a; /* large, and the callbacks reach it through the window */
+    ps_memory_map_large_blocks(); /* a long session's memory stays flat (core/memory.h) */
     ps_error err;
     ps_error_clear(&err);
     bool help = false;

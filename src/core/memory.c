@@ -4,9 +4,20 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #define BYTES_PER_MIB (1024.0 * 1024.0)
 #define BYTES_PER_GIB (1024.0 * BYTES_PER_MIB)
+
+void ps_memory_map_large_blocks(void)
+{
+#ifdef __GLIBC__
+    /* Setting it turns glibc's own adjustment of it off. */
+    (void)mallopt(M_MMAP_THRESHOLD, PS_MEMORY_MAP_THRESHOLD);
+#endif
+}
 
 int ps_memory_parse_size(const char *text, uint64_t *out)
 {
