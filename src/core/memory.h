@@ -43,7 +43,7 @@ ps_status ps_memory_check(uint64_t bytes, const char *who, const char *what, ps_
  * from the heap and stayed there: `make soak`'s resident memory grew 10-15
  * MiB over 187 s (limit 12.5) with the repair's arrays of 2026-12-03, 1.4
  * MiB with the threshold fixed, at the cost of first-touch faults on each
- * new large block (a move's update 0.027-0.036 -> 0.029-0.049 s at 10^6 photons).
+ * new large block (a move's update 0.017-0.038 -> 0.029-0.049 s at 10^6 photons).
  * Elsewhere (no glibc) nothing. */
 #define PS_MEMORY_MAP_THRESHOLD (128 * 1024)
 void ps_memory_map_large_blocks(void);

@@ -421,6 +421,16 @@ static void count_range(void *arg, size_t job)
  * out of memory for the table. Jobs of granules on every core (an edit's
  * update waits for the new plan's: 10^6 indices, 9 ms on one core): the
  * same table for any thread count. */
+/* The plan's counts are those of `total` photons: each stratum's share of
+ * the power, 1 / its count. */
+static void set_counted(map_plan *p, uint64_t total)
+{
+    for (size_t k = 0; k < p->count; k++)
+        p->scale[k] = p->counts[k] ? 1.0 / (double)p->counts[k] : 0.0;
+    p->counted_total = total;
+    p->counted = true;
+}
+
 static bool count_strata(map_plan *p, uint64_t total, bool keep_seq)
 {
     if (p->counted && p->counted_total == total)
@@ -458,10 +468,7 @@ static bool count_strata(map_plan *p, uint64_t total, bool keep_seq)
     free(c.sums);
     if (total % RANK_GRANULE == 0)
         memcpy(prefix + (size_t)(total / RANK_GRANULE) * p->count, p->counts, p->count * sizeof *p->counts);
-    for (size_t k = 0; k < p->count; k++)
-        p->scale[k] = p->counts[k] ? 1.0 / (double)p->counts[k] : 0.0;
-    p->counted_total = total;
-    p->counted = true;
+    set_counted(p, total);
     return true;
 }
 
@@ -998,17 +1005,13 @@ static bool copy_counts(map_plan *pb, const map_plan *pa, uint64_t total, bool k
         memcpy(pb->seq, pa->seq, (size_t)total);
     }
     memcpy(pb->counts, pa->counts, pa->count * sizeof *pb->counts);
-    for (size_t k = 0; k < pb->count; k++)
-        pb->scale[k] = pb->counts[k] ? 1.0 / (double)pb->counts[k] : 0.0;
-    pb->counted_total = total;
-    pb->counted = true;
+    set_counted(pb, total);
     return true;
 }
 
 struct ps_source_map {
     const map_plan *pb; /* the edited scene's plan (its tracer outlives the map) */
     uint64_t end;
-    bool b_enabled;
     bool identity;      /* every source is its own index or none */
     bool none;          /* no index has a source */
     size_t *match;      /* b's stratum kb is a's match[kb] (SIZE_MAX: none) */
@@ -1050,7 +1053,7 @@ static void fill_range(const ps_source_map *m, uint64_t from, uint64_t to, ps_ph
                        uint64_t *count)
 {
     const map_plan *pb = m->pb;
-    if (!m->b_enabled) {
+    if (!pb->enabled) {
         for (uint64_t i = from; i < to; i++)
             out[i - from] = (ps_photon_source){PS_SOURCE_NONE, 0, UINT32_MAX, false};
         return;
@@ -1101,7 +1104,6 @@ ps_status ps_source_map_create(ps_tracer *a, ps_tracer *b, ps_map_kind kind, uin
                             (unsigned long long)end);
     m->pb = pb;
     m->end = end;
-    m->b_enabled = pb->enabled;
     m->none = true;
     if (!pb->enabled) {
         *out = m;
