@@ -420,6 +420,55 @@ static void memory_budget(void **state)
     ps_scene_destroy(s);
 }
 
+/* The moving camera's lit mesh (ps_mesh_moving_options): edges twice as
+ * long, so each flat face split the least that keeps them within that
+ * (ceil(n / 2) for n, about a quarter of the vertices), the same surfaces
+ * (each object's area, its ranges' objects and materials, in order) and the
+ * sphere exactly the fine mesh's, vertex for vertex: the depth prepass draws
+ * that tessellation, and a coarser one would lie behind it. Counted before
+ * building, as built. */
+static void moving_mesh(void **state)
+{
+    (void)state;
+    ps_scene *s = load(ROOM);
+    ps_mesh_options fine_o = ps_mesh_default_options(s), moving_o = ps_mesh_moving_options(&fine_o);
+    assert_near(moving_o.max_edge, PS_MESH_MOVING_EDGE_SCALE * fine_o.max_edge, 0.0);
+    assert_near(moving_o.sphere_tolerance, fine_o.sphere_tolerance, 0.0);
+    ps_preview_mesh fine = build(s, fine_o.max_edge), moving = build(s, moving_o.max_edge);
+    assert_int_equal(ps_preview_mesh_vertex_count(s, &fine_o), fine.vertex_count);
+    assert_int_equal(ps_preview_mesh_vertex_count(s, &moving_o), moving.vertex_count);
+    printf("moving mesh: %zu vertices of the fine mesh's %zu\n", moving.vertex_count, fine.vertex_count);
+    for (uint32_t obj = 0; obj < OBJECTS; obj++) {
+        size_t flo, fhi, mlo, mhi;
+        object_span(&fine, obj, &flo, &fhi);
+        object_span(&moving, obj, &mlo, &mhi);
+        double fa = span_area(&fine, flo, fhi), ma = span_area(&moving, mlo, mhi);
+        assert_near(ma, fa, FLOAT_TOL * fa);
+        for (size_t t = mlo / 3; t < mhi / 3; t++)
+            assert_true(longest_edge(&moving, t) <= moving_o.max_edge * (1.0 + EDGE_SLACK));
+        if (obj == SPHERE) {
+            assert_int_equal(mhi - mlo, fhi - flo);
+            assert_memory_equal(moving.positions + 3 * mlo, fine.positions + 3 * flo, 3 * sizeof(float) * (fhi - flo));
+        }
+    }
+    /* The floor (2 x 2, its diagonal 2.83 the longest edge): n x n pieces
+     * each side at the fine edge, ceil(n / 2) at the moving one. */
+    size_t flo, fhi, mlo, mhi;
+    object_span(&fine, FLOOR, &flo, &fhi);
+    object_span(&moving, FLOOR, &mlo, &mhi);
+    size_t n = (size_t)ceil(sqrt(8.0) / fine_o.max_edge), half = (n + 1) / 2;
+    assert_int_equal(fhi - flo, 2 * 3 * n * n);
+    assert_int_equal(mhi - mlo, 2 * 3 * half * half);
+    assert_int_equal(moving.range_count, fine.range_count);
+    for (size_t r = 0; r < fine.range_count; r++) {
+        assert_int_equal(moving.ranges[r].object, fine.ranges[r].object);
+        assert_int_equal(moving.ranges[r].material, fine.ranges[r].material);
+    }
+    ps_preview_mesh_free(&fine);
+    ps_preview_mesh_free(&moving);
+    ps_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -427,6 +476,7 @@ int main(void)
         cmocka_unit_test(split_limits),
         cmocka_unit_test(defaults_and_errors),
         cmocka_unit_test(memory_budget),
+        cmocka_unit_test(moving_mesh),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

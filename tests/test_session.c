@@ -456,6 +456,51 @@ static void moving_growth_held(void **state)
     ps_scene_destroy(scene);
 }
 
+/* While the camera moves the global map's layer is drawn at half the view's
+ * pixels (ps_session_layer.shrink) where its triangle splats grew 2x (their
+ * pixels then as many as a full-detail splat's), never the caustic layer;
+ * not when the growth is less (few photons arrived: the level of detail
+ * draws most of them), nor for points, nor once the camera is still. The
+ * lit mesh while moving is the lighter one only in incremental sessions. */
+static void moving_global_layer_shrunk(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    for (int pass = 0; pass < 3; pass++) {
+        /* 0: triangles, 9 batches of global photons (sqrt(9) > 2); 1: the
+         * same as points; 2: triangles, as many global photons as one
+         * batch of the caustic's share draws (no growth). */
+        ps_session_settings set = settings(scene, true);
+        set.caps[PS_MAP_CAUSTIC] = 9 * PS_FEED_BATCH;
+        set.caps[PS_MAP_GLOBAL] = pass == 2 ? 1024 : 9 * PS_FEED_BATCH;
+        set.splat = pass == 1 ? PS_SPLAT_POINTS : PS_SPLAT_TRIANGLES;
+        ps_camera_frame cam;
+        ps_session_frame f;
+        ps_session *s = start_and_refresh(scene, &set, &cam, &f);
+        assert_true(ps_session_moving_mesh(s)->vertex_count < ps_session_mesh(s)->vertex_count);
+        ps_session_drawn(s, 100.0);
+        wait_ended(s);
+        cam.eye.x += 0.05;
+        refresh(s, &cam, &f);
+        assert_true(f.moving && !f.edit_lod);
+        double growth = f.map[PS_MAP_GLOBAL].radius / set.radius[PS_MAP_GLOBAL];
+        assert_true(pass == 2 ? growth < PS_SESSION_MOVING_GLOBAL_SHRINK : growth >= PS_SESSION_MOVING_GLOBAL_SHRINK);
+        assert_int_equal(f.map[PS_MAP_GLOBAL].shrink, pass == 0 ? PS_SESSION_MOVING_GLOBAL_SHRINK : 1);
+        assert_int_equal(f.map[PS_MAP_CAUSTIC].shrink, 1);
+        refresh(s, &cam, &f); /* still */
+        assert_false(f.moving);
+        assert_int_equal(f.map[PS_MAP_GLOBAL].shrink, 1);
+        assert_int_equal(f.map[PS_MAP_CAUSTIC].shrink, 1);
+        ps_session_destroy(s);
+    }
+    /* Whole refreshes draw no level of detail: no second mesh. */
+    ps_session_settings set = settings(scene, false);
+    ps_session *s = open_session(scene, &set);
+    assert_ptr_equal(ps_session_moving_mesh(s), ps_session_mesh(s));
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 /* A splat as bytes: its vertices' positions and its colour (the same on each
  * vertex), for comparing splat sets whatever their order. */
 enum { SPLAT_RECORD_FLOATS = 3 * 3 + 4 };
@@ -592,6 +637,7 @@ int main(void)
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(moving_camera_level_of_detail),
         cmocka_unit_test(moving_growth_held),
+        cmocka_unit_test(moving_global_layer_shrunk),
         cmocka_unit_test(after_the_stop_converges_to_the_whole_view),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -70,7 +70,7 @@ bool ps_gl_has_albedo(const ps_gl_renderer *r) { return r->albedo_count > 0; }
 /* multiply: into what is there (dst = dst * T), else replacing it. */
 static void draw(const ps_gl_renderer *r, bool multiply)
 {
-    const ps_preview_mesh *m = r->in.mesh;
+    const ps_preview_mesh *m = r->lit; /* the frame's lit surfaces: the same texture coordinates */
     if (!r->albedo_count || !m->texcoords)
         return;
     glDisable(GL_LIGHTING);

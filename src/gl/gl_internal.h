@@ -10,6 +10,9 @@
 
 struct ps_gl_renderer {
     ps_gl_scene in;
+    /* The mesh this frame's lit passes draw: in.mesh, or in.moving for a
+     * moving camera's level of detail (ps_gl_begin_frame_shadows). */
+    const ps_preview_mesh *lit;
     ps_gl_options opt;
     int shadow_size;
     /* shadow[i][f]: GL light i's depth texture of cube face f (0: none yet). */
@@ -98,9 +101,11 @@ void ps_gl_make_shadow_maps(ps_gl_renderer *r);
  * faces; shadows: through the shadow cubes (else one pass a light). */
 void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows);
 /* ps_gl_begin_frame with the shadows said here instead of by the options
- * (the window's moving camera draws without them). */
+ * (the window's moving camera draws without them), and moving: the lit
+ * passes (and the texture factor) on the scene's moving mesh (in.moving),
+ * a moving camera's level of detail. */
 void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
-                               bool shadows);
+                               bool shadows, bool moving);
 /* Area lights as the eye sees them, in their radiance times exposure, or
  * black when the direct layer is off. */
 void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct);

@@ -96,7 +96,7 @@ static bool box_clipped(ps_aabb b, const double p[4])
 static void draw_ranges(const ps_gl_renderer *r, bool with_materials, bool stencil, const double (*planes)[4],
                         int plane_count, uint64_t *vertices)
 {
-    const ps_preview_mesh *m = with_materials ? r->in.mesh : r->in.coarse;
+    const ps_preview_mesh *m = with_materials ? r->lit : r->in.coarse;
     bool cull = planes && with_materials && r->range_bounds && r->range_bounds_of == m->positions &&
                 !r->opt.whole_face_passes;
     glEnableClientState(GL_VERTEX_ARRAY);
@@ -189,12 +189,13 @@ static void make_range_bounds(ps_gl_renderer *r)
 
 void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
 {
-    ps_gl_begin_frame_shadows(r, cam, exposure, direct, r->opt.shadows);
+    ps_gl_begin_frame_shadows(r, cam, exposure, direct, r->opt.shadows, false);
 }
 
 void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
-                               bool shadows)
+                               bool shadows, bool moving)
 {
+    r->lit = moving && r->in.moving ? r->in.moving : r->in.mesh;
     r->stats.light_passes = 0;
     r->stats.light_vertices = 0;
     if (direct && shadows && !r->shadows_valid)
@@ -299,13 +300,15 @@ ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err)
 ps_gl_scene ps_gl_scene_of(const ps_session *s)
 {
     ps_gl_scene in = {ps_session_mesh(s), ps_session_coarse_mesh(s), ps_session_materials(s), ps_session_lights(s),
-                      ps_scene_bounds(ps_session_scene(s)), ps_session_illuminance(s), ps_session_scene(s)};
+                      ps_scene_bounds(ps_session_scene(s)), ps_session_illuminance(s), ps_session_scene(s),
+                      ps_session_moving_mesh(s)};
     return in;
 }
 
 static void set_inputs(ps_gl_renderer *r, const ps_gl_scene *in)
 {
     r->in = *in;
+    r->lit = in->mesh;
     make_range_bounds(r);
     r->scene_diag = ps_v3_len(ps_aabb_diag(in->bounds));
     if (!(r->scene_diag > 0.0) || !isfinite(r->scene_diag))

@@ -63,6 +63,8 @@ typedef struct ps_gl_scene {
     ps_aabb bounds;                  /* of geometry and lights: near and far planes */
     bool hide_emitters;              /* look through emitters (illuminance mode) */
     const ps_scene *scene;           /* its textures (map_Kd), uploaded once; NULL: none */
+    const ps_preview_mesh *moving;   /* lit passes while the camera moves (ps_session_moving_mesh);
+                                      * NULL: the fine one */
 } ps_gl_scene;
 
 /* A session's meshes, lights and materials as they stand (its illuminance

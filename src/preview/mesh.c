@@ -31,6 +31,13 @@ ps_mesh_options ps_mesh_default_options(const ps_scene *s)
     return o;
 }
 
+ps_mesh_options ps_mesh_moving_options(const ps_mesh_options *fine)
+{
+    ps_mesh_options o = *fine;
+    o.max_edge *= PS_MESH_MOVING_EDGE_SCALE;
+    return o;
+}
+
 static bool reserve(builder *b, size_t vertices)
 {
     size_t need = b->m->vertex_count + vertices;
@@ -215,6 +222,11 @@ static bool share_vertices(ps_preview_mesh *m)
     }
     free(table);
     return true;
+}
+
+uint64_t ps_preview_mesh_vertex_count(const ps_scene *s, const ps_mesh_options *o)
+{
+    return count_vertices(s, o, o->max_edge > 0.0 ? o->max_edge : 1.0);
 }
 
 ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_preview_mesh *out, ps_error *err)

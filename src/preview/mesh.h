@@ -62,6 +62,20 @@ typedef struct ps_mesh_options {
  * tessellation default. */
 ps_mesh_options ps_mesh_default_options(const ps_scene *s);
 
+/* The lit mesh of a moving camera's level of detail (preview/session.h):
+ * flat faces cut with edges PS_MESH_MOVING_EDGE_SCALE times longer, a
+ * quarter of their vertices (llvmpipe's lit passes are vertex-bound: the
+ * default scene's walls lit 10-13 ms a moving frame on the fine mesh, 3-4 ms
+ * on this one), for 4x the interpolation error, about 0.4 % at a twentieth
+ * of the light's height, in a picture drawn at half the pixels a side while
+ * it moves. Spheres as fine: the depth prepass draws their tessellation
+ * (the coarse mesh), and a coarser one would lie behind it, unlit. */
+#define PS_MESH_MOVING_EDGE_SCALE 2.0
+ps_mesh_options ps_mesh_moving_options(const ps_mesh_options *fine);
+
+/* The vertices ps_preview_mesh_build would make, counted without building. */
+uint64_t ps_preview_mesh_vertex_count(const ps_scene *s, const ps_mesh_options *o);
+
 /* Refuses (PS_ERR_LIMIT) a mesh that would not fit in the memory budget
  * (core/memory.h), counted before anything is allocated. */
 ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_preview_mesh *out, ps_error *err);

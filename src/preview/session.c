@@ -19,6 +19,10 @@ struct ps_session {
     ps_tracer *tracer;
     ps_feed *feed;
     ps_preview_mesh mesh, coarse;
+    /* The lit mesh while the camera moves (ps_mesh_moving_options): built
+     * for incremental sessions, the only ones with a level of detail, where
+     * it is lighter than the fine one; else empty and the fine one serves. */
+    ps_preview_mesh moving_mesh;
     ps_specular *spec;     /* the specular layer's lookups over mesh */
     ps_preview_lights lights;
     ps_kernel_texture kernel;
@@ -132,6 +136,7 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
     s->spec = NULL;
     ps_preview_mesh_free(&s->mesh);
     ps_preview_mesh_free(&s->coarse);
+    ps_preview_mesh_free(&s->moving_mesh);
     ps_status st = ps_world_create(s->scene, NULL, &s->world, err);
     ps_mesh_options mo = ps_mesh_default_options(s->scene);
     if (st == PS_OK)
@@ -148,6 +153,12 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
     if (st == PS_OK && ps_specular_cube_count(s->spec) == old_cubes)
         for (int c = 0; c < old_cubes; c++)
             ps_specular_set_lookup_centre(s->spec, c, looked[c]);
+    /* Where it saves a quarter of the vertices or more (a scene of small
+     * triangles, cut no further, would only hold a second copy). */
+    ps_mesh_options moving = ps_mesh_moving_options(&mo);
+    if (st == PS_OK && incremental(s) &&
+        4 * ps_preview_mesh_vertex_count(s->scene, &moving) <= 3 * (uint64_t)s->mesh.vertex_count)
+        st = ps_preview_mesh_build(s->scene, &moving, &s->moving_mesh, err);
     /* The scene's own triangles, not subdivided, for depth-only passes:
      * subdividing changes no depth, only how many vertices are lit. */
     mo.max_edge = HUGE_VAL;
@@ -312,6 +323,7 @@ void ps_session_destroy(ps_session *s)
     ps_specular_destroy(s->spec);
     ps_preview_mesh_free(&s->mesh);
     ps_preview_mesh_free(&s->coarse);
+    ps_preview_mesh_free(&s->moving_mesh);
     ps_preview_lights_free(&s->lights);
     ps_kernel_texture_free(&s->kernel);
     for (int k = 0; k < PS_MAP_COUNT; k++)
@@ -612,6 +624,9 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     const ps_photon_map *maps = ps_feed_maps(s->feed);
     if (out->new_view)
         s->lobe_drawn = 0;
+    double growth[PS_MAP_COUNT]; /* the level of detail's radius growth */
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        growth[k] = 1.0;
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
         if (k == PS_MAP_GLOBAL && s->imap) {
             if (s->set.layers & PS_LAYER_GLOBAL)
@@ -645,7 +660,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
             size_t nm;
             const ps_feed_mark *mk = ps_feed_marks(s->feed, (ps_map_kind)k, &nm);
             double arrived = nm ? (double)mk[nm - 1].emitted : (double)emitted;
-            s->splat_radius[k] *= fmin(PS_SESSION_MOVING_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
+            growth[k] = fmin(PS_SESSION_MOVING_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
+            s->splat_radius[k] *= growth[k];
         }
         p.radius = s->splat_radius[k];
         p.kernel_mean = s->kernel.mean;
@@ -711,6 +727,13 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         l->batch = &s->batch[k];
         l->radius = s->splat_radius[k];
         l->gain = !shown ? 0.0 : inc ? exposure(s) * (double)s->set.caps[k] / (double)out->emitted[k] : 1.0;
+        /* Fewer pixels only for a moving camera (an edit's level of detail
+         * is the picture of the edit), where the splats grew as much (their
+         * pixels then as many as at full detail) and are triangles (points
+         * and sprites are sized in pixels); not the illumination maps' lobes. */
+        bool shrunk = out->moving && !out->edit_lod && k == PS_MAP_GLOBAL && !s->imap && s->set.splat == PS_SPLAT_TRIANGLES &&
+                      growth[k] >= PS_SESSION_MOVING_GLOBAL_SHRINK;
+        l->shrink = shrunk ? PS_SESSION_MOVING_GLOBAL_SHRINK : 1;
     }
     if (out->imap_colors && out->map[PS_MAP_GLOBAL].gain == 0.0)
         out->imap_colors = NULL;
@@ -1056,6 +1079,10 @@ const ps_scene *ps_session_scene(const ps_session *s) { return s->scene; }
 const ps_world *ps_session_world(const ps_session *s) { return s->world; }
 const ps_preview_mesh *ps_session_mesh(const ps_session *s) { return &s->mesh; }
 const ps_preview_mesh *ps_session_coarse_mesh(const ps_session *s) { return &s->coarse; }
+const ps_preview_mesh *ps_session_moving_mesh(const ps_session *s)
+{
+    return s->moving_mesh.vertex_count > 0 ? &s->moving_mesh : &s->mesh;
+}
 const ps_preview_lights *ps_session_lights(const ps_session *s) { return &s->lights; }
 const ps_kernel_texture *ps_session_kernel(const ps_session *s) { return &s->kernel; }
 const ps_tracer *ps_session_tracer(const ps_session *s) { return s->tracer; }

@@ -72,6 +72,15 @@
  * specular objects) was most of a moving frame (0.11 s at 512^2 over 10^6
  * photons in the default scene, 95 % of it in llvmpipe's threads). */
 #define PS_SESSION_MOVING_SCALE 2
+/* ... and the global map's layer, as triangle splats grown this much or
+ * more, at 1/PS_SESSION_MOVING_GLOBAL_SHRINK of that view's pixels a side
+ * again (ps_session_layer.shrink): a splat grown 2x then covers as many of
+ * its pixels as a full-detail splat covers of the full view's, and the
+ * global map's wide splats (the default scene's r0 is 5x the caustic's)
+ * filled 7-25 ms of a moving frame at 256^2, llvmpipe's fill; the caustic
+ * layer keeps its pixels (its small splats cost their setup, not fill, and
+ * are the picture's sharp part). */
+#define PS_SESSION_MOVING_GLOBAL_SHRINK 2
 /* Once the camera stops, until the view is drawn in full again, a refresh
  * draws this much more than the budget (0.8 of tau at the default share of
  * 0.5 instead of half of it): the picture the user waits for comes back
@@ -215,6 +224,9 @@ typedef struct ps_session_layer {
     const ps_splat_batch *batch; /* splats to add (possibly none) */
     double radius;               /* the radius they were built with */
     double gain;                 /* the layer's weight in the composite (0: not shown) */
+    int shrink;                  /* drawn at 1/shrink of the view's pixels a side, scaled up in
+                                  * the composite (PS_SESSION_MOVING_GLOBAL_SHRINK; 1: all of
+                                  * them); read at a new view, kept until the next */
 } ps_session_layer;
 
 typedef struct ps_session_frame {
@@ -313,7 +325,7 @@ ps_status ps_session_restore_scene(ps_session *s, const ps_scene *snapshot, ps_e
 
 /* What ps_session_update rebuilt, for the drawing side to follow. */
 typedef struct ps_session_changes {
-    bool geometry; /* meshes are new (ps_session_mesh, _coarse_mesh); the lights always are */
+    bool geometry; /* meshes are new (ps_session_mesh, _coarse_mesh, _moving_mesh); the lights always are */
 } ps_session_changes;
 /* Whether edits wait for ps_session_update. */
 bool ps_session_edited(const ps_session *s);
@@ -334,6 +346,10 @@ const ps_scene *ps_session_scene(const ps_session *s);
 const ps_world *ps_session_world(const ps_session *s);
 const ps_preview_mesh *ps_session_mesh(const ps_session *s);        /* fine: lit passes */
 const ps_preview_mesh *ps_session_coarse_mesh(const ps_session *s); /* the scene's own triangles: depth only */
+/* Lit passes while the camera moves (mesh.h, ps_mesh_moving_options): the
+ * fine mesh where a lighter one would not save much, or in sessions that
+ * draw no level of detail (whole refreshes). */
+const ps_preview_mesh *ps_session_moving_mesh(const ps_session *s);
 const ps_preview_lights *ps_session_lights(const ps_session *s);
 const ps_kernel_texture *ps_session_kernel(const ps_session *s);
 const ps_tracer *ps_session_tracer(const ps_session *s);

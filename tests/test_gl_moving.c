@@ -1,0 +1,234 @@
+/* test_gl_moving.c: a moving camera's level of detail in the window's float
+ * layers (preview/session.h), where it departs from the full view's way of
+ * drawing:
+ *  - the global map's splats at half the view's pixels a side
+ *    (ps_session_layer.shrink), scaled up by the composite: inside a furnace
+ *    sphere (albedo 0.5, a point light at its centre) every pixel within 15 %
+ *    of the closed form rho^2 Phi / (4 pi^2 R^2 (1 - rho)) (a read past the
+ *    shrunk corner, of the black around it, would not be) and the picture's
+ *    mean within 1 % of the same frame drawn at the view's pixels;
+ *  - the direct layer lit on the moving mesh (mesh.h: a quarter of a flat
+ *    face's vertices): a floor under a low point light, where Gouraud
+ *    interpolation errs most, within 3 % a pixel and 0.5 % on the mean of the
+ *    same frame lit on the fine mesh, and its lit pass drawing exactly the
+ *    moving mesh's vertices. */
+#include "test.h"
+
+#include <GL/osmesa.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_render.h"
+#include "image/image.h"
+#include "preview/session.h"
+#include "scene/scene.h"
+
+#define SIDE 96
+#define EXPOSURE 0.4
+
+/* A closed cube of flat walls (albedo 0.5) lit from its centre, seen from
+ * inside toward a corner: splats lie in their wall's plane. */
+static const char *const CUBE = "camera eye 0.2 -0.1 0.5 target -1 -0.6 -1 fov 70\n"
+                                "material wall diffuse albedo 0.5 0.5 0.5\n"
+                                "quad corner -1 -1 -1 edge1 0 0 2 edge2 2 0 0 material wall\n"
+                                "quad corner -1 1 -1 edge1 2 0 0 edge2 0 0 2 material wall\n"
+                                "quad corner -1 -1 -1 edge1 2 0 0 edge2 0 2 0 material wall\n"
+                                "quad corner -1 -1 1 edge1 0 2 0 edge2 2 0 0 material wall\n"
+                                "quad corner -1 -1 -1 edge1 0 2 0 edge2 0 0 2 material wall\n"
+                                "quad corner 1 -1 -1 edge1 0 0 2 edge2 0 2 0 material wall\n"
+                                "light point position 0 0 0 power 100 100 100\n"
+                                "photons caustic 0 global 200000\n"
+                                "radius caustic 0.02 global 0.3\n";
+
+/* A 2 x 2 floor 0.4 under a point light, seen from above. */
+static const char *const FLOOR = "camera eye 0 2 1.2 target 0 0 0 fov 60\n"
+                                 "material white diffuse albedo 0.8 0.8 0.8\n"
+                                 "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
+                                 "light point position 0 0.4 0 power 10 10 10\n"
+                                 "photons caustic 0 global 2000\n";
+
+typedef struct rig {
+    ps_scene *scene;
+    ps_session *s;
+    OSMesaContext ctx;
+    uint8_t *buffer;
+    ps_camera_frame cam;
+} rig;
+
+static void rig_open(rig *g, const char *text, unsigned layers)
+{
+    ps_error err;
+    if (ps_scene_load_text(text, "moving.scn", "", NULL, &g->scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_session_settings set = ps_session_default_settings(g->scene);
+    set.threads = 2;
+    set.seed = 1;
+    set.float_buffer = true;
+    set.incremental = true;
+    set.exposure = EXPOSURE;
+    set.layers = layers;
+    if (ps_session_create(g->scene, &set, &g->s, &err) != PS_OK)
+        fail_msg("session: %s", err.msg);
+    assert_int_equal(ps_session_trace_all(g->s, &err), PS_OK);
+    g->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    assert_non_null(g->ctx);
+    g->buffer = malloc(4 * SIDE * SIDE);
+    assert_non_null(g->buffer);
+    assert_true(OSMesaMakeCurrent(g->ctx, g->buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
+    g->cam = ps_camera_frame_make(ps_scene_camera(g->scene), SIDE, SIDE);
+}
+
+static void rig_close(rig *g)
+{
+    OSMesaDestroyContext(g->ctx);
+    free(g->buffer);
+    ps_session_destroy(g->s);
+    ps_scene_destroy(g->scene);
+}
+
+static ps_gl_renderer *renderer(const ps_gl_scene *gs, ps_session *s)
+{
+    ps_gl_options go = {true, true, 0, false};
+    ps_gl_renderer *gl;
+    ps_error err;
+    assert_int_equal(ps_gl_renderer_create(gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
+    return gl;
+}
+
+/* Every photon drawn for the still camera, then one refresh with the camera
+ * moved a little: the level of detail, in *f (not drawn). */
+static void still_then_move(rig *g, ps_gl_layers *l, ps_gl_renderer *gl, ps_session_frame *f)
+{
+    ps_error err;
+    do {
+        assert_int_equal(ps_session_refresh(g->s, &g->cam, f, &err), PS_OK);
+        assert_false(f->moving);
+        ps_gl_layers_draw(l, gl, &g->cam, f);
+        ps_session_drawn(g->s, 0.01);
+    } while (!ps_session_settled(g->s));
+    g->cam.eye.x += 0.01;
+    assert_int_equal(ps_session_refresh(g->s, &g->cam, f, &err), PS_OK);
+    assert_true(f->moving && f->new_view && !f->edit_lod);
+    assert_int_equal(f->view.width, (SIDE + PS_SESSION_MOVING_SCALE - 1) / PS_SESSION_MOVING_SCALE);
+}
+
+static ps_image composite(ps_gl_layers *l, const ps_session_frame *f)
+{
+    double gains[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        gains[k] = f->map[k].gain;
+    ps_image img;
+    ps_error err;
+    assert_int_equal(ps_gl_layers_composite(l, f->direct_gain, gains, &img, &err), PS_OK);
+    return img;
+}
+
+static double image_mean(const ps_image *img)
+{
+    double sum = 0.0;
+    size_t n = 3 * (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n; i++)
+        sum += img->rgb[i];
+    return sum / (double)n;
+}
+
+static void global_layer_shrunk(void **state)
+{
+    (void)state;
+    rig g;
+    rig_open(&g, CUBE, PS_LAYER_GLOBAL);
+    ps_gl_scene gs = ps_gl_scene_of(g.s);
+    ps_gl_renderer *gl = renderer(&gs, g.s);
+    ps_gl_layers *l;
+    ps_error err;
+    assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &l, &err), PS_OK);
+    ps_session_frame f;
+    still_then_move(&g, l, gl, &f);
+    /* A batch of the 2 * 10^5 photons: its radius grown 2x, its layer shrunk. */
+    assert_int_equal(f.map[PS_MAP_GLOBAL].shrink, PS_SESSION_MOVING_GLOBAL_SHRINK);
+    assert_int_equal(f.map[PS_MAP_CAUSTIC].shrink, 1);
+    ps_gl_layers_draw(l, gl, &g.cam, &f);
+    ps_image shrunk = composite(l, &f);
+    /* The same frame at the view's pixels. */
+    f.map[PS_MAP_GLOBAL].shrink = 1;
+    ps_gl_layers_draw(l, gl, &g.cam, &f);
+    ps_image full = composite(l, &f);
+    /* Pixel by pixel against the view's pixels: the same but where the
+     * prepass taken down to half differs (within a shrunk pixel of a
+     * wall's edge, where splats in one wall's plane are cut by the next). */
+    size_t n = 3 * (size_t)SIDE * SIDE;
+    double lo = INFINITY, hi = 0.0, se = 0.0, ss = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        assert_true(full.rgb[i] > 0.0f);
+        double q = shrunk.rgb[i] / full.rgb[i];
+        lo = fmin(lo, q), hi = fmax(hi, q);
+        se += (shrunk.rgb[i] - full.rgb[i]) * (shrunk.rgb[i] - full.rgb[i]);
+        ss += full.rgb[i] * full.rgb[i];
+    }
+    double ms = image_mean(&shrunk), mf = image_mean(&full);
+    printf("global layer while moving: shrunk mean %.5f, at the view's pixels %.5f; pixels %.3f .. %.3f of those, "
+           "relative squared error %.2g\n",
+           ms, mf, lo, hi, se / ss);
+    assert_near(ms, mf, 0.01 * mf);
+    assert_true(lo >= 0.6 && hi <= 1.4);
+    assert_true(se / ss <= 0.002);
+    ps_image_destroy(&shrunk);
+    ps_image_destroy(&full);
+    ps_gl_layers_destroy(l);
+    ps_gl_renderer_destroy(gl);
+    rig_close(&g);
+}
+
+static void direct_on_the_moving_mesh(void **state)
+{
+    (void)state;
+    rig g;
+    rig_open(&g, FLOOR, PS_LAYER_DIRECT);
+    const ps_preview_mesh *fine = ps_session_mesh(g.s), *moving = ps_session_moving_mesh(g.s);
+    assert_true(moving != fine);
+    printf("moving mesh: %zu vertices, the fine one %zu\n", moving->vertex_count, fine->vertex_count);
+    assert_true(4 * moving->vertex_count <= 3 * fine->vertex_count);
+    ps_gl_scene gs = ps_gl_scene_of(g.s), gs_fine = gs;
+    gs_fine.moving = NULL; /* lit on the fine mesh while moving too */
+    ps_gl_renderer *gl = renderer(&gs, g.s), *gl_fine = renderer(&gs_fine, g.s);
+    ps_gl_layers *l;
+    ps_error err;
+    assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &l, &err), PS_OK);
+    ps_session_frame f;
+    still_then_move(&g, l, gl, &f);
+    ps_gl_layers_draw(l, gl, &g.cam, &f);
+    assert_int_equal(ps_gl_get_stats(gl).light_vertices, moving->vertex_count);
+    ps_image a = composite(l, &f);
+    ps_gl_layers_draw(l, gl_fine, &g.cam, &f);
+    assert_int_equal(ps_gl_get_stats(gl_fine).light_vertices, fine->vertex_count);
+    ps_image b = composite(l, &f);
+    size_t n = 3 * (size_t)SIDE * SIDE;
+    double peak = 0.0, worst = 0.0;
+    for (size_t i = 0; i < n; i++)
+        peak = fmax(peak, b.rgb[i]);
+    assert_true(peak > 0.0);
+    for (size_t i = 0; i < n; i++)
+        if (b.rgb[i] > 0.01 * peak)
+            worst = fmax(worst, fabs(a.rgb[i] - b.rgb[i]) / b.rgb[i]);
+    double ma = image_mean(&a), mb = image_mean(&b);
+    printf("direct layer while moving: moving mesh mean %.5f, fine mesh %.5f, worst pixel %.2f %%\n", ma, mb,
+           100.0 * worst);
+    assert_true(worst <= 0.03);
+    assert_near(ma, mb, 0.005 * mb);
+    ps_image_destroy(&a);
+    ps_image_destroy(&b);
+    ps_gl_layers_destroy(l);
+    ps_gl_renderer_destroy(gl);
+    ps_gl_renderer_destroy(gl_fine);
+    rig_close(&g);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(global_layer_shrunk),
+        cmocka_unit_test(direct_on_the_moving_mesh),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
