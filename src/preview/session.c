@@ -731,8 +731,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
          * is the picture of the edit), where the splats grew as much (their
          * pixels then as many as at full detail) and are triangles (points
          * and sprites are sized in pixels); not the illumination maps' lobes. */
-        bool shrunk = out->moving && !out->edit_lod && k == PS_MAP_GLOBAL && !s->imap && s->set.splat == PS_SPLAT_TRIANGLES &&
-                      growth[k] >= PS_SESSION_MOVING_GLOBAL_SHRINK;
+        bool shrunk = out->moving && !out->edit_lod && k == PS_MAP_GLOBAL && !s->imap &&
+                      s->set.splat == PS_SPLAT_TRIANGLES && growth[k] >= PS_SESSION_MOVING_GLOBAL_SHRINK;
         l->shrink = shrunk ? PS_SESSION_MOVING_GLOBAL_SHRINK : 1;
     }
     if (out->imap_colors && out->map[PS_MAP_GLOBAL].gain == 0.0)
