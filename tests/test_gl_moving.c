@@ -2,11 +2,14 @@
  * layers (preview/session.h), where it departs from the full view's way of
  * drawing:
  *  - the global map's splats at half the view's pixels a side
- *    (ps_session_layer.shrink), scaled up by the composite: inside a furnace
- *    sphere (albedo 0.5, a point light at its centre) every pixel within 15 %
- *    of the closed form rho^2 Phi / (4 pi^2 R^2 (1 - rho)) (a read past the
- *    shrunk corner, of the black around it, would not be) and the picture's
- *    mean within 1 % of the same frame drawn at the view's pixels;
+ *    (ps_session_layer.shrink), scaled up by the composite: in a closed cube
+ *    of flat walls lit from its centre, the picture's mean within 1 % of the
+ *    same frame drawn at the view's pixels, every pixel 0.6-1.4 of it and the
+ *    relative squared error at most 0.002 (a read past the shrunk corner, of
+ *    the black around it, or of the view's corner as if it were the shrunk
+ *    one, fails them; a furnace sphere would not do: splats in the tangent
+ *    plane of so curved a wall are cut by the depth test, and more so at a
+ *    coarser depth);
  *  - the direct layer lit on the moving mesh (mesh.h: a quarter of a flat
  *    face's vertices): a floor under a low point light, where Gouraud
  *    interpolation errs most, within 3 % a pixel and 0.5 % on the mean of the
