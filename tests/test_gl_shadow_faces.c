@@ -215,17 +215,24 @@ static void moved_light_renders_its_cube(void **state)
 }
 
 /* The shadowed lit passes leave out the objects outside each cube face's
- * pyramid (ps_gl_draw_mesh_within): the same picture, float for float, as
- * passes that draw every object in every face, from fewer vertices: here
- * and in the two-light box (its spheres lie in one face of the point light,
- * its walls in two or three). */
+ * pyramid (ps_gl_draw_mesh_within), and mirrors and glass, which add
+ * nothing there: the same picture, float for float, as passes that draw
+ * every object in every face, from fewer vertices: here, in the two-light
+ * box (its spheres lie in one face of the point light, its walls in two or
+ * three) and here with a mirror and a glass sphere added (none of their
+ * vertices drawn). */
 static void culled_faces_draw_the_same(void **state)
 {
     (void)state;
-    char box[2048];
+    char box[2048], spheres[2048];
     snprintf(box, sizeof box, TWO_LIGHTS_SCENE "60 50 40\n");
-    const char *texts[2] = {scene_text, box};
-    for (int t = 0; t < 2; t++) {
+    /* A mirror and a glass sphere beside the occluder: lit passes leave them out. */
+    snprintf(spheres, sizeof spheres,
+             "%smaterial m mirror reflectance 1 1 1\nmaterial g dielectric ior 1.5\n"
+             "sphere center 0.8 0.3 0.6 radius 0.3 material m\nsphere center -0.8 0.3 -0.6 radius 0.3 material g\n",
+             scene_text);
+    const char *texts[3] = {scene_text, box, spheres};
+    for (int t = 0; t < 3; t++) {
         ps_error err;
         gl_rig g = gl_rig_open(texts[t]);
         ps_scene *s = g.s;
@@ -249,6 +256,16 @@ static void culled_faces_draw_the_same(void **state)
         assert_true(vertices[0] < vertices[1]);
         if (t == 1) /* six faces of the point light, the spot's one or two */
             assert_true(vertices[0] < vertices[1] / 2);
+        if (t == 2) { /* the spheres' vertices (most of the mesh) in no pass */
+            size_t nobj;
+            const ps_object *objects = ps_scene_objects(s, &nobj);
+            uint64_t sphere_vertices = 0;
+            for (size_t i = 0; i < in.mesh.range_count; i++)
+                if (objects[in.mesh.ranges[i].object].type == PS_OBJ_SPHERE)
+                    sphere_vertices += in.mesh.ranges[i].count;
+            assert_true(sphere_vertices > 0);
+            assert_true(vertices[0] + sphere_vertices <= vertices[1]);
+        }
         ps_image_destroy(&pic[0]);
         ps_image_destroy(&pic[1]);
         inputs_free(&in);

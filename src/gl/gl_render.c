@@ -99,6 +99,11 @@ static void draw_ranges(const ps_gl_renderer *r, bool with_materials, bool stenc
     const ps_preview_mesh *m = with_materials ? r->lit : r->in.coarse;
     bool cull = planes && with_materials && r->range_bounds && r->range_bounds_of == m->positions &&
                 !r->opt.whole_face_passes;
+    /* Mirrors and glass add nothing to a lit pass (no diffuse or Phong
+     * term below: their light is the specular layer's), which writes no
+     * depth: left out, the same pixels. The default scene's two spheres
+     * were 58 800 of the 143 070 vertices every lit pass drew. */
+    bool skip_black = with_materials && !r->opt.whole_face_passes;
     glEnableClientState(GL_VERTEX_ARRAY);
     glVertexPointer(3, GL_FLOAT, 0, m->positions);
     if (with_materials) {
@@ -107,7 +112,7 @@ static void draw_ranges(const ps_gl_renderer *r, bool with_materials, bool stenc
     }
     for (size_t i = 0; i < m->range_count; i++) {
         const ps_mesh_range *rg = &m->ranges[i];
-        if (r->skip_specular && ps_material_is_specular(&r->in.materials[rg->material]))
+        if ((r->skip_specular || skip_black) && ps_material_is_specular(&r->in.materials[rg->material]))
             continue;
         bool outside = false;
         for (int p = 0; cull && p < plane_count && !outside; p++)

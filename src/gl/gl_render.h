@@ -49,8 +49,10 @@ typedef struct ps_gl_options {
     bool float_buffer; /* the colour buffer keeps floats: no clamping anywhere */
     int shadow_size;   /* shadow maps' side in texels; 0: PS_GL_SHADOW_SIZE */
     bool whole_face_passes; /* tests: every object in every shadowed face's lit
-                             * pass (default false: those outside the face's
-                             * pyramid are left out, the same pixels) */
+                             * pass, and mirrors and glass in every lit pass
+                             * (default false: those outside the face's
+                             * pyramid, and mirrors and glass, which add
+                             * nothing there, are left out: the same pixels) */
 } ps_gl_options;
 
 /* What the renderer draws, prepared GL-free; everything pointed to must
