@@ -417,10 +417,6 @@ static void count_range(void *arg, size_t job)
     }
 }
 
-/* Counts, normalisation and the rank table for `total` photons; false when
- * out of memory for the table. Jobs of granules on every core (an edit's
- * update waits for the new plan's: 10^6 indices, 9 ms on one core): the
- * same table for any thread count. */
 /* The plan's counts are those of `total` photons: each stratum's share of
  * the power, 1 / its count. */
 static void set_counted(map_plan *p, uint64_t total)
@@ -431,6 +427,10 @@ static void set_counted(map_plan *p, uint64_t total)
     p->counted = true;
 }
 
+/* Counts, normalisation and the rank table for `total` photons; false when
+ * out of memory for the table. Jobs of granules on every core (an edit's
+ * update waits for the new plan's: 10^6 indices, 9 ms on one core): the
+ * same table for any thread count. */
 static bool count_strata(map_plan *p, uint64_t total, bool keep_seq)
 {
     if (p->counted && p->counted_total == total)
