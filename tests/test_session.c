@@ -152,6 +152,74 @@ static void whole_refresh_splats_everything(void **state)
     ps_scene_destroy(scene);
 }
 
+/* A whole refresh's cap (photosplat-snap's checkpoints, app/pace.h): a
+ * prefix of each map ending at a batch the feed handed over, scaled by N / n
+ * for the photons it holds: the splats of a session whose caps were that
+ * prefix, vertex for vertex (photon i is the same whatever the cap), and the
+ * same colour within 10^-4 (a photon's power is 1 / its stratum's count,
+ * which rounds differently for another cap: 2*10^-5 here). 1 again: every
+ * photon. */
+static void whole_cap_draws_a_prefix(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, false);
+    set.float_buffer = true; /* whole, in float: the colours are the photons' own */
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_start(s, false, &err), PS_OK);
+    wait_ended(s);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    double half[PS_MAP_COUNT] = {0.5 * (double)set.caps[0], 0.5 * (double)set.caps[1]};
+    ps_session_set_whole_most(s, half);
+    refresh(s, &cam, &f);
+    uint64_t part[PS_MAP_COUNT];
+    double sums[PS_MAP_COUNT];
+    size_t splats[PS_MAP_COUNT];
+    float *where[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        part[k] = f.emitted[k];
+        assert_true(part[k] > 0);
+        assert_true(part[k] <= set.caps[k] / 2);
+        sums[k] = batch_sum(f.map[k].batch);
+        splats[k] = f.map[k].batch->splats;
+        size_t bytes = sizeof(float) * 3 * f.map[k].batch->vertex_count;
+        where[k] = malloc(bytes);
+        assert_non_null(where[k]);
+        memcpy(where[k], f.map[k].batch->positions, bytes);
+        assert_true(sums[k] > 0.0);
+    }
+    /* A cap at exactly what it drew: that prefix again (a later checkpoint never shows fewer). */
+    double again[PS_MAP_COUNT] = {(double)part[0], (double)part[1]};
+    ps_session_set_whole_most(s, again);
+    refresh(s, &cam, &f);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        assert_int_equal(f.emitted[k], part[k]);
+    /* All of them again. */
+    ps_session_set_whole_most(s, NULL);
+    refresh(s, &cam, &f);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        assert_int_equal(f.emitted[k], set.caps[k]);
+    ps_session_destroy(s);
+    /* The same splats from a session traced to that prefix. */
+    ps_session_settings cut = set;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        cut.caps[k] = part[k];
+    s = open_session(scene, &cut);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    refresh(s, &cam, &f);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        assert_int_equal(f.emitted[k], part[k]);
+        assert_int_equal(f.map[k].batch->splats, splats[k]);
+        assert_memory_equal(f.map[k].batch->positions, where[k], sizeof(float) * 3 * f.map[k].batch->vertex_count);
+        assert_near(batch_sum(f.map[k].batch), sums[k], 1e-4 * sums[k]);
+        free(where[k]);
+    }
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 /* Incremental refreshes: the first shows the first round (the feed held
  * until it is drawn), later ones only batches not drawn yet, at stored power,
  * with the gain exposure N / n in the composite; together they splat every
@@ -628,6 +696,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(whole_refresh_splats_everything),
+        cmocka_unit_test(whole_cap_draws_a_prefix),
         cmocka_unit_test(incremental_refresh_splats_each_photon_once),
         cmocka_unit_test(budget_bounds_a_refresh),
         cmocka_unit_test(counter_stops_shooting),

@@ -3,17 +3,19 @@
 
 #include <math.h>
 
+/* Of a whole refresh's time, what does not grow with the photons. */
+static double scene_part(const ps_pace_model *m) { return fmax(0.0, m->seconds - m->per_photon * m->photons); }
+
 double ps_pace_seconds(const ps_pace_model *m, double photons)
 {
-    return m->seconds + m->per_photon * fmax(0.0, photons - m->photons);
+    return scene_part(m) + m->per_photon * fmax(0.0, photons) + m->unheld;
 }
 
-void ps_pace_learn(ps_pace_model *m, double seconds, double photons, bool whole)
+void ps_pace_learn(ps_pace_model *m, double seconds, double photons, double photon_seconds, bool whole)
 {
-    if (!whole)
-        m->per_photon = 0.0;
-    else if (m->seconds > 0.0 && photons >= PS_PACE_FIT_GROWTH * m->photons)
-        m->per_photon = fmax(0.0, (seconds - m->seconds) / (photons - m->photons));
+    double part = fmin(seconds, fmax(0.0, photon_seconds));
+    m->per_photon = whole && photons > 0.0 ? part / photons : 0.0;
+    m->learned = whole ? m->learned + 1 : 0;
     m->seconds = seconds;
     m->photons = photons;
 }
@@ -27,10 +29,16 @@ static double ideal_start(const ps_pace_model *m, double now, double d_now, doub
     return now + (cp + PS_PACE_MARGIN * d_now - now - d_now) / (1.0 + slope);
 }
 
+/* The photons a whole refresh draws to last `d` seconds (0: one batch). */
+static double photons_for(const ps_pace_model *m, double d)
+{
+    return fmax(0.0, (d - scene_part(m) - m->unheld) / m->per_photon);
+}
+
 ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, double due, const double *pending,
                           int count)
 {
-    ps_pace_plan p = {fmax(now, due), HUGE_VAL, -1};
+    ps_pace_plan p = {fmax(now, due), HUGE_VAL, -1, HUGE_VAL};
     if (count <= 0)
         return p;
     p.start = fmax(now, fmin(due, pending[0]));
@@ -44,19 +52,38 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
     p.target = 0;
     double cp = pending[0];
     double ideal = ideal_start(m, now, d_now, cp);
+    double d_ideal = ps_pace_seconds(m, photons + m->rate * fmax(0.0, ideal - now));
+    /* A whole refresh longer than its share of the checkpoint's time draws
+     * fewer photons, to last that share, started later (pace.h). */
+    double cap = m->per_photon > 0.0 ? PS_PACE_FRAME_SHARE * cp : HUGE_VAL;
+    if (d_ideal > cap) {
+        d_ideal = cap;
+        ideal = cp - (1.0 - PS_PACE_MARGIN) * cap;
+    }
+    double aim = ideal + d_ideal; /* when the checkpoint's frame should end */
     /* Cube faces may push the checkpoint's frame to end as late as
      * PS_PACE_FACES_LATE of its time after it, or the margin if later. */
-    double d_ideal = ps_pace_seconds(m, photons + m->rate * fmax(0.0, ideal - now));
-    double last_end = fmax(cp * (1.0 + PS_PACE_FACES_LATE), ideal + d_ideal);
+    double last_end = fmax(cp * (1.0 + PS_PACE_FACES_LATE), aim);
     double last_start = last_end - d_ideal;
     double s0 = now >= ideal ? now : fmax(now, due);
     double d0 = ps_pace_seconds(m, photons + m->rate * (s0 - now));
-    if (now >= ideal || s0 + d0 > last_start) {
+    /* Whole refreshes no checkpoint shows are only drawn and thrown away
+     * (snap is headless): the checkpoint's frame is the next. */
+    if (now >= ideal || s0 + d0 > last_start || m->per_photon > 0.0) {
         /* The checkpoint's frame, at its start (a refresh started now
          * would delay it past last_start) or at once when that is past:
-         * faces only while it ends by last_end. */
+         * faces only while it ends by last_end. A whole one started late
+         * draws what ends it by the aim (at least one batch). */
         p.start = now >= ideal ? now : ideal;
-        double d = ps_pace_seconds(m, photons + m->rate * (p.start - now));
+        double n = photons + m->rate * (p.start - now);
+        double d = fmin(ps_pace_seconds(m, n), cap);
+        if (m->per_photon > 0.0 && p.start + d > aim)
+            d = fmax(aim - p.start, 0.0);
+        if (m->per_photon > 0.0 && photons_for(m, d) < n) {
+            p.photons = photons_for(m, d);
+            n = p.photons;
+        }
+        d = ps_pace_seconds(m, n);
         p.faces_deadline = last_end - d > p.start ? last_end - d + fmin(m->lead, d) : p.start;
     } else {
         /* A refresh that ends before the checkpoint's frame must start:

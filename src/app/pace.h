@@ -3,18 +3,23 @@
  * soon after it rather than a whole refresh later.
  *
  * A refresh is predicted from the last one: its time without cube faces,
- * plus, for whole refreshes (8 bits redraw every photon, so their time grows
- * with the run), the time a photon took between the last two times the
- * photons it will draw beyond the last's; as is for incremental ones. (Time
- * proportional to the photons overstated it several-fold: the first frames
- * are mostly the direct layer, and a frame predicted too long starts early,
- * ends before the checkpoint and leaves it to the next, a refresh late.) The
+ * for whole refreshes (8 bits redraw every photon, so their time grows with
+ * the run) split into the photons' part (building their splats, and drawing
+ * them, finished before and after), which scales with the photons it will
+ * draw, and the scene's (the rest); as is for incremental ones.
+ * (Fitting the photon's cost from two refreshes' difference was up to 3x
+ * low: their scene parts vary as much as the photons' parts differ.) The
  * refresh that will show the checkpoint starts when it would end
  * PS_PACE_MARGIN of its time after it; a refresh that would end after that
  * start waits for it instead (snap is headless: an idle moment only leaves
  * the cores to the tracer), and cube faces run only while the checkpoint's
  * frame still ends within PS_PACE_FACES_LATE of it (or the margin, if later).
- * Which photons a picture shows is untouched: only when pictures are made. */
+ * A whole refresh showing a checkpoint lasts at most PS_PACE_FRAME_SHARE of
+ * the checkpoint's time (ps_pace_plan.photons: a prefix of the photons, an
+ * unbiased picture of fewer), so that its prediction's error stays within
+ * bench's 20 %. Which photons are drawn, a prefix in index order, stays a
+ * function of the count alone: only when pictures are made, and how many
+ * photons they show, is timing's. */
 #ifndef PS_APP_PACE_H
 #define PS_APP_PACE_H
 
@@ -33,29 +38,47 @@
  * layer stayed black through every checkpoint of a 2 s run. */
 #define PS_PACE_FACES_LATE 0.1
 
+/* A whole refresh that shows a checkpoint lasts at most this share of the
+ * checkpoint's time: aimed to end PS_PACE_MARGIN of its length after the
+ * checkpoint, a prediction off by up to that margin then ends it between the
+ * checkpoint and PS_PACE_FRAME_SHARE * 2 * PS_PACE_MARGIN = 20 % after
+ * (8-bit refreshes of 1-3 s varied by a third on a loaded 2-core machine; a
+ * redraw of all 3*10^6 photons that had arrived by the 5 s checkpoint took
+ * 3.5-4.7 s and landed it at 7.2-9.6 s). */
+#define PS_PACE_FRAME_SHARE (1.0 / 3.0)
+
 typedef struct ps_pace_model {
     double seconds;    /* the last refresh's time without cube faces (0: nothing known yet) */
     double photons;    /* the photons emitted that it drew */
-    double per_photon; /* whole refreshes: seconds a photon more costs (0: incremental) */
+    double per_photon; /* whole refreshes: seconds a photon costs (0: incremental) */
     double rate;       /* photons emitted a second */
     double lead;       /* of seconds, what comes before the faces (the session's splats) */
+    int learned;       /* whole refreshes learned in a row */
+    double unheld;     /* the next refresh's cube faces that no deadline holds back, seconds
+                        * (the first round's: ps_gl_specular_unheld_seconds) */
 } ps_pace_model;
 
-/* After a refresh of `seconds` (no cube faces) drawing `photons`: whole
- * refreshes fit the photon's cost from this one and the last (once the
- * photons grew PS_PACE_FIT_GROWTH-fold, never below 0). */
-#define PS_PACE_FIT_GROWTH 1.2
-void ps_pace_learn(ps_pace_model *m, double seconds, double photons, bool whole);
+/* After a refresh of `seconds` (no cube faces) drawing `photons`, of which
+ * `photon_seconds` grew with the photons (building and drawing their
+ * splats): whole refreshes take a photon's cost as that part over the
+ * photons, the rest of the time as the scene's. (The part has a constant
+ * of its own, 0.01-0.1 s, so a larger refresh costs a little less a photon
+ * than predicted and ends early, which the margin absorbs; fitting the
+ * constant from two refreshes' difference predicted a 3*10^6-photon frame
+ * 35 % short, and it landed late.) */
+void ps_pace_learn(ps_pace_model *m, double seconds, double photons, double photon_seconds, bool whole);
 /* The cube faces come after the session's part of a refresh (`lead`
  * seconds of it, the last time): the faces deadline is later by that. */
 
-/* A refresh's predicted time when it starts with `photons` emitted. */
+/* A refresh's predicted time when it draws `photons` emitted, its unheld
+ * faces included. */
 double ps_pace_seconds(const ps_pace_model *m, double photons);
 
 typedef struct ps_pace_plan {
     double start;           /* when to start the next refresh (>= now) */
     double faces_deadline;  /* its cube faces end by then (<= start: none); HUGE_VAL: no limit */
     int target;             /* the checkpoint planned for (index into the list: 0), -1: none */
+    double photons;         /* whole: the most photons emitted it draws (0: one batch); HUGE_VAL: all */
 } ps_pace_plan;
 
 /* The next refresh, at `now` with `photons` emitted, due at `due` (tau's

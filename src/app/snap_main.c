@@ -185,6 +185,7 @@ typedef struct snap_run {
     ps_latency lat;     /* --script: each edit's first refresh, phase by phase (app/latency.h) */
     bool awaiting_edit; /* the next refresh is the first after an update */
     ps_pace_model pace; /* --checkpoints: the last refresh, to plan the next (app/pace.h) */
+    double shown[PS_MAP_COUNT]; /* ... and each map's photons emitted that the last checkpoint showed */
 } snap_run;
 
 /* One refresh: what the session says, drawn into the layers (the new
@@ -192,6 +193,8 @@ typedef struct snap_run {
 static ps_status refresh(snap_run *s, ps_error *err)
 {
     double t_refresh = ps_now_seconds();
+    ps_session_counts before;
+    ps_session_get_counts(s->session, &before);
     ps_status st = ps_session_refresh(s->session, &s->cam, &s->frame, err);
     if (st == PS_OK && s->frame.lights_changed) {
         ps_gl_scene gs = ps_gl_scene_of(s->session);
@@ -212,7 +215,7 @@ static ps_status refresh(snap_run *s, ps_error *err)
     st = ps_gl_specular_refresh(s->spec, s->gl, s->session, &s->frame, faces, err);
     if (st != PS_OK)
         return st;
-    double t_draw = ps_now_seconds();
+    double t_draw = ps_now_seconds(), splat_seconds = 0.0;
     ps_gl_stats gst = ps_gl_get_stats(s->gl);
     ps_latency_add(&s->lat, PS_LAT_SPECULAR, t_draw - t0 - gst.shadow_seconds_last);
     ps_latency_add(&s->lat, PS_LAT_SHADOWS, gst.shadow_seconds_last);
@@ -226,9 +229,10 @@ static ps_status refresh(snap_run *s, ps_error *err)
         if (s->frame.splats > 0)
             ps_gl_finish(); /* llvmpipe draws when flushed: time the drawing, not the queueing */
     } else {
-        ps_gl_draw_frame(s->gl, &s->cam, &s->frame);
+        ps_gl_draw_frame_timed(s->gl, &s->cam, &s->frame, &splat_seconds);
         if (s->frame.specular)
             ps_gl_specular_draw(s->spec, s->gl, s->session, s->frame.direct_exposure);
+        ps_gl_finish();
     }
     double t1 = ps_now_seconds(), spent = t1 - t0;
     gst = ps_gl_get_stats(s->gl);
@@ -249,9 +253,13 @@ static ps_status refresh(snap_run *s, ps_error *err)
      * a new view or new lights (the direct layer drawn again, once), unless
      * nothing is known yet; whole ones redraw everything every time. */
     double plain = (t1 - t_refresh) - (t_draw - t0) - gst.shadow_seconds_last;
+    ps_session_counts after;
+    ps_session_get_counts(s->session, &after);
+    double build_seconds = after.splat_seconds - before.splat_seconds;
     if (!s->layers || s->pace.seconds <= 0.0 || !(s->frame.new_view || s->frame.lights_changed))
     {
-        ps_pace_learn(&s->pace, fmax(plain, 1e-6), (double)(s->frame.emitted[0] + s->frame.emitted[1]), !s->layers);
+        ps_pace_learn(&s->pace, fmax(plain, 1e-6), (double)(s->frame.emitted[0] + s->frame.emitted[1]),
+                      build_seconds + splat_seconds, !s->layers);
         s->pace.lead = t0 - t_refresh;
     }
     return PS_OK;
@@ -483,6 +491,26 @@ static ps_status last_picture(snap_run *s, ps_status st, ps_error *err)
     return st;
 }
 
+/* The photons' arrival rate for the pace: counted at each plan. */
+typedef struct pace_rate {
+    double at, photons;
+} pace_rate;
+
+/* The next refresh on snap's clock (starting at `clock`), due at `due` by
+ * tau's schedule, checkpoints cp on not yet shown (pace.h). */
+static ps_pace_plan plan_refresh(snap_run *s, double clock, double due, int cp, pace_rate *rate)
+{
+    double now = ps_now_seconds() - clock;
+    ps_session_counts counts;
+    ps_session_get_counts(s->session, &counts);
+    double photons = (double)(counts.map[0].emitted + counts.map[1].emitted);
+    if (now > rate->at && photons >= rate->photons)
+        s->pace.rate = (photons - rate->photons) / (now - rate->at);
+    rate->at = now, rate->photons = photons;
+    s->pace.unheld = ps_gl_specular_unheld_seconds(s->spec, s->session);
+    return ps_pace_next(&s->pace, now, photons, due, s->o->checkpoints + cp, s->o->checkpoint_count - cp);
+}
+
 /* Progressive: trace in the background, refresh every tau. As in the window,
  * the first round is traced before the first frame, so that it already shows
  * photons. Time spent writing checkpoints is taken off the clock (the tracer
@@ -493,7 +521,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
     snap_checkpoint_row rows[SNAP_MAX_CHECKPOINTS];
     ps_status st = ps_session_start(s->session, false, err);
     double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
-    double last_now = 0.0, last_photons = 0.0; /* the trace rate for the pace */
+    pace_rate rate = {0.0, 0.0};
     int cp = 0;
     while (st == PS_OK) {
         if (ps_cancelled(o->cancel)) {
@@ -503,19 +531,62 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         }
         /* When to refresh, and how long its cube faces may take, so that
          * the frame each checkpoint shows lands soon after it (pace.h). */
-        double clock = t_start + excluded, at_plan = ps_now_seconds() - clock;
-        ps_session_counts counts;
-        ps_session_get_counts(s->session, &counts);
-        double photons = (double)(counts.map[0].emitted + counts.map[1].emitted);
-        if (at_plan > last_now && photons >= last_photons)
-            s->pace.rate = (photons - last_photons) / (at_plan - last_now);
-        last_now = at_plan, last_photons = photons;
-        ps_pace_plan plan = ps_pace_next(&s->pace, at_plan, photons, fmin(next, end) - clock, o->checkpoints + cp,
-                                         o->checkpoint_count - cp);
+        double clock = t_start + excluded;
+        ps_pace_plan plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
+        /* 8 bits: after the first frame, one batch drawn in the wait and
+         * not shown. The first frame's time holds llvmpipe's first compiles
+         * and the first specular traces (its scene's part 0.2-0.4 s at 256^2
+         * against 0.04-0.06 s after), which left the 1 s checkpoint's frame
+         * one batch. */
+        if (!s->layers && s->pace.learned == 1 && cp < o->checkpoint_count &&
+            plan.start > ps_now_seconds() - clock) {
+            const double one[PS_MAP_COUNT] = {0.0, 0.0};
+            ps_session_set_whole_most(s->session, one);
+            ps_gl_specular_set_deadline(s->spec, ps_now_seconds()); /* no faces in it */
+            ps_session_hold(s->session, true);
+            st = refresh(s, err);
+            ps_session_hold(s->session, false);
+            if (st != PS_OK)
+                break;
+            plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
+        }
+        /* 8 bits: a refresh that waits for its start leaves that time to
+         * the cube faces, which would otherwise ride in the frames (the
+         * first round's, which no deadline holds back, made the frame of a
+         * 2 s checkpoint 0.5 s late), then is planned again with what they
+         * left to it. */
+        if (!s->layers && s->frames > 0 && plan.start > ps_now_seconds() - clock) {
+            /* A face never timed: as long as the last frame (the first,
+             * at 256^2, 0.4 s: one started in a 0.2 s wait made the 1 s
+             * checkpoint 0.35 s late). */
+            st = ps_gl_specular_idle(s->spec, s->gl, s->session, &s->frame, clock + plan.start, s->pace.seconds, err);
+            if (st != PS_OK)
+                break;
+            plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
+        }
         ps_gl_specular_set_deadline(s->spec, isfinite(plan.faces_deadline) ? clock + plan.faces_deadline : 0.0);
         sleep_until(clock + plan.start);
+        ps_session_counts counts;
         ps_session_get_counts(s->session, &counts);
+        /* A whole refresh showing a checkpoint draws the photons it has time
+         * for: a prefix of those there now. */
+        double there = (double)(counts.map[0].emitted + counts.map[1].emitted);
+        double most[PS_MAP_COUNT];
+        for (int k = 0; k < PS_MAP_COUNT; k++) /* each map its part, never fewer than the last checkpoint showed */
+            most[k] = there > plan.photons ? fmax(plan.photons * (double)counts.map[k].emitted / there, s->shown[k])
+                                           : HUGE_VAL;
+        ps_session_set_whole_most(s->session, most);
+        /* 8 bits: the tracer waits while a checkpoint's frame is drawn (its
+         * photons are those there now), so that llvmpipe has both cores:
+         * sharing them, a photon cost 1.2-1.9 us from one frame to the
+         * next, alone 0.9-1.5 us, the prediction's error the larger part of
+         * a checkpoint's lateness. */
+        bool hold = !s->layers && cp < o->checkpoint_count;
+        if (hold)
+            ps_session_hold(s->session, true);
         st = refresh(s, err);
+        if (hold)
+            ps_session_hold(s->session, false);
         if (st != PS_OK)
             break;
         double now = ps_now_seconds();
@@ -525,6 +596,8 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             /* This frame is the first done at or after every checkpoint time
              * it passed: each of them shows it. */
             ps_session_hold(s->session, true);
+            for (int k = 0; k < PS_MAP_COUNT; k++)
+                s->shown[k] = (double)s->frame.emitted[k];
             double at = now - t_start - excluded;
             for (int first = cp; st == PS_OK && cp < o->checkpoint_count && at >= o->checkpoints[cp]; cp++) {
                 if (cp > first) /* the layers of the last one overwrote it */
@@ -542,10 +615,14 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         if (ps_session_counter_stopped(s->session, NULL))
             break;
         next += o->p.tau;
-        if (counts.ended || ps_now_seconds() >= end)
+        /* Every photon traced: float layers show the rest at once; an 8-bit
+         * redraw of them all takes seconds, so checkpoints still to come get
+         * their own frames, on time, and the last picture follows. */
+        if ((counts.ended && (s->layers || cp >= o->checkpoint_count)) || ps_now_seconds() >= end)
             break;
     }
     ps_gl_specular_set_deadline(s->spec, 0.0);
+    ps_session_set_whole_most(s->session, NULL);
     st = last_picture(s, st, err);
     /* Checkpoints after the end (every cap reached, or the counter stopped
      * the tracer) show the final picture, at the time it was done. */
@@ -884,6 +961,12 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
      * script keeps the window's budget). */
     if (st == PS_OK && !o->script)
         ps_gl_specular_set_first_round(s.spec, PS_GL_SPECULAR_FIRST_REFRESHES);
+    /* ... but 8-bit checkpoints' frames hold theirs to the pace's deadline:
+     * the first round's three faces a frame were longer than the frame of a
+     * 1 s checkpoint may be (PS_PACE_FRAME_SHARE); the waits before those
+     * frames draw them instead (refine). */
+    if (st == PS_OK && !o->script && !s.layers && o->checkpoint_count > 0)
+        ps_gl_specular_hold_first_round(s.spec, true);
     double t_start = ps_now_seconds(), first_frame = -1.0;
     if (st == PS_OK && o->script) {
         st = run_script(&s, t_start, &first_frame, err);

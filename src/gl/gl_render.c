@@ -1,6 +1,8 @@
 /* gl_render.c: the renderer, the mesh and the frame in fixed-function GL (gl_render.h). */
 #include "gl/gl_internal.h"
 
+#include "core/clock.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -265,11 +267,26 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
 
 void ps_gl_draw_frame(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f)
 {
+    ps_gl_draw_frame_timed(r, cam, f, NULL);
+}
+
+void ps_gl_draw_frame_timed(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f,
+                            double *splat_seconds)
+{
     ps_gl_begin_frame(r, cam, f->direct_exposure, f->direct);
     ps_gl_draw_illummap(r, f->imap_colors);
+    double t0 = 0.0;
+    if (splat_seconds) {
+        glFinish();
+        t0 = ps_now_seconds();
+    }
     for (int k = 0; k < PS_MAP_COUNT; k++)
         if (f->map[k].gain > 0.0)
             ps_gl_draw_splats(r, f->map[k].batch, f->splat, f->map[k].radius, f->point_size);
+    if (splat_seconds) {
+        glFinish();
+        *splat_seconds = ps_now_seconds() - t0;
+    }
     /* All of it (lit with Kd, splats with Kd) times the surfaces' textures. */
     ps_gl_multiply_albedo(r);
 }

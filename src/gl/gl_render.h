@@ -94,6 +94,11 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
 /* A whole frame into the current framebuffer as a session's refresh says it
  * (photosplat-snap: no layers kept): the scene, then each map's splats. */
 void ps_gl_draw_frame(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f);
+/* The same, with the splats finished before and after: *splat_seconds is
+ * their time, the part of a whole frame that grows with the photons
+ * (photosplat-snap's pace, app/pace.h). */
+void ps_gl_draw_frame_timed(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f,
+                            double *splat_seconds);
 
 /* Adds a batch of splats (preview/splat.h) to the frame, depth tested against
  * the scene, additively. point_size: the points' side in pixels; sprites take

@@ -67,6 +67,9 @@ struct ps_gl_specular {
      * an area light's virtual lights). face_max: the dearest seen, for a
      * face not timed yet. */
     double deadline;
+    bool idle; /* ps_gl_specular_idle: faces while they fit, the first round's too */
+    double idle_guess; /* ... a face never timed taking this long */
+    bool first_held; /* ps_gl_specular_hold_first_round */
     float face_time[PS_SPECULAR_MAX_CUBES * 6];
     double face_max;
 };
@@ -79,10 +82,12 @@ bool ps_gl_specular_face_fits(double now, double at, double estimate) { return a
 static double face_estimate(const ps_gl_specular *g)
 {
     double t = g->face_time[g->cursor];
-    return t > 0.0 ? t : g->face_max;
+    return t > 0.0 ? t : g->face_max > 0.0 || !g->idle ? g->face_max : g->idle_guess;
 }
 
 void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes) { g->first_refreshes = refreshes > 0 ? refreshes : 0; }
+
+void ps_gl_specular_hold_first_round(ps_gl_specular *g, bool held) { g->first_held = held; }
 
 ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err)
 {
@@ -272,6 +277,44 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
     return st;
 }
 
+double ps_gl_specular_unheld_seconds(const ps_gl_specular *g, ps_session *s)
+{
+    int total = 6 * g->cube_count;
+    if (g->frozen || total == 0 || g->first_refreshes <= 0 || g->first_held || g->since_change >= total)
+        return 0.0;
+    /* As ps_gl_specular_refresh decides a quick face: the first round, not settled. */
+    ps_session_counts counts;
+    ps_session_get_counts(s, &counts);
+    if (counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL))
+        return 0.0;
+    /* Each face as it took last, or the dearest seen (faces differ several-fold). */
+    int n = (total + g->first_refreshes - 1) / g->first_refreshes;
+    double t = 0.0;
+    for (int i = 0; i < n; i++) {
+        double fi = g->face_time[(g->cursor + i) % total];
+        t += fi > 0.0 ? fi : fmax(g->face_max, g->face_seconds);
+    }
+    return t;
+}
+
+ps_status ps_gl_specular_idle(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
+                              double deadline, double guess, ps_error *err)
+{
+    if (deadline <= 0.0)
+        return PS_OK;
+    /* Not a new view's refresh: nothing waits for the picture. */
+    ps_session_frame idle = *f;
+    idle.new_view = idle.lights_changed = false;
+    double keep = g->deadline;
+    g->deadline = deadline;
+    g->idle = true;
+    g->idle_guess = guess;
+    ps_status st = ps_gl_specular_refresh(g, r, s, &idle, 6 * PS_SPECULAR_MAX_CUBES, err);
+    g->idle = false;
+    g->deadline = keep;
+    return st;
+}
+
 ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
                                  int faces, ps_error *err)
 {
@@ -330,6 +373,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
      * drawn, in the default scene). */
     bool first_round = g->first_refreshes > 0 && g->since_change < total;
     int n = faces <= 0 || faces > total ? total
+            : g->idle ? faces
             : settled ? (total + PS_GL_SPECULAR_SETTLE_REFRESHES - 1) / PS_GL_SPECULAR_SETTLE_REFRESHES
             : first_round ? (total + g->first_refreshes - 1) / g->first_refreshes
                           : faces;
@@ -343,10 +387,10 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
      * stayed black past 2 s (the default box's specular relMSE 0.145 at 1
      * and 2 s against 0.053 and 0.008-0.053 with it drawn), a worse picture
      * at each time for the sake of the time it is shown at. */
-    bool timed = faces > 0 && g->deadline > 0.0 && !quick;
+    bool timed = faces > 0 && g->deadline > 0.0 && (!quick || g->idle || g->first_held);
     if (timed && !ps_gl_specular_face_fits(ps_now_seconds(), g->deadline, face_estimate(g)))
         return PS_OK; /* before the budget's credit is spent on it */
-    if (faces > 0 && !settled && !first_round) {
+    if (faces > 0 && !settled && !first_round && !g->idle) {
         /* A face only when the refreshes' share of tau has saved up for one
          * (it took face_seconds last time; the first comes at once). */
         g->credit = fmin(g->credit + PS_GL_SPECULAR_TIME_SHARE * ps_session_get_settings(s)->tau,

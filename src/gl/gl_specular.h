@@ -72,6 +72,10 @@ void ps_gl_specular_destroy(ps_gl_specular *g); /* accepts NULL */
 /* The first round of faces after a change over `refreshes` refreshes
  * whatever the budget (0, the default: within the budget, as later rounds). */
 void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes);
+/* Whether that first round's faces, too, end by the deadline
+ * (ps_gl_specular_set_deadline) in a refresh: for a program that gives them
+ * its waits instead (ps_gl_specular_idle). */
+void ps_gl_specular_hold_first_round(ps_gl_specular *g, bool held);
 
 /* The next refreshes' cube faces past the first round after a change end
  * by `at` (ps_now_seconds' clock; 0: no limit), as each face's last time
@@ -84,6 +88,19 @@ void ps_gl_specular_set_deadline(ps_gl_specular *g, double at);
  * allowed until the deadline) may start at `now` under deadline `at` (0:
  * none). */
 bool ps_gl_specular_face_fits(double now, double at, double estimate);
+
+/* The seconds the next refresh's faces (a few a refresh, not a new view's)
+ * take whatever the deadline: the first round's (ps_gl_specular_set_first_round)
+ * while it lasts, at the last faces' mean time (0 before any was drawn). */
+double ps_gl_specular_unheld_seconds(const ps_gl_specular *g, ps_session *s);
+
+/* While the program waits anyway (photosplat-snap before the frame a
+ * checkpoint shows, app/pace.h), after refresh f: faces, the first round's
+ * too, each while it is predicted to end by `deadline` (before any face was
+ * timed, a face predicted to take `guess` seconds). Nothing else of the
+ * frame is drawn. */
+ps_status ps_gl_specular_idle(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
+                              double deadline, double guess, ps_error *err);
 
 /* Before drawing refresh f of session s: up to `faces` cube faces rendered
  * (0: every face of every cube), when f shows the specular layer. Leaves the

@@ -37,6 +37,8 @@ struct ps_session {
     uint64_t drawn_emitted[PS_MAP_COUNT];
     double splat_radius[PS_MAP_COUNT];
     double budget;         /* incremental: photons a map per refresh */
+    double whole_most[PS_MAP_COUNT]; /* whole: each map's photons emitted a refresh draws at most
+                                      * (ps_session_set_whole_most; HUGE_VAL: all) */
     size_t last_splats;    /* built by the last refresh ... */
     double last_build;     /* ... in this many seconds */
     double round_off;
@@ -287,6 +289,8 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
     s->scene = scene;
     s->set = *set;
     s->budget = PS_SESSION_BUDGET_START;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        s->whole_most[k] = HUGE_VAL;
     s->area_side = set->progressive_lights ? 1 : PS_PREVIEW_AREA_SIDE;
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_splat_batch_init(&s->batch[k]);
@@ -392,9 +396,10 @@ static bool same_camera(const ps_camera_frame *a, const ps_camera_frame *b)
 }
 
 /* How far into map k this refresh draws, from `from` photons (`from_emitted`
- * emitted): whole batches as the feed handed them over; incremental, at most
- * the budget beyond `from`, but at least one batch. *emitted: the photons
- * emitted for that prefix, which its splats are scaled by. Under the lock. */
+ * emitted): whole batches as the feed handed them over, at most `budget`
+ * photons beyond `from` (HUGE_VAL: all of them), but at least one batch.
+ * *emitted: the photons emitted for that prefix, which its splats are scaled
+ * by. Under the lock. */
 static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t from_emitted, double budget,
                             uint64_t *emitted);
 
@@ -410,6 +415,20 @@ static bool edit_draws_whole(const ps_session *s, uint64_t photons)
 
 static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emitted, uint64_t *emitted)
 {
+    if (!incremental(s)) {
+        /* At most whole_most[k] emitted: the stored photons up to the last
+         * batch within it (prefix_within keeps at least one). */
+        double budget = HUGE_VAL;
+        if (isfinite(s->whole_most[k])) {
+            size_t n;
+            const ps_feed_mark *m = ps_feed_marks(s->feed, (ps_map_kind)k, &n);
+            budget = 0.0;
+            for (size_t i = 0; i < n; i++)
+                if ((double)m[i].emitted <= s->whole_most[k])
+                    budget = fmax(budget, (double)m[i].stored - (double)from);
+        }
+        return prefix_within(s, k, from, from_emitted, budget, emitted);
+    }
     double budget = s->moving     ? s->budget * PS_SESSION_MOVING_SHARE
                     : s->catch_up ? s->budget * PS_SESSION_CATCH_UP_GAIN
                                   : s->budget;
@@ -428,7 +447,7 @@ static size_t prefix_within(const ps_session *s, int k, size_t from, uint64_t fr
     for (size_t i = 0; i < n; i++) {
         if (m[i].stored < from || m[i].emitted < *emitted)
             continue;
-        bool over = incremental(s) && (double)(m[i].stored - from) > budget;
+        bool over = (double)(m[i].stored - from) > budget;
         if (over && end > from)
             break;
         end = m[i].stored;
@@ -465,7 +484,10 @@ static ps_status imap_refresh(ps_session *s, const ps_photon_map *m, const ps_ca
     ps_splat_batch_reset_carry(b);
     b->wanted = b->lost = 0.0;
     uint64_t emitted;
-    size_t end = prefix_within(s, k, ps_illummap_count(s->imap), s->imap_emitted, s->imap_budget, &emitted);
+    /* The maps only grow (a whole refresh's share does not apply: they hold
+     * what earlier refreshes added, and drawing them costs no more). */
+    size_t end = prefix_within(s, k, ps_illummap_count(s->imap), s->imap_emitted, inc ? s->imap_budget : HUGE_VAL,
+                               &emitted);
     if (emitted == 0)
         return PS_OK;
     size_t added;
@@ -855,6 +877,12 @@ void ps_session_set_radius(ps_session *s, ps_map_kind k, double radius)
 }
 
 void ps_session_set_tau(ps_session *s, double tau) { s->set.tau = tau; }
+
+void ps_session_set_whole_most(ps_session *s, const double most[PS_MAP_COUNT])
+{
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        s->whole_most[k] = most && !(most[k] < 0.0) ? most[k] : HUGE_VAL;
+}
 
 ps_status ps_session_set_global_layer(ps_session *s, ps_global_layer g, ps_error *err)
 {

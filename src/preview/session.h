@@ -288,6 +288,14 @@ void ps_session_set_exposure(ps_session *s, double exposure);
 /* Map k's r0; radius <= 0 leaves it. */
 void ps_session_set_radius(ps_session *s, ps_map_kind k, double radius);
 void ps_session_set_tau(ps_session *s, double tau);
+/* Whole refreshes draw of map k at most most[k] photons emitted: the prefix
+ * up to the last batch the feed handed over within it (at least one batch),
+ * scaled by N / n for the photons it holds, so an unbiased picture of fewer
+ * photons. NULL, or HUGE_VAL (the default): all of them. For a refresh that
+ * must end by a time (photosplat-snap's 8-bit checkpoints: a redraw of
+ * every photon took seconds). The illumination maps keep all theirs.
+ * Incremental refreshes ignore it. */
+void ps_session_set_whole_most(ps_session *s, const double most[PS_MAP_COUNT]);
 /* Splats or illumination maps for the global layer; the maps are made (and
  * checked against the memory budget) when first asked for. */
 ps_status ps_session_set_global_layer(ps_session *s, ps_global_layer g, ps_error *err);
