@@ -685,6 +685,25 @@ static void area_lights_refine(void **state)
     assert_int_equal(ps_session_update(s, &ch, &err), PS_OK);
     assert_int_equal(ps_session_lights(s)->count, 1);
     ps_session_destroy(s);
+    /* Held (photosplat-snap's 8-bit checkpoints): refreshes keep the level;
+     * each ps_session_refine_lights brings the next, until all are there. */
+    s = open_session(scene, &set);
+    ps_session_hold_lights(s, true);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    for (int i = 0; i < 3; i++) {
+        refresh(s, &cam, &f);
+        assert_int_equal(ps_session_lights(s)->count, 1);
+        ps_session_drawn(s, 0.001);
+    }
+    for (int i = 1; i < 3; i++) {
+        assert_true(ps_session_refine_lights(s));
+        refresh(s, &cam, &f);
+        assert_true(f.lights_changed);
+        assert_int_equal(ps_session_lights(s)->count, want[i]);
+        ps_session_drawn(s, 0.001);
+    }
+    assert_false(ps_session_refine_lights(s));
+    ps_session_destroy(s);
     set.progressive_lights = false;
     s = open_session(scene, &set);
     assert_int_equal(ps_session_lights(s)->count, PS_PREVIEW_AREA_SAMPLES);

@@ -30,6 +30,7 @@ struct ps_session {
     bool illuminance;      /* white Lambertian, exposure 1, float (ps_session_set_illuminance) */
     int area_side;         /* an area light's virtual lights a side, refined up to PS_PREVIEW_AREA_SIDE */
     bool lights_pending;   /* area_side grew: lights to rebuild at the next refresh */
+    bool lights_held;      /* area_side grows only by ps_session_refine_lights */
     ps_material *white;    /* as many as the scene's, for illuminance mode */
     /* Invariant: drawn[k] photons of map k (a prefix ending at a feed mark,
      * drawn_emitted[k] emitted) are in the layers since the last new view. */
@@ -800,10 +801,19 @@ void ps_session_drawn(ps_session *s, double draw_seconds)
     /* Progressive area lights: a refresh drawn, the next one with twice as
      * many virtual lights a side, until all (only when the scene has an area
      * light: the others' GL lights do not change). */
-    if (s->area_side < PS_PREVIEW_AREA_SIDE && has_area_lights(s)) {
-        s->area_side *= 2;
-        s->lights_pending = true;
-    }
+    if (!s->lights_held)
+        ps_session_refine_lights(s);
+}
+
+void ps_session_hold_lights(ps_session *s, bool held) { s->lights_held = held; }
+
+bool ps_session_refine_lights(ps_session *s)
+{
+    if (s->area_side >= PS_PREVIEW_AREA_SIDE || !has_area_lights(s))
+        return false;
+    s->area_side *= 2;
+    s->lights_pending = true;
+    return true;
 }
 
 bool ps_session_settled(ps_session *s)
