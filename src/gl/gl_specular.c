@@ -386,7 +386,9 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
      * it starved behind snap's dense early checkpoints and the mirrors
      * stayed black past 2 s (the default box's specular relMSE 0.145 at 1
      * and 2 s against 0.053 and 0.008-0.053 with it drawn), a worse picture
-     * at each time for the sake of the time it is shown at. */
+     * at each time for the sake of the time it is shown at. A program that
+     * gives the faces its waits instead holds it (photosplat-snap's 8-bit
+     * checkpoints: ps_gl_specular_hold_first_round, ps_gl_specular_idle). */
     bool timed = faces > 0 && g->deadline > 0.0 && (!quick || g->idle || g->first_held);
     if (timed && !ps_gl_specular_face_fits(ps_now_seconds(), g->deadline, face_estimate(g)))
         return PS_OK; /* before the budget's credit is spent on it */

@@ -485,8 +485,9 @@ static ps_status imap_refresh(ps_session *s, const ps_photon_map *m, const ps_ca
     ps_splat_batch_reset_carry(b);
     b->wanted = b->lost = 0.0;
     uint64_t emitted;
-    /* The maps only grow (a whole refresh's share does not apply: they hold
-     * what earlier refreshes added, and drawing them costs no more). */
+    /* The maps only grow (a whole refresh's cap, ps_session_set_whole_most,
+     * does not apply: they hold what earlier refreshes added, and drawing
+     * them costs no more). */
     size_t end = prefix_within(s, k, ps_illummap_count(s->imap), s->imap_emitted, inc ? s->imap_budget : HUGE_VAL,
                                &emitted);
     if (emitted == 0)
