@@ -654,6 +654,40 @@ static void after_the_stop_converges_to_the_whole_view(void **state)
     ps_scene_destroy(scene);
 }
 
+
+/* After a camera move, the first still refresh draws the budget (the camera
+ * may only have paused between two steps), the next ones
+ * PS_SESSION_CATCH_UP_GAIN times it, until the view is whole again. */
+static void catch_up_after_the_first_still_refresh(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = 8 * PS_FEED_BATCH;
+    ps_camera_frame cam;
+    ps_session_frame f;
+    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
+    /* Drawn at the rate that makes the caustic's budget 1.6 batches (less
+     * the time its splats took to build): one batch a refresh, 4.8 (at
+     * least three while the build takes under 0.6 of the drawing; 2 at the
+     * gain of 1.6) when caught up. */
+    double rate = 1.6 * PS_FEED_BATCH * PS_MAP_COUNT / (set.tau * set.splat_share);
+    ps_session_drawn(s, (double)f.splats / rate);
+    wait_ended(s);
+    cam.eye.x += 0.05;
+    refresh(s, &cam, &f);
+    assert_true(f.moving);
+    ps_session_drawn(s, 1.0);
+    refresh(s, &cam, &f); /* the same camera again: still */
+    assert_false(f.moving);
+    assert_true(f.new_view);
+    assert_int_equal(f.emitted[PS_MAP_CAUSTIC], PS_FEED_BATCH);
+    ps_session_drawn(s, (double)f.splats / rate);
+    refresh(s, &cam, &f);
+    assert_true(f.emitted[PS_MAP_CAUSTIC] >= 4 * PS_FEED_BATCH); /* the first and three more */
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
 /* Progressive area lights: the first refresh with one virtual light an area
  * light, then 2 x 2, then all 16, each change said (lights_changed); an
  * edit starts over at one; without the setting, 16 from the start. */
@@ -722,6 +756,7 @@ int main(void)
         cmocka_unit_test(edits_restart_the_maps),
         cmocka_unit_test(hidden_layers_are_skipped),
         cmocka_unit_test(radius_follows_the_schedule),
+        cmocka_unit_test(catch_up_after_the_first_still_refresh),
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(moving_camera_level_of_detail),
         cmocka_unit_test(moving_growth_held),

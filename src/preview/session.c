@@ -50,6 +50,7 @@ struct ps_session {
                             * left to the thread has not copied them all yet) */
     bool dragging;         /* ps_session_set_dragging */
     bool catch_up;         /* still after a move, the view not yet drawn in full */
+    int still_refreshes;   /* ... and the refreshes drawn since the camera stopped */
     ps_camera_frame cam;
     bool edited, geometry_edited;
     uint64_t edits;
@@ -431,7 +432,7 @@ static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emit
         return prefix_within(s, k, from, from_emitted, budget, emitted);
     }
     double budget = s->moving     ? s->budget * PS_SESSION_MOVING_SHARE
-                    : s->catch_up ? s->budget * PS_SESSION_CATCH_UP_GAIN
+                    : s->catch_up ? s->budget * (s->still_refreshes > 0 ? PS_SESSION_CATCH_UP_GAIN : 1.0)
                                   : s->budget;
     if (s->edit_view && !s->moving && edit_draws_whole(s, s->edit_held))
         budget = HUGE_VAL;
@@ -566,6 +567,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         /* Still again: the view starts over at full detail. */
         s->moving = false;
         s->catch_up = true;
+        s->still_refreshes = 0;
         s->view_dirty = true;
     }
     /* An edit's first picture, unless it draws every photon (the edit then
@@ -707,8 +709,10 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     bool whole = true;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         whole = whole && s->drawn[k] >= maps[k].count;
-    if (s->catch_up) /* the view is whole again once every stored photon is drawn */
+    if (s->catch_up) { /* the view is whole again once every stored photon is drawn */
         s->catch_up = !whole && !s->moving;
+        s->still_refreshes++;
+    }
     bool merge = whole && ps_feed_merge_pending(s->feed);
     ps_feed_unlock(s->feed);
     /* Every photon of a repaired feed drawn: its maps back in index order
