@@ -517,6 +517,20 @@ static ps_pace_plan plan_refresh(snap_run *s, double clock, double due, int cp, 
     return ps_pace_next(&s->pace, now, photons, due, s->o->checkpoints + cp, s->o->checkpoint_count - cp);
 }
 
+/* 8 bits, between checkpoints: a whole refresh of one batch, drawn and not
+ * shown, the tracer held and no cube faces in it, for what it teaches the
+ * pace or brings (an area light's next virtual lights). */
+static ps_status unseen_batch(snap_run *s, ps_error *err)
+{
+    const double one[PS_MAP_COUNT] = {0.0, 0.0};
+    ps_session_set_whole_most(s->session, one);
+    ps_gl_specular_set_deadline(s->spec, ps_now_seconds());
+    ps_session_hold(s->session, true);
+    ps_status st = refresh(s, err);
+    ps_session_hold(s->session, false);
+    return st;
+}
+
 /* Progressive: trace in the background, refresh every tau. As in the window,
  * the first round is traced before the first frame, so that it already shows
  * photons. Time spent writing checkpoints is taken off the clock (the tracer
@@ -546,12 +560,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
          * one batch. */
         if (!s->layers && s->pace.learned == 1 && cp < o->checkpoint_count &&
             plan.start > ps_now_seconds() - clock) {
-            const double one[PS_MAP_COUNT] = {0.0, 0.0};
-            ps_session_set_whole_most(s->session, one);
-            ps_gl_specular_set_deadline(s->spec, ps_now_seconds()); /* no faces in it */
-            ps_session_hold(s->session, true);
-            st = refresh(s, err);
-            ps_session_hold(s->session, false);
+            st = unseen_batch(s, err);
             if (st != PS_OK)
                 break;
             plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
@@ -564,12 +573,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             double wait = clock + plan.start - ps_now_seconds();
             unsigned lights = ps_gl_get_stats(s->gl).virtual_lights;
             if (wait > 4.0 * lights * s->shadow_per_light + s->pace.seconds && ps_session_refine_lights(s->session)) {
-                const double one[PS_MAP_COUNT] = {0.0, 0.0};
-                ps_session_set_whole_most(s->session, one);
-                ps_gl_specular_set_deadline(s->spec, ps_now_seconds());
-                ps_session_hold(s->session, true);
-                st = refresh(s, err);
-                ps_session_hold(s->session, false);
+                st = unseen_batch(s, err);
                 if (st != PS_OK)
                     break;
                 plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
