@@ -73,7 +73,7 @@ awk -F, 'NR > 1 && $3 > 1.5 * $2 { print "checkpoint " $2 " s at " $3 " s"; bad 
     "$cli_tmp/ct.csv" && ok || bad "checkpoints late: $(cat "$cli_tmp/ct.csv")"
 # ... and in 8 bits, whose frames redraw every photon shown: the frame a
 # checkpoint shows draws the prefix that fits (app/pace.h; before, a redraw
-# of the 2-3*10^6 photons there by then made the 2 s one land at 3.3-3.4 s in
+# of the 1.8-3*10^6 photons there by then made the 2 s one land at 3.3-3.4 s in
 # two runs of four), never fewer photons than the checkpoint before.
 expect_success "8-bit checkpoints on time" "$snap" "$mirror" --size 64x64 --time 2 --checkpoints 1,2 \
     --checkpoint-prefix "$cli_tmp/c8" --caustic-photons 20000000 --color-depth 8

@@ -89,7 +89,7 @@
  * keeps the budget, so that a camera that only paused between two steps is
  * not held up by a long one (at 3x from the first, an orbit of 60 steps
  * 0.05 s apart drew 49-58 frames against 58-59). The full picture after an
- * orbit over 1.25*10^6 photons: 1.6-2.0 s, against 2.8-3.7 s at 1.6x from
+ * orbit over 1.25*10^6 photons: 1.6-2.0 s, against 2.8-4.0 s at 1.6x from
  * the first. Moving refreshes teach the budget nothing (their time is the
  * level of detail's). */
 #define PS_SESSION_CATCH_UP_GAIN 3.0
