@@ -277,15 +277,24 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
     return st;
 }
 
+/* Every photon has arrived, or tracing is held for good (paused, or the
+ * error counter stopped it): *arrived, the photons emitted in both maps. */
+static bool photons_settled(ps_session *s, uint64_t *arrived)
+{
+    ps_session_counts counts;
+    ps_session_get_counts(s, &counts);
+    *arrived = counts.map[0].emitted + counts.map[1].emitted;
+    return counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL);
+}
+
 double ps_gl_specular_unheld_seconds(const ps_gl_specular *g, ps_session *s)
 {
     int total = 6 * g->cube_count;
     if (g->frozen || total == 0 || g->first_refreshes <= 0 || g->first_held || g->since_change >= total)
         return 0.0;
     /* As ps_gl_specular_refresh decides a quick face: the first round, not settled. */
-    ps_session_counts counts;
-    ps_session_get_counts(s, &counts);
-    if (counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL))
+    uint64_t arrived;
+    if (photons_settled(s, &arrived))
         return 0.0;
     /* Each face as it took last, or the dearest seen (faces differ several-fold). */
     int n = (total + g->first_refreshes - 1) / g->first_refreshes;
@@ -346,11 +355,8 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     /* Settled: every photon has arrived (the feed ended; a new view of the
      * same photons changes no cube), and since the last arrived a whole
      * round was drawn: nothing new to show. */
-    ps_session_counts counts;
-    ps_session_get_counts(s, &counts);
-    uint64_t arrived = counts.map[0].emitted + counts.map[1].emitted;
-    /* Held for good (paused, or the error counter stopped it): as ended. */
-    bool settled = counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL);
+    uint64_t arrived;
+    bool settled = photons_settled(s, &arrived); /* held for good: as ended */
     if (arrived != g->arrived || !settled) {
         g->arrived = arrived;
         /* The last photons arrived: the round from here on is every face
@@ -481,12 +487,10 @@ bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s)
      * layer changed), not the per-vertex lookups shown until then. */
     if (!ps_specular_pixel_points(ps_session_specular(s)).ready)
         return false;
-    ps_session_counts counts;
-    ps_session_get_counts(s, &counts);
     int total = 6 * cubes;
-    bool settled = counts.ended || ps_session_paused(s) || ps_session_counter_stopped(s, NULL);
-    return settled && counts.map[0].emitted + counts.map[1].emitted == g->arrived && g->since_settled >= total &&
-           g->since_change >= total;
+    uint64_t arrived;
+    bool settled = photons_settled(s, &arrived);
+    return settled && arrived == g->arrived && g->since_settled >= total && g->since_change >= total;
 }
 
 /* The weights of term k times exposure (the arrays as they are at 1). */
