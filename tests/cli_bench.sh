@@ -80,6 +80,18 @@ expect_success "8-bit checkpoints on time" "$snap" "$mirror" --size 64x64 --time
 awk -F, 'NR > 1 && ($3 > 1.5 * $2 || $3 < $2 || $4 < n) { print "checkpoint " $2 " s at " $3 " s, " $4 " photons"; bad = 1 }
          NR > 1 { n = $4 } END { exit bad }' "$cli_tmp/c8.csv" && ok || bad "8-bit checkpoints late: $(cat "$cli_tmp/c8.csv")"
 
+# ... and when every cap is reached in the first round: in float the
+# checkpoints still to come get their own frames, at or after their time
+# (before, the last picture, with every area light's 16 virtual lights and
+# every cube face, showed them all: the 0.5 s one at 1.3-1.6 s, the 2 s one
+# before its time). The area light's next virtual lights wait while their
+# shadow cubes would make a checkpoint late.
+expect_success "capped float checkpoints on time" "$snap" data/scenes/cornell-caustic-area.scn --size 64x64 \
+    --time 2.5 --checkpoints 0.5,2 --checkpoint-prefix "$cli_tmp/cc" --caustic-photons 20000 \
+    --global-photons 5000 --color-depth float
+awk -F, 'NR > 1 && ($3 < $2 || $3 > 1.5 * $2 + 0.25 || $4 != 20000) { print "checkpoint " $2 " s at " $3 " s, " $4 " photons"; bad = 1 }
+         END { exit bad }' "$cli_tmp/cc.csv" && ok || bad "capped float checkpoints: $(cat "$cli_tmp/cc.csv")"
+
 # ---- compare --clamp --------------------------------------------------------------
 expect_usage_error "bad clamp" "$compare" "$cli_tmp/w.pfm" "$cli_tmp/w.pfm" --clamp 0
 expect_success "clamp" "$compare" "$cli_tmp/l-caustic.pfm" "$cli_tmp/l-direct.pfm" --clamp 1e-30

@@ -188,6 +188,7 @@ typedef struct snap_run {
     double shown[PS_MAP_COUNT]; /* ... and each map's photons emitted that the last checkpoint showed */
     double shadow_per_light;    /* ... and a virtual light's shadow cube, seconds (0: not timed) */
     bool lights_held;           /* area lights refined in the waits (ps_session_hold_lights) */
+    double lit_seconds;         /* the last refresh with new lights, less its cube faces (0: none yet) */
 } snap_run;
 
 /* One refresh: what the session says, drawn into the layers (the new
@@ -222,7 +223,7 @@ static ps_status refresh(snap_run *s, ps_error *err)
     ps_latency_add(&s->lat, PS_LAT_SPECULAR, t_draw - t0 - gst.shadow_seconds_last);
     ps_latency_add(&s->lat, PS_LAT_SHADOWS, gst.shadow_seconds_last);
     ps_latency_add_faces(&s->lat, gst.shadow_faces_last);
-    double shadows = gst.shadow_seconds_last;
+    double shadows = gst.shadow_seconds_last, faces_seconds = t_draw - t0 - shadows;
     ps_gl_clear_shadow_timing(s->gl);
     if (s->layers) {
         ps_gl_layers_draw(s->layers, s->gl, &s->cam, &s->frame);
@@ -242,6 +243,8 @@ static ps_status refresh(snap_run *s, ps_error *err)
     shadows += gst.shadow_seconds_last;
     if (shadows > 0.0 && gst.virtual_lights > 0)
         s->shadow_per_light = shadows / gst.virtual_lights;
+    if (s->frame.lights_changed || s->frames == 0)
+        s->lit_seconds = t1 - t_refresh - faces_seconds;
     ps_latency_add(&s->lat, PS_LAT_SHADOWS, gst.shadow_seconds_last);
     ps_latency_add_faces(&s->lat, gst.shadow_faces_last);
     ps_latency_add(&s->lat, PS_LAT_DRAW, t1 - t_draw - gst.shadow_seconds_last);
@@ -565,19 +568,34 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
                 break;
             plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
         }
-        /* 8 bits: the next level of an area light's virtual lights when its
-         * shadow cubes fit in the wait (from the last level's, a light as
-         * long), drawn in a batch not shown; in a checkpoint's frame they
-         * made the area box's 1 s checkpoint land at 1.5-2.3 s. */
-        if (!s->layers && s->lights_held && s->shadow_per_light > 0.0 && cp < o->checkpoint_count) {
-            double wait = clock + plan.start - ps_now_seconds();
+        /* The next level of an area light's virtual lights, only when it
+         * keeps the next checkpoint on time. 8 bits: when its shadow cubes
+         * fit in the wait (from the last level's, a light as long), drawn
+         * in a batch not shown; in a checkpoint's frame they made the area
+         * box's 1 s checkpoint land at 1.5-2.3 s. */
+        if (s->lights_held && s->shadow_per_light > 0.0 && cp < o->checkpoint_count) {
             unsigned lights = ps_gl_get_stats(s->gl).virtual_lights;
-            if (wait > 4.0 * lights * s->shadow_per_light + s->pace.seconds && ps_session_refine_lights(s->session)) {
+            double wait = clock + plan.start - ps_now_seconds();
+            if (!s->layers && wait > 4.0 * lights * s->shadow_per_light + s->pace.seconds &&
+                ps_session_refine_lights(s->session)) {
                 st = unseen_batch(s, err);
                 if (st != PS_OK)
                     break;
                 plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
             }
+            /* Float: the next refresh draws them when it ends before the
+             * next checkpoint, taken as 4x the last refresh with new lights
+             * (4x the lights: their shadow cubes and lit passes; its cube
+             * faces left out). A refresh that took the area box's lights
+             * from 4 to 16 ended 0.3-0.4 s after a 0.5 s checkpoint at 64^2;
+             * the shadow cubes alone, predicted, left the 1 s one 14-17 % late. */
+            if (s->layers && ps_now_seconds() + 4.0 * s->lit_seconds < clock + o->checkpoints[cp])
+                ps_session_refine_lights(s->session);
+        }
+        /* Every checkpoint shown: the lights grow a level a refresh again. */
+        if (s->lights_held && cp >= o->checkpoint_count) {
+            ps_session_hold_lights(s->session, false);
+            s->lights_held = false;
         }
         /* 8 bits: a refresh that waits for its start leaves that time to
          * the cube faces, which would otherwise ride in the frames (the
@@ -644,10 +662,12 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         if (ps_session_counter_stopped(s->session, NULL))
             break;
         next += o->p.tau;
-        /* Every photon traced: float layers show the rest at once; an 8-bit
-         * redraw of them all takes seconds, so checkpoints still to come get
-         * their own frames, on time, and the last picture follows. */
-        if ((counts.ended && (s->layers || cp >= o->checkpoint_count)) || ps_now_seconds() >= end)
+        /* Every photon traced: checkpoints still to come get their own
+         * frames, on time, and the last picture follows. (An 8-bit redraw of
+         * them all takes seconds; in float the last picture's every virtual
+         * light and cube face did: the area box's 1 s checkpoint, at the
+         * scene's counts, came at 2.7 s.) */
+        if ((counts.ended && cp >= o->checkpoint_count) || ps_now_seconds() >= end)
             break;
     }
     ps_gl_specular_set_deadline(s->spec, 0.0);
@@ -994,8 +1014,11 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
      * the first round's three faces a frame were longer than the frame of a
      * 1 s checkpoint may be (PS_PACE_FRAME_SHARE); the waits before those
      * frames draw them instead (refine). */
-    if (st == PS_OK && !o->script && !s.layers && o->checkpoint_count > 0) {
+    if (st == PS_OK && !o->script && !s.layers && o->checkpoint_count > 0)
         ps_gl_specular_hold_first_round(s.spec, true);
+    /* Checkpoints: an area light's next virtual lights when their shadow
+     * cubes fit before the next checkpoint (refine). */
+    if (st == PS_OK && !o->script && o->checkpoint_count > 0) {
         ps_session_hold_lights(s.session, true);
         s.lights_held = true;
     }

@@ -275,9 +275,10 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
  * (a snapshot's last picture). */
 void ps_session_full_lights(ps_session *s);
 /* Whether progressive area lights grow only when asked (ps_session_refine_lights)
- * instead of a level a refresh: photosplat-snap's 8-bit checkpoints refine
- * them in the waits between frames, where their shadow cubes (1.2-1.9 s for
- * the area box's 16 virtual lights at 256^2) fit, not in a checkpoint's frame. */
+ * instead of a level a refresh: photosplat-snap's checkpoints refine them
+ * where their shadow cubes (1.2-1.9 s for the area box's 16 virtual lights at
+ * 256^2) keep the next checkpoint on time (8 bits: in the waits between
+ * frames), not in a checkpoint's frame. */
 void ps_session_hold_lights(ps_session *s, bool held);
 /* Twice the virtual lights a side from the next refresh on; false when all
  * are there (or the scene has no area light). */
