@@ -137,6 +137,12 @@ expect_success "bench: replot" "$bench" --replot --quick --size 24x24 --budgets 
 cmp -s "$cli_tmp/b/bench.csv" "$cli_tmp/b.csv" && ok || bad "bench: --replot changed the CSV"
 grep -q '^Remade by `photosplat-bench --replot`' "$cli_tmp/b/bench.md" && grep -q '^| triangles float fixed | [0-9.]* @ ' "$cli_tmp/b/bench.md" &&
     ok || bad "bench: --replot did not remake bench.md"
+# The checkpoints on time (done within 20 % of their seconds), counted from
+# the CSV the replot read: all of them, and those asked for from 0.5 s on.
+want=$(awk -F, 'NR > 1 { n++; if ($8 <= 1.2 * $7) k++; if ($7 >= 0.5) { m++; if ($8 <= 1.2 * $7) j++ } }
+                END { printf "%d of %d; of those asked for from 0.5 s on, %d of %d", k, n, j, m }' "$cli_tmp/b/bench.csv")
+grep -qF "Checkpoints on time (within 20 %): $want." "$cli_tmp/b/bench.md" && ok ||
+    bad "bench.md's checkpoints on time are not the CSV's ($want): $(grep '^Checkpoints on time' "$cli_tmp/b/bench.md")"
 expect_usage_error "bench: replot, other budgets" "$bench" --replot --quick --size 24x24 --budgets 0.05 \
     --scenes "$cli_tmp/tiny.scn:0.5" --out "$cli_tmp/b" --bin "$bin"
 # Again: the references come from the cache; a changed scene renders anew.
