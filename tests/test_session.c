@@ -8,6 +8,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "photon/tracer.h"
 #include "preview/feed.h"
 #include "preview/session.h"
 #include "scene/scene.h"
@@ -303,6 +304,88 @@ static void budget_bounds_a_refresh(void **state)
     assert_int_equal(f.emitted[PS_MAP_CAUSTIC], before + PS_FEED_BATCH);
     ps_session_destroy(s);
     ps_scene_destroy(scene);
+}
+
+/* Waits (at most 5 s) until the caustic map holds the same photons for
+ * 0.2 s: the feed paused or ended. Returns its stored count. */
+static uint64_t wait_still(ps_session *s)
+{
+    ps_session_counts a, b;
+    ps_session_get_counts(s, &a);
+    for (int i = 0; i < 25; i++) {
+        struct timespec ts = {0, 200000000};
+        nanosleep(&ts, NULL);
+        ps_session_get_counts(s, &b);
+        if (b.map[PS_MAP_CAUSTIC].stored == a.map[PS_MAP_CAUSTIC].stored)
+            return b.map[PS_MAP_CAUSTIC].stored;
+        a = b;
+    }
+    fail_msg("the tracer did not wait within 5 s");
+    return 0;
+}
+
+/* photosplat-snap's float layers (backlog_refreshes): the tracer waits while
+ * a map holds more photons not drawn than that many refreshes' budgets, and
+ * goes on as the refreshes draw them, to the cap. Without the setting it
+ * runs to the cap however far behind the drawing is. */
+static void backlog_holds_the_tracer(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    for (int held = 0; held < 2; held++) {
+        ps_session_settings set = settings(scene, true);
+        set.caps[PS_MAP_CAUSTIC] = 100 * PS_FEED_BATCH;
+        set.backlog_refreshes = held ? 1.0 : 0.0;
+        ps_camera_frame cam;
+        ps_session_frame f;
+        ps_session *s = start_and_refresh(scene, &set, &cam, &f);
+        /* A second per splat: the budget at its floor, a batch a refresh. */
+        ps_session_drawn(s, (double)f.splats);
+        ps_session_counts c;
+        for (int i = 0; i < 1000; i++) { /* until a few batches wait, or the end */
+            ps_session_get_counts(s, &c);
+            if (c.ended || c.map[PS_MAP_CAUSTIC].emitted >= f.emitted[PS_MAP_CAUSTIC] + 4 * PS_FEED_BATCH)
+                break;
+            struct timespec ts = {0, 5000000};
+            nanosleep(&ts, NULL);
+        }
+        ps_session_drawn(s, (double)f.splats);
+        uint64_t still = wait_still(s);
+        ps_session_get_counts(s, &c);
+        if (!held) {
+            assert_true(c.ended);
+            assert_int_equal(c.map[PS_MAP_CAUSTIC].emitted, set.caps[PS_MAP_CAUSTIC]);
+        } else {
+            /* Waiting, well short of the cap ... */
+            assert_false(c.ended);
+            assert_true(c.map[PS_MAP_CAUSTIC].emitted < set.caps[PS_MAP_CAUSTIC] / 2);
+            /* ... and going on as the refreshes draw what waits. */
+            for (int i = 0; i < 4000 && !c.ended; i++) {
+                refresh(s, &cam, &f);
+                ps_session_drawn(s, (double)f.splats);
+                struct timespec ts = {0, 1000000};
+                nanosleep(&ts, NULL);
+                ps_session_get_counts(s, &c);
+            }
+            assert_true(c.ended);
+            assert_true(c.map[PS_MAP_CAUSTIC].stored > still);
+            assert_int_equal(c.map[PS_MAP_CAUSTIC].emitted, set.caps[PS_MAP_CAUSTIC]);
+        }
+        ps_session_destroy(s);
+    }
+    ps_scene_destroy(scene);
+}
+
+/* Tracing threads: those asked for; else every core, but one left to
+ * drawing where refreshes draw while tracing goes on. */
+static void tracing_threads_leave_a_core_to_drawing(void **state)
+{
+    (void)state;
+    assert_int_equal(ps_session_tracing_threads(3, true), 3);
+    assert_int_equal(ps_session_tracing_threads(3, false), 3);
+    assert_int_equal(ps_session_tracing_threads(0, false), 0);
+    int cores = ps_online_cores();
+    assert_int_equal(ps_session_tracing_threads(0, true), cores > 1 ? cores - 1 : 0);
 }
 
 /* The error counter (thesis 5.1): in 8 bits, once a refresh loses more than
@@ -760,6 +843,8 @@ int main(void)
         cmocka_unit_test(whole_cap_draws_a_prefix),
         cmocka_unit_test(incremental_refresh_splats_each_photon_once),
         cmocka_unit_test(budget_bounds_a_refresh),
+        cmocka_unit_test(backlog_holds_the_tracer),
+        cmocka_unit_test(tracing_threads_leave_a_core_to_drawing),
         cmocka_unit_test(counter_stops_shooting),
         cmocka_unit_test(edits_restart_the_maps),
         cmocka_unit_test(hidden_layers_are_skipped),

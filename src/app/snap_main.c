@@ -47,7 +47,8 @@ static const char usage[] =
     "  --caustic-radius R       caustic splat radius, scene units\n"
     "  --global-radius R        global splat radius, scene units\n"
     "  --seed S                 photon i depends only on (scene, seed, i) (default 0)\n"
-    "  --threads N              tracing threads (default: all cores)\n"
+    "  --threads N              tracing threads (default: all cores; float layers\n"
+    "                           refining (--time, --script): all but one, left to drawing)\n"
     "  --stats FILE.json        figures of the run\n"
     "  --dump-photons FILE      every stored photon: map x y z r g b dx dy dz nx ny nz\n"
     "  --time SECONDS           progressive mode: trace and refine this long\n"
@@ -84,6 +85,14 @@ static const char usage[] =
 /* Progressive float refreshes may give this share of tau to new splats:
  * snap shows nothing between them (the window leaves room to show). */
 #define SNAP_SPLAT_SHARE 0.9
+/* --time in float layers: the tracer waits while a map holds more photons
+ * not drawn than this many refreshes draw. Tracing ran 2-3 times ahead of
+ * the drawing it shared the cores with: the default box's 2 s checkpoint
+ * showed 65 536 caustic photons of 1.8 million traced and its 5 s one
+ * 0.6 million (the rest drawn after --time, which ended at 10 s for 5);
+ * waiting, 0.36 and 1.6 million, ended at 6 s (2, 4 and 8 refreshes alike;
+ * 8 bits redraw whatever is there). */
+#define SNAP_BACKLOG_REFRESHES 4.0
 
 /* Enough checkpoints for a log-spaced curve from milliseconds to hours. */
 #define SNAP_MAX_CHECKPOINTS 64
@@ -226,12 +235,19 @@ static ps_status refresh(snap_run *s, ps_error *err)
     double shadows = gst.shadow_seconds_last, faces_seconds = t_draw - t0 - shadows;
     ps_gl_clear_shadow_timing(s->gl);
     if (s->layers) {
+        /* The splats' own time, as the window's: the rate the next budget
+         * comes from (session.h). With the cube faces and the specular layer
+         * in it, the default box's budget stayed at one batch a map while
+         * tracing, and its 2 s checkpoint showed 3 % of the photons traced. */
         ps_gl_layers_draw(s->layers, s->gl, &s->cam, &s->frame);
+        if (s->frame.splats > 0)
+            ps_gl_finish(); /* llvmpipe draws when flushed: time the drawing, not the queueing */
+        splat_seconds = ps_now_seconds() - t_draw;
         st = ps_gl_specular_layer(s->spec, s->layers, s->gl, s->session, &s->frame, err);
         if (st != PS_OK)
             return st;
-        if (s->frame.splats > 0)
-            ps_gl_finish(); /* llvmpipe draws when flushed: time the drawing, not the queueing */
+        if (s->frame.specular)
+            ps_gl_finish();
     } else {
         ps_gl_draw_frame_timed(s->gl, &s->cam, &s->frame, &splat_seconds);
         if (s->frame.specular)
@@ -256,7 +272,7 @@ static ps_status refresh(snap_run *s, ps_error *err)
     s->splats += s->frame.splats;
     s->draw_seconds += spent;
     s->frames++;
-    ps_session_drawn(s->session, spent);
+    ps_session_drawn(s->session, s->layers ? splat_seconds : spent);
     /* The pace's model: this refresh less its cube faces and shadow maps
      * (made once for new lights). Incremental refreshes learn nothing from
      * a new view or new lights (the direct layer drawn again, once), unless
@@ -990,9 +1006,15 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
      * (and a checkpoint) comes when it is due however many have arrived. */
     bool progressive = o->time > 0.0 || o->script;
     set.incremental = progressive && set.float_buffer;
+    /* Float layers draw while the tracer runs, as the window's: a core left
+     * to drawing (session.h). 8 bits redraw every photon each refresh, and
+     * the tracer waits while a checkpoint's frame is drawn: every core. */
+    set.threads = ps_session_tracing_threads(o->c.threads, set.incremental);
     /* Only a script edits: path records for the selective repair then. */
     set.repair = o->script != NULL && !o->no_repair;
     set.splat_share = SNAP_SPLAT_SHARE;
+    if (o->time > 0.0 && !o->script)
+        set.backlog_refreshes = SNAP_BACKLOG_REFRESHES;
     /* Progressive: the first picture without waiting for every area light's
      * 16 shadow cubes; a fixed photon count draws once, with all of them. */
     set.progressive_lights = progressive;

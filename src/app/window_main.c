@@ -85,7 +85,7 @@ static const char usage[] =
     "  --caustic-radius R       caustic splat radius, scene units\n"
     "  --global-radius R        global splat radius, scene units\n"
     "  --seed S                 photon i depends only on (scene, seed, i) (default 0)\n"
-    "  --threads N              tracing threads (default: all cores)\n"
+    "  --threads N              tracing threads (default: all cores but one, left to drawing)\n"
     "  --stats FILE.json        figures of the session, written at the end\n"
     "  --script FILE            timed actions (see the README), e.g. for tests\n"
     "  --tau SECONDS            time between refreshes (default 0.1)\n"
@@ -276,9 +276,7 @@ static ps_camera_frame camera_frame(const app *a) { return ps_camera_frame_make(
 static ps_status open_session(app *a, ps_error *err)
 {
     ps_session_settings set = ps_preview_settings(&a->o.c, &a->o.p, a->scene);
-    /* One core is left to drawing (llvmpipe draws on the CPU too): with every
-     * core tracing, the picture after a light move took four times as long. */
-    set.threads = a->o.c.threads > 0 ? (int)a->o.c.threads : (ps_online_cores() > 1 ? ps_online_cores() - 1 : 1);
+    set.threads = ps_session_tracing_threads(a->o.c.threads, true); /* a core left to drawing */
     set.cancel = a->o.cancel;
     set.max_stored = (size_t)a->o.max_photons;
     set.incremental = true;

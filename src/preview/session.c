@@ -56,6 +56,7 @@ struct ps_session {
     uint64_t edits;
     /* Tracing: the feed is held while any of these holds. */
     bool started, user_paused, hold, first_pending, counter_stopped;
+    bool backlogged;       /* incremental: more traced than the next refreshes draw */
     uint64_t counter_at;
     double splat_seconds;
     uint64_t refreshes;
@@ -83,6 +84,14 @@ struct ps_session {
     uint64_t feed_gen;     /* the feed's generation the drawn prefixes belong to */
     uint64_t maps_epoch;   /* ps_session_maps_epoch */
 };
+
+int ps_session_tracing_threads(int64_t requested, bool draws_while_tracing)
+{
+    if (requested > 0)
+        return (int)requested;
+    int cores = ps_online_cores();
+    return draws_while_tracing && cores > 1 ? cores - 1 : 0;
+}
 
 ps_session_settings ps_session_default_settings(const ps_scene *scene)
 {
@@ -123,7 +132,8 @@ static double exposure(const ps_session *s) { return s->illuminance ? 1.0 : s->s
 static void apply_pause(ps_session *s)
 {
     if (s->feed)
-        ps_feed_pause(s->feed, s->user_paused || s->hold || s->first_pending || s->counter_stopped || s->edited);
+        ps_feed_pause(s->feed, s->user_paused || s->hold || s->first_pending || s->counter_stopped || s->edited ||
+                                   s->backlogged);
 }
 
 /* ---- building ----------------------------------------------------------------- */
@@ -793,6 +803,17 @@ void ps_session_drawn(ps_session *s, double draw_seconds)
     if (incremental(s) && s->last_splats > 0 && !s->moving) {
         double rate = (double)s->last_splats / fmax(s->last_build + draw_seconds, 1e-6);
         s->budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * s->set.splat_share / PS_MAP_COUNT);
+    }
+    /* The tracer waits while the picture is far behind it (settings). */
+    s->backlogged = false;
+    if (incremental(s) && s->set.backlog_refreshes > 0.0 && s->feed) {
+        ps_feed_lock(s->feed);
+        const ps_photon_map *maps = ps_feed_maps(s->feed);
+        for (int k = 0; k < PS_MAP_COUNT; k++)
+            if (!(k == PS_MAP_GLOBAL && s->imap) &&
+                (double)maps[k].count - (double)s->drawn[k] > s->set.backlog_refreshes * s->budget)
+                s->backlogged = true;
+        ps_feed_unlock(s->feed);
     }
     /* Thesis 5.1: once a refresh loses this much to round-off, more photons
      * only add noise: stop shooting (until the next edit). */

@@ -161,6 +161,9 @@ typedef struct ps_session_settings {
     double exposure;
     bool incremental;              /* see above: only with float_buffer */
     double tau;                    /* seconds between refreshes: the budget's time */
+    double backlog_refreshes;      /* incremental: the tracer waits while a map holds more
+                                    * photons not drawn than this many refreshes' budgets
+                                    * (0: never; photosplat-snap) */
     double splat_share;            /* incremental: the share of tau new splats may take
                                     * (PS_SESSION_SPLAT_TIME_SHARE; more where nothing else
                                     * waits, as in photosplat-snap) */
@@ -190,6 +193,15 @@ typedef struct ps_session_settings {
  * cone kernel, 8 bits with error diffusion, fixed radius, exposure 1, whole
  * refreshes, tau 0.1, shadow maps of 1024. */
 ps_session_settings ps_session_default_settings(const ps_scene *scene);
+/* The tracing threads of a session whose refreshes draw while it traces
+ * (incremental: the window, photosplat-snap's float layers): those asked
+ * for (requested > 0), else every core but one, left to drawing (llvmpipe
+ * draws on the CPU too; with every core tracing, the window's picture after
+ * a light move took four times as long, and snap's float refreshes drew
+ * 0.4-0.55 M splats a second at 256^2 while the tracer ran 2-3 times ahead
+ * of them). A session that draws only once it has traced takes every core
+ * (0). */
+int ps_session_tracing_threads(int64_t requested, bool draws_while_tracing);
 
 typedef struct ps_session ps_session;
 
