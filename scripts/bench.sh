@@ -33,8 +33,8 @@ done
 # PS_BENCH_REF=0 skips it.
 [ "${PS_BENCH_REF:-1}" != 0 ] && step bench-ref scripts/bench-ref.sh
 # The preview's error against time on the four bench scenes (photosplat-bench):
-# bench/results/bench.{csv,md,png}. 22 minutes on 2 cores with its references
-# rendered (4 of those minutes); PS_BENCH_QUICK=1 runs its --quick subset,
+# bench/results/bench.{csv,md,png}. 16 minutes on 2 cores with its references
+# rendered (4 of those minutes; 12 cached); PS_BENCH_QUICK=1 runs its --quick subset,
 # PS_BENCH_PREVIEW=0 skips it.
 quick=()
 [ "${PS_BENCH_QUICK:-0}" != 0 ] && quick=(--quick)

@@ -13,66 +13,78 @@ set style line 3 lw 2 dt 1 pt 3
 title2 = 'triangles float fixed'
 set style line 4 lw 2 dt 1 pt 4
 title3 = 'triangles float progressive'
-set style line 5 lw 1 dt 2 pt 5
-title4 = 'triangles 8-bit none fixed'
-set style line 6 lw 1 dt 2 pt 6
-title5 = 'triangles 8-bit counter fixed'
+set style line 5 lw 2 dt 1 pt 5
+title4 = 'triangles+maps float fixed'
+set style line 6 lw 2 dt 1 pt 6
+title5 = 'triangles+maps float progressive'
 set style line 7 lw 1 dt 2 pt 7
-title6 = 'points 8-bit diffusion fixed'
+title6 = 'triangles 8-bit none fixed'
 set style line 8 lw 1 dt 2 pt 1
-title7 = 'points float fixed'
+title7 = 'triangles 8-bit counter fixed'
 set style line 9 lw 1 dt 2 pt 2
-title8 = 'sprites 8-bit diffusion fixed'
+title8 = 'points 8-bit diffusion fixed'
 set style line 10 lw 1 dt 2 pt 3
-title9 = 'sprites float fixed'
+title9 = 'points float fixed'
+set style line 11 lw 1 dt 2 pt 4
+title10 = 'sprites 8-bit diffusion fixed'
+set style line 12 lw 1 dt 2 pt 5
+title11 = 'sprites float fixed'
 set terminal pngcairo size 1280,960
 set output 'bench/results/bench-photons.png'
 set multiplot layout 2,2
 set xlabel 'photons emitted (both maps)'
 set title 'cornell-caustic: whole'
-plot 'bench/results/data/cornell-caustic.dat' index 0 using 7:2 with linespoints ls 1 title title0, \
-     'bench/results/data/cornell-caustic.dat' index 1 using 7:2 with linespoints ls 2 title title1, \
-     'bench/results/data/cornell-caustic.dat' index 2 using 7:2 with linespoints ls 3 title title2, \
-     'bench/results/data/cornell-caustic.dat' index 3 using 7:2 with linespoints ls 4 title title3, \
-     'bench/results/data/cornell-caustic.dat' index 4 using 7:2 with linespoints ls 5 title title4, \
-     'bench/results/data/cornell-caustic.dat' index 5 using 7:2 with linespoints ls 6 title title5, \
-     'bench/results/data/cornell-caustic.dat' index 6 using 7:2 with linespoints ls 7 title title6, \
-     'bench/results/data/cornell-caustic.dat' index 7 using 7:2 with linespoints ls 8 title title7, \
-     'bench/results/data/cornell-caustic.dat' index 8 using 7:2 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic.dat' index 9 using 7:2 with linespoints ls 10 title title9
+plot 'bench/results/data/cornell-caustic.dat' index 0 using 8:2 with linespoints ls 1 title title0, \
+     'bench/results/data/cornell-caustic.dat' index 1 using 8:2 with linespoints ls 2 title title1, \
+     'bench/results/data/cornell-caustic.dat' index 2 using 8:2 with linespoints ls 3 title title2, \
+     'bench/results/data/cornell-caustic.dat' index 3 using 8:2 with linespoints ls 4 title title3, \
+     'bench/results/data/cornell-caustic.dat' index 4 using 8:2 with linespoints ls 5 title title4, \
+     'bench/results/data/cornell-caustic.dat' index 5 using 8:2 with linespoints ls 6 title title5, \
+     'bench/results/data/cornell-caustic.dat' index 6 using 8:2 with linespoints ls 7 title title6, \
+     'bench/results/data/cornell-caustic.dat' index 7 using 8:2 with linespoints ls 8 title title7, \
+     'bench/results/data/cornell-caustic.dat' index 8 using 8:2 with linespoints ls 9 title title8, \
+     'bench/results/data/cornell-caustic.dat' index 9 using 8:2 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic.dat' index 10 using 8:2 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic.dat' index 11 using 8:2 with linespoints ls 12 title title11
 set title 'cornell-caustic-area: whole'
-plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 7:2 with linespoints ls 1 title title0, \
-     'bench/results/data/cornell-caustic-area.dat' index 1 using 7:2 with linespoints ls 2 title title1, \
-     'bench/results/data/cornell-caustic-area.dat' index 2 using 7:2 with linespoints ls 3 title title2, \
-     'bench/results/data/cornell-caustic-area.dat' index 3 using 7:2 with linespoints ls 4 title title3, \
-     'bench/results/data/cornell-caustic-area.dat' index 4 using 7:2 with linespoints ls 5 title title4, \
-     'bench/results/data/cornell-caustic-area.dat' index 5 using 7:2 with linespoints ls 6 title title5, \
-     'bench/results/data/cornell-caustic-area.dat' index 6 using 7:2 with linespoints ls 7 title title6, \
-     'bench/results/data/cornell-caustic-area.dat' index 7 using 7:2 with linespoints ls 8 title title7, \
-     'bench/results/data/cornell-caustic-area.dat' index 8 using 7:2 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic-area.dat' index 9 using 7:2 with linespoints ls 10 title title9
+plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 8:2 with linespoints ls 1 title title0, \
+     'bench/results/data/cornell-caustic-area.dat' index 1 using 8:2 with linespoints ls 2 title title1, \
+     'bench/results/data/cornell-caustic-area.dat' index 2 using 8:2 with linespoints ls 3 title title2, \
+     'bench/results/data/cornell-caustic-area.dat' index 3 using 8:2 with linespoints ls 4 title title3, \
+     'bench/results/data/cornell-caustic-area.dat' index 4 using 8:2 with linespoints ls 5 title title4, \
+     'bench/results/data/cornell-caustic-area.dat' index 5 using 8:2 with linespoints ls 6 title title5, \
+     'bench/results/data/cornell-caustic-area.dat' index 6 using 8:2 with linespoints ls 7 title title6, \
+     'bench/results/data/cornell-caustic-area.dat' index 7 using 8:2 with linespoints ls 8 title title7, \
+     'bench/results/data/cornell-caustic-area.dat' index 8 using 8:2 with linespoints ls 9 title title8, \
+     'bench/results/data/cornell-caustic-area.dat' index 9 using 8:2 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic-area.dat' index 10 using 8:2 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic-area.dat' index 11 using 8:2 with linespoints ls 12 title title11
 set title 'ring-caustic: whole'
-plot 'bench/results/data/ring-caustic.dat' index 0 using 7:2 with linespoints ls 1 title title0, \
-     'bench/results/data/ring-caustic.dat' index 1 using 7:2 with linespoints ls 2 title title1, \
-     'bench/results/data/ring-caustic.dat' index 2 using 7:2 with linespoints ls 3 title title2, \
-     'bench/results/data/ring-caustic.dat' index 3 using 7:2 with linespoints ls 4 title title3, \
-     'bench/results/data/ring-caustic.dat' index 4 using 7:2 with linespoints ls 5 title title4, \
-     'bench/results/data/ring-caustic.dat' index 5 using 7:2 with linespoints ls 6 title title5, \
-     'bench/results/data/ring-caustic.dat' index 6 using 7:2 with linespoints ls 7 title title6, \
-     'bench/results/data/ring-caustic.dat' index 7 using 7:2 with linespoints ls 8 title title7, \
-     'bench/results/data/ring-caustic.dat' index 8 using 7:2 with linespoints ls 9 title title8, \
-     'bench/results/data/ring-caustic.dat' index 9 using 7:2 with linespoints ls 10 title title9
+plot 'bench/results/data/ring-caustic.dat' index 0 using 8:2 with linespoints ls 1 title title0, \
+     'bench/results/data/ring-caustic.dat' index 1 using 8:2 with linespoints ls 2 title title1, \
+     'bench/results/data/ring-caustic.dat' index 2 using 8:2 with linespoints ls 3 title title2, \
+     'bench/results/data/ring-caustic.dat' index 3 using 8:2 with linespoints ls 4 title title3, \
+     'bench/results/data/ring-caustic.dat' index 4 using 8:2 with linespoints ls 5 title title4, \
+     'bench/results/data/ring-caustic.dat' index 5 using 8:2 with linespoints ls 6 title title5, \
+     'bench/results/data/ring-caustic.dat' index 6 using 8:2 with linespoints ls 7 title title6, \
+     'bench/results/data/ring-caustic.dat' index 7 using 8:2 with linespoints ls 8 title title7, \
+     'bench/results/data/ring-caustic.dat' index 8 using 8:2 with linespoints ls 9 title title8, \
+     'bench/results/data/ring-caustic.dat' index 9 using 8:2 with linespoints ls 10 title title9, \
+     'bench/results/data/ring-caustic.dat' index 10 using 8:2 with linespoints ls 11 title title10, \
+     'bench/results/data/ring-caustic.dat' index 11 using 8:2 with linespoints ls 12 title title11
 set title 'design-room: whole'
-plot 'bench/results/data/design-room.dat' index 0 using 7:2 with linespoints ls 1 title title0, \
-     'bench/results/data/design-room.dat' index 1 using 7:2 with linespoints ls 2 title title1, \
-     'bench/results/data/design-room.dat' index 2 using 7:2 with linespoints ls 3 title title2, \
-     'bench/results/data/design-room.dat' index 3 using 7:2 with linespoints ls 4 title title3, \
-     'bench/results/data/design-room.dat' index 4 using 7:2 with linespoints ls 5 title title4, \
-     'bench/results/data/design-room.dat' index 5 using 7:2 with linespoints ls 6 title title5, \
-     'bench/results/data/design-room.dat' index 6 using 7:2 with linespoints ls 7 title title6, \
-     'bench/results/data/design-room.dat' index 7 using 7:2 with linespoints ls 8 title title7, \
-     'bench/results/data/design-room.dat' index 8 using 7:2 with linespoints ls 9 title title8, \
-     'bench/results/data/design-room.dat' index 9 using 7:2 with linespoints ls 10 title title9
+plot 'bench/results/data/design-room.dat' index 0 using 8:2 with linespoints ls 1 title title0, \
+     'bench/results/data/design-room.dat' index 1 using 8:2 with linespoints ls 2 title title1, \
+     'bench/results/data/design-room.dat' index 2 using 8:2 with linespoints ls 3 title title2, \
+     'bench/results/data/design-room.dat' index 3 using 8:2 with linespoints ls 4 title title3, \
+     'bench/results/data/design-room.dat' index 4 using 8:2 with linespoints ls 5 title title4, \
+     'bench/results/data/design-room.dat' index 5 using 8:2 with linespoints ls 6 title title5, \
+     'bench/results/data/design-room.dat' index 6 using 8:2 with linespoints ls 7 title title6, \
+     'bench/results/data/design-room.dat' index 7 using 8:2 with linespoints ls 8 title title7, \
+     'bench/results/data/design-room.dat' index 8 using 8:2 with linespoints ls 9 title title8, \
+     'bench/results/data/design-room.dat' index 9 using 8:2 with linespoints ls 10 title title9, \
+     'bench/results/data/design-room.dat' index 10 using 8:2 with linespoints ls 11 title title10, \
+     'bench/results/data/design-room.dat' index 11 using 8:2 with linespoints ls 12 title title11
 unset multiplot
 set terminal pngcairo size 1280,960
 set output 'bench/results/bench.png'
@@ -88,7 +100,9 @@ plot 'bench/results/data/cornell-caustic.dat' index 0 using 1:2 with linespoints
      'bench/results/data/cornell-caustic.dat' index 6 using 1:2 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic.dat' index 7 using 1:2 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic.dat' index 8 using 1:2 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic.dat' index 9 using 1:2 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic.dat' index 9 using 1:2 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic.dat' index 10 using 1:2 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic.dat' index 11 using 1:2 with linespoints ls 12 title title11
 set title 'cornell-caustic-area: whole'
 plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 1:2 with linespoints ls 1 title title0, \
      'bench/results/data/cornell-caustic-area.dat' index 1 using 1:2 with linespoints ls 2 title title1, \
@@ -99,7 +113,9 @@ plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 1:2 with linesp
      'bench/results/data/cornell-caustic-area.dat' index 6 using 1:2 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic-area.dat' index 7 using 1:2 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic-area.dat' index 8 using 1:2 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:2 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:2 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic-area.dat' index 10 using 1:2 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic-area.dat' index 11 using 1:2 with linespoints ls 12 title title11
 set title 'ring-caustic: whole'
 plot 'bench/results/data/ring-caustic.dat' index 0 using 1:2 with linespoints ls 1 title title0, \
      'bench/results/data/ring-caustic.dat' index 1 using 1:2 with linespoints ls 2 title title1, \
@@ -110,7 +126,9 @@ plot 'bench/results/data/ring-caustic.dat' index 0 using 1:2 with linespoints ls
      'bench/results/data/ring-caustic.dat' index 6 using 1:2 with linespoints ls 7 title title6, \
      'bench/results/data/ring-caustic.dat' index 7 using 1:2 with linespoints ls 8 title title7, \
      'bench/results/data/ring-caustic.dat' index 8 using 1:2 with linespoints ls 9 title title8, \
-     'bench/results/data/ring-caustic.dat' index 9 using 1:2 with linespoints ls 10 title title9
+     'bench/results/data/ring-caustic.dat' index 9 using 1:2 with linespoints ls 10 title title9, \
+     'bench/results/data/ring-caustic.dat' index 10 using 1:2 with linespoints ls 11 title title10, \
+     'bench/results/data/ring-caustic.dat' index 11 using 1:2 with linespoints ls 12 title title11
 set title 'design-room: whole'
 plot 'bench/results/data/design-room.dat' index 0 using 1:2 with linespoints ls 1 title title0, \
      'bench/results/data/design-room.dat' index 1 using 1:2 with linespoints ls 2 title title1, \
@@ -121,7 +139,9 @@ plot 'bench/results/data/design-room.dat' index 0 using 1:2 with linespoints ls 
      'bench/results/data/design-room.dat' index 6 using 1:2 with linespoints ls 7 title title6, \
      'bench/results/data/design-room.dat' index 7 using 1:2 with linespoints ls 8 title title7, \
      'bench/results/data/design-room.dat' index 8 using 1:2 with linespoints ls 9 title title8, \
-     'bench/results/data/design-room.dat' index 9 using 1:2 with linespoints ls 10 title title9
+     'bench/results/data/design-room.dat' index 9 using 1:2 with linespoints ls 10 title title9, \
+     'bench/results/data/design-room.dat' index 10 using 1:2 with linespoints ls 11 title title10, \
+     'bench/results/data/design-room.dat' index 11 using 1:2 with linespoints ls 12 title title11
 unset multiplot
 set terminal pngcairo size 1280,960
 set output 'bench/results/cornell-caustic.png'
@@ -137,7 +157,9 @@ plot 'bench/results/data/cornell-caustic.dat' index 0 using 1:2 with linespoints
      'bench/results/data/cornell-caustic.dat' index 6 using 1:2 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic.dat' index 7 using 1:2 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic.dat' index 8 using 1:2 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic.dat' index 9 using 1:2 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic.dat' index 9 using 1:2 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic.dat' index 10 using 1:2 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic.dat' index 11 using 1:2 with linespoints ls 12 title title11
 set title 'cornell-caustic: direct'
 plot 'bench/results/data/cornell-caustic.dat' index 0 using 1:3 with linespoints ls 1 title title0, \
      'bench/results/data/cornell-caustic.dat' index 1 using 1:3 with linespoints ls 2 title title1, \
@@ -148,7 +170,9 @@ plot 'bench/results/data/cornell-caustic.dat' index 0 using 1:3 with linespoints
      'bench/results/data/cornell-caustic.dat' index 6 using 1:3 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic.dat' index 7 using 1:3 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic.dat' index 8 using 1:3 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic.dat' index 9 using 1:3 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic.dat' index 9 using 1:3 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic.dat' index 10 using 1:3 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic.dat' index 11 using 1:3 with linespoints ls 12 title title11
 set title 'cornell-caustic: caustic'
 plot 'bench/results/data/cornell-caustic.dat' index 0 using 1:4 with linespoints ls 1 title title0, \
      'bench/results/data/cornell-caustic.dat' index 1 using 1:4 with linespoints ls 2 title title1, \
@@ -159,7 +183,9 @@ plot 'bench/results/data/cornell-caustic.dat' index 0 using 1:4 with linespoints
      'bench/results/data/cornell-caustic.dat' index 6 using 1:4 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic.dat' index 7 using 1:4 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic.dat' index 8 using 1:4 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic.dat' index 9 using 1:4 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic.dat' index 9 using 1:4 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic.dat' index 10 using 1:4 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic.dat' index 11 using 1:4 with linespoints ls 12 title title11
 set title 'cornell-caustic: global'
 plot 'bench/results/data/cornell-caustic.dat' index 0 using 1:5 with linespoints ls 1 title title0, \
      'bench/results/data/cornell-caustic.dat' index 1 using 1:5 with linespoints ls 2 title title1, \
@@ -170,7 +196,9 @@ plot 'bench/results/data/cornell-caustic.dat' index 0 using 1:5 with linespoints
      'bench/results/data/cornell-caustic.dat' index 6 using 1:5 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic.dat' index 7 using 1:5 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic.dat' index 8 using 1:5 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic.dat' index 9 using 1:5 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic.dat' index 9 using 1:5 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic.dat' index 10 using 1:5 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic.dat' index 11 using 1:5 with linespoints ls 12 title title11
 unset multiplot
 set terminal pngcairo size 1280,960
 set output 'bench/results/cornell-caustic-area.png'
@@ -186,7 +214,9 @@ plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 1:2 with linesp
      'bench/results/data/cornell-caustic-area.dat' index 6 using 1:2 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic-area.dat' index 7 using 1:2 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic-area.dat' index 8 using 1:2 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:2 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:2 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic-area.dat' index 10 using 1:2 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic-area.dat' index 11 using 1:2 with linespoints ls 12 title title11
 set title 'cornell-caustic-area: direct'
 plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 1:3 with linespoints ls 1 title title0, \
      'bench/results/data/cornell-caustic-area.dat' index 1 using 1:3 with linespoints ls 2 title title1, \
@@ -197,7 +227,9 @@ plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 1:3 with linesp
      'bench/results/data/cornell-caustic-area.dat' index 6 using 1:3 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic-area.dat' index 7 using 1:3 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic-area.dat' index 8 using 1:3 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:3 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:3 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic-area.dat' index 10 using 1:3 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic-area.dat' index 11 using 1:3 with linespoints ls 12 title title11
 set title 'cornell-caustic-area: caustic'
 plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 1:4 with linespoints ls 1 title title0, \
      'bench/results/data/cornell-caustic-area.dat' index 1 using 1:4 with linespoints ls 2 title title1, \
@@ -208,7 +240,9 @@ plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 1:4 with linesp
      'bench/results/data/cornell-caustic-area.dat' index 6 using 1:4 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic-area.dat' index 7 using 1:4 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic-area.dat' index 8 using 1:4 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:4 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:4 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic-area.dat' index 10 using 1:4 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic-area.dat' index 11 using 1:4 with linespoints ls 12 title title11
 set title 'cornell-caustic-area: global'
 plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 1:5 with linespoints ls 1 title title0, \
      'bench/results/data/cornell-caustic-area.dat' index 1 using 1:5 with linespoints ls 2 title title1, \
@@ -219,7 +253,9 @@ plot 'bench/results/data/cornell-caustic-area.dat' index 0 using 1:5 with linesp
      'bench/results/data/cornell-caustic-area.dat' index 6 using 1:5 with linespoints ls 7 title title6, \
      'bench/results/data/cornell-caustic-area.dat' index 7 using 1:5 with linespoints ls 8 title title7, \
      'bench/results/data/cornell-caustic-area.dat' index 8 using 1:5 with linespoints ls 9 title title8, \
-     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:5 with linespoints ls 10 title title9
+     'bench/results/data/cornell-caustic-area.dat' index 9 using 1:5 with linespoints ls 10 title title9, \
+     'bench/results/data/cornell-caustic-area.dat' index 10 using 1:5 with linespoints ls 11 title title10, \
+     'bench/results/data/cornell-caustic-area.dat' index 11 using 1:5 with linespoints ls 12 title title11
 unset multiplot
 set terminal pngcairo size 1280,960
 set output 'bench/results/ring-caustic.png'
@@ -235,7 +271,9 @@ plot 'bench/results/data/ring-caustic.dat' index 0 using 1:2 with linespoints ls
      'bench/results/data/ring-caustic.dat' index 6 using 1:2 with linespoints ls 7 title title6, \
      'bench/results/data/ring-caustic.dat' index 7 using 1:2 with linespoints ls 8 title title7, \
      'bench/results/data/ring-caustic.dat' index 8 using 1:2 with linespoints ls 9 title title8, \
-     'bench/results/data/ring-caustic.dat' index 9 using 1:2 with linespoints ls 10 title title9
+     'bench/results/data/ring-caustic.dat' index 9 using 1:2 with linespoints ls 10 title title9, \
+     'bench/results/data/ring-caustic.dat' index 10 using 1:2 with linespoints ls 11 title title10, \
+     'bench/results/data/ring-caustic.dat' index 11 using 1:2 with linespoints ls 12 title title11
 set title 'ring-caustic: direct'
 plot 'bench/results/data/ring-caustic.dat' index 0 using 1:3 with linespoints ls 1 title title0, \
      'bench/results/data/ring-caustic.dat' index 1 using 1:3 with linespoints ls 2 title title1, \
@@ -246,7 +284,9 @@ plot 'bench/results/data/ring-caustic.dat' index 0 using 1:3 with linespoints ls
      'bench/results/data/ring-caustic.dat' index 6 using 1:3 with linespoints ls 7 title title6, \
      'bench/results/data/ring-caustic.dat' index 7 using 1:3 with linespoints ls 8 title title7, \
      'bench/results/data/ring-caustic.dat' index 8 using 1:3 with linespoints ls 9 title title8, \
-     'bench/results/data/ring-caustic.dat' index 9 using 1:3 with linespoints ls 10 title title9
+     'bench/results/data/ring-caustic.dat' index 9 using 1:3 with linespoints ls 10 title title9, \
+     'bench/results/data/ring-caustic.dat' index 10 using 1:3 with linespoints ls 11 title title10, \
+     'bench/results/data/ring-caustic.dat' index 11 using 1:3 with linespoints ls 12 title title11
 set title 'ring-caustic: caustic'
 plot 'bench/results/data/ring-caustic.dat' index 0 using 1:4 with linespoints ls 1 title title0, \
      'bench/results/data/ring-caustic.dat' index 1 using 1:4 with linespoints ls 2 title title1, \
@@ -257,7 +297,9 @@ plot 'bench/results/data/ring-caustic.dat' index 0 using 1:4 with linespoints ls
      'bench/results/data/ring-caustic.dat' index 6 using 1:4 with linespoints ls 7 title title6, \
      'bench/results/data/ring-caustic.dat' index 7 using 1:4 with linespoints ls 8 title title7, \
      'bench/results/data/ring-caustic.dat' index 8 using 1:4 with linespoints ls 9 title title8, \
-     'bench/results/data/ring-caustic.dat' index 9 using 1:4 with linespoints ls 10 title title9
+     'bench/results/data/ring-caustic.dat' index 9 using 1:4 with linespoints ls 10 title title9, \
+     'bench/results/data/ring-caustic.dat' index 10 using 1:4 with linespoints ls 11 title title10, \
+     'bench/results/data/ring-caustic.dat' index 11 using 1:4 with linespoints ls 12 title title11
 set title 'ring-caustic: global'
 plot 'bench/results/data/ring-caustic.dat' index 0 using 1:5 with linespoints ls 1 title title0, \
      'bench/results/data/ring-caustic.dat' index 1 using 1:5 with linespoints ls 2 title title1, \
@@ -268,7 +310,9 @@ plot 'bench/results/data/ring-caustic.dat' index 0 using 1:5 with linespoints ls
      'bench/results/data/ring-caustic.dat' index 6 using 1:5 with linespoints ls 7 title title6, \
      'bench/results/data/ring-caustic.dat' index 7 using 1:5 with linespoints ls 8 title title7, \
      'bench/results/data/ring-caustic.dat' index 8 using 1:5 with linespoints ls 9 title title8, \
-     'bench/results/data/ring-caustic.dat' index 9 using 1:5 with linespoints ls 10 title title9
+     'bench/results/data/ring-caustic.dat' index 9 using 1:5 with linespoints ls 10 title title9, \
+     'bench/results/data/ring-caustic.dat' index 10 using 1:5 with linespoints ls 11 title title10, \
+     'bench/results/data/ring-caustic.dat' index 11 using 1:5 with linespoints ls 12 title title11
 unset multiplot
 set terminal pngcairo size 1280,960
 set output 'bench/results/design-room.png'
@@ -284,7 +328,9 @@ plot 'bench/results/data/design-room.dat' index 0 using 1:2 with linespoints ls 
      'bench/results/data/design-room.dat' index 6 using 1:2 with linespoints ls 7 title title6, \
      'bench/results/data/design-room.dat' index 7 using 1:2 with linespoints ls 8 title title7, \
      'bench/results/data/design-room.dat' index 8 using 1:2 with linespoints ls 9 title title8, \
-     'bench/results/data/design-room.dat' index 9 using 1:2 with linespoints ls 10 title title9
+     'bench/results/data/design-room.dat' index 9 using 1:2 with linespoints ls 10 title title9, \
+     'bench/results/data/design-room.dat' index 10 using 1:2 with linespoints ls 11 title title10, \
+     'bench/results/data/design-room.dat' index 11 using 1:2 with linespoints ls 12 title title11
 set title 'design-room: direct'
 plot 'bench/results/data/design-room.dat' index 0 using 1:3 with linespoints ls 1 title title0, \
      'bench/results/data/design-room.dat' index 1 using 1:3 with linespoints ls 2 title title1, \
@@ -295,7 +341,9 @@ plot 'bench/results/data/design-room.dat' index 0 using 1:3 with linespoints ls 
      'bench/results/data/design-room.dat' index 6 using 1:3 with linespoints ls 7 title title6, \
      'bench/results/data/design-room.dat' index 7 using 1:3 with linespoints ls 8 title title7, \
      'bench/results/data/design-room.dat' index 8 using 1:3 with linespoints ls 9 title title8, \
-     'bench/results/data/design-room.dat' index 9 using 1:3 with linespoints ls 10 title title9
+     'bench/results/data/design-room.dat' index 9 using 1:3 with linespoints ls 10 title title9, \
+     'bench/results/data/design-room.dat' index 10 using 1:3 with linespoints ls 11 title title10, \
+     'bench/results/data/design-room.dat' index 11 using 1:3 with linespoints ls 12 title title11
 set title 'design-room: caustic'
 plot 'bench/results/data/design-room.dat' index 0 using 1:4 with linespoints ls 1 title title0, \
      'bench/results/data/design-room.dat' index 1 using 1:4 with linespoints ls 2 title title1, \
@@ -306,7 +354,9 @@ plot 'bench/results/data/design-room.dat' index 0 using 1:4 with linespoints ls 
      'bench/results/data/design-room.dat' index 6 using 1:4 with linespoints ls 7 title title6, \
      'bench/results/data/design-room.dat' index 7 using 1:4 with linespoints ls 8 title title7, \
      'bench/results/data/design-room.dat' index 8 using 1:4 with linespoints ls 9 title title8, \
-     'bench/results/data/design-room.dat' index 9 using 1:4 with linespoints ls 10 title title9
+     'bench/results/data/design-room.dat' index 9 using 1:4 with linespoints ls 10 title title9, \
+     'bench/results/data/design-room.dat' index 10 using 1:4 with linespoints ls 11 title title10, \
+     'bench/results/data/design-room.dat' index 11 using 1:4 with linespoints ls 12 title title11
 set title 'design-room: global'
 plot 'bench/results/data/design-room.dat' index 0 using 1:5 with linespoints ls 1 title title0, \
      'bench/results/data/design-room.dat' index 1 using 1:5 with linespoints ls 2 title title1, \
@@ -317,5 +367,7 @@ plot 'bench/results/data/design-room.dat' index 0 using 1:5 with linespoints ls 
      'bench/results/data/design-room.dat' index 6 using 1:5 with linespoints ls 7 title title6, \
      'bench/results/data/design-room.dat' index 7 using 1:5 with linespoints ls 8 title title7, \
      'bench/results/data/design-room.dat' index 8 using 1:5 with linespoints ls 9 title title8, \
-     'bench/results/data/design-room.dat' index 9 using 1:5 with linespoints ls 10 title title9
+     'bench/results/data/design-room.dat' index 9 using 1:5 with linespoints ls 10 title title9, \
+     'bench/results/data/design-room.dat' index 10 using 1:5 with linespoints ls 11 title title10, \
+     'bench/results/data/design-room.dat' index 11 using 1:5 with linespoints ls 12 title title11
 unset multiplot
