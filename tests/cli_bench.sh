@@ -92,10 +92,13 @@ awk -F, 'NR > 1 && ($3 > 1.5 * $2 || $3 < $2 || $4 < n) { print "checkpoint " $2
 # every cube face, showed them all: the 0.5 s one at 1.3-1.6 s, the 2 s one
 # before its time). The area light's next virtual lights wait while their
 # shadow cubes would make a checkpoint late.
+# The caps within the first round (16 384 photons of the larger map, traced
+# before the first frame): 20 000 needed a second round, which under the
+# sanitizers, with a core left to drawing, came after the 0.5 s frame.
 expect_success "capped float checkpoints on time" "$snap" data/scenes/cornell-caustic-area.scn --size 64x64 \
-    --time 2.5 --checkpoints 0.5,2 --checkpoint-prefix "$cli_tmp/cc" --caustic-photons 20000 \
-    --global-photons 5000 --color-depth float
-awk -F, 'NR > 1 && ($3 < $2 || $3 > 1.5 * $2 + 0.25 || $4 != 20000) { print "checkpoint " $2 " s at " $3 " s, " $4 " photons"; bad = 1 }
+    --time 2.5 --checkpoints 0.5,2 --checkpoint-prefix "$cli_tmp/cc" --caustic-photons 16000 \
+    --global-photons 4000 --color-depth float
+awk -F, 'NR > 1 && ($3 < $2 || $3 > 1.5 * $2 + 0.25 || $4 != 16000) { print "checkpoint " $2 " s at " $3 " s, " $4 " photons"; bad = 1 }
          END { exit bad }' "$cli_tmp/cc.csv" && ok || bad "capped float checkpoints: $(cat "$cli_tmp/cc.csv")"
 
 # ---- compare --clamp --------------------------------------------------------------
