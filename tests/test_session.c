@@ -308,6 +308,44 @@ static void budget_bounds_a_refresh(void **state)
     ps_scene_destroy(scene);
 }
 
+/* ps_session_set_budget_share: the next refreshes draw that share of the
+ * budget (at least a batch), until set again (photosplat-snap's float
+ * checkpoints' frames: pace.h). */
+static void budget_share_draws_a_share(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = 12 * PS_FEED_BATCH;
+    set.tau = 10.0; /* the budget a drawing time of seconds: building the splats small beside it */
+    ps_camera_frame cam;
+    ps_session_frame f;
+    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
+    /* Drawn at the rate that makes the caustic's budget 4.8 batches. */
+    double rate = 4.8 * PS_FEED_BATCH * PS_MAP_COUNT / (set.tau * set.splat_share);
+    ps_session_counts c;
+    ps_session_get_counts(s, &c);
+    double built = c.splat_seconds;
+    ps_session_drawn(s, fmax(1e-3, (double)f.splats / rate - built));
+    wait_ended(s);
+    uint64_t before = f.emitted[PS_MAP_CAUSTIC];
+    ps_session_set_budget_share(s, 0.25); /* 1.2 batches: one */
+    refresh(s, &cam, &f);
+    assert_int_equal(f.emitted[PS_MAP_CAUSTIC], before + PS_FEED_BATCH);
+    ps_session_get_counts(s, &c);
+    ps_session_drawn(s, fmax(1e-3, (double)f.splats / rate - (c.splat_seconds - built)));
+    built = c.splat_seconds;
+    refresh(s, &cam, &f); /* still a share */
+    assert_int_equal(f.emitted[PS_MAP_CAUSTIC], before + 2 * PS_FEED_BATCH);
+    ps_session_get_counts(s, &c);
+    ps_session_drawn(s, fmax(1e-3, (double)f.splats / rate - (c.splat_seconds - built)));
+    ps_session_set_budget_share(s, 1.0); /* the whole budget again: four */
+    refresh(s, &cam, &f);
+    assert_true(f.emitted[PS_MAP_CAUSTIC] >= before + 6 * PS_FEED_BATCH);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 /* Waits (at most 15 s: the sanitizers' batches, under a loaded suite) until
  * the caustic map holds the same photons for 0.2 s: the feed paused or
  * ended. Returns its stored count. */
@@ -847,6 +885,7 @@ int main(void)
         cmocka_unit_test(whole_cap_draws_a_prefix),
         cmocka_unit_test(incremental_refresh_splats_each_photon_once),
         cmocka_unit_test(budget_bounds_a_refresh),
+        cmocka_unit_test(budget_share_draws_a_share),
         cmocka_unit_test(backlog_holds_the_tracer),
         cmocka_unit_test(tracing_threads_leave_a_core_to_drawing),
         cmocka_unit_test(counter_stops_shooting),

@@ -6,9 +6,24 @@
 /* Of a whole refresh's time, what does not grow with the photons. */
 static double scene_part(const ps_pace_model *m) { return fmax(0.0, m->seconds - m->per_photon * m->photons); }
 
+/* The photons' part of a whole refresh drawing n, beyond the n0 it was
+ * learned at growing as n (n / n0)^PS_PACE_GROWTH. */
+static double photons_part(const ps_pace_model *m, double n)
+{
+    double part = m->per_photon * fmax(0.0, n);
+    return n > m->photons && m->photons > 0.0 ? part * pow(n / m->photons, PS_PACE_GROWTH) : part;
+}
+
 double ps_pace_seconds(const ps_pace_model *m, double photons)
 {
-    return scene_part(m) + m->per_photon * fmax(0.0, photons) + m->unheld;
+    return scene_part(m) + photons_part(m, photons) + m->unheld;
+}
+
+/* The checkpoint's frame (ps_pace_plan.shows) holds its first round of cube
+ * faces to the deadline like any others, and draws a share of the budget. */
+static double shown_seconds(const ps_pace_model *m, double photons)
+{
+    return ps_pace_seconds(m, photons) - m->unheld - (1.0 - PS_PACE_SHOWN_BUDGET) * m->splats;
 }
 
 void ps_pace_learn(ps_pace_model *m, double seconds, double photons, double photon_seconds, bool whole)
@@ -32,19 +47,22 @@ static double ideal_start(const ps_pace_model *m, double now, double d_now, doub
 /* The photons a whole refresh draws to last `d` seconds (0: one batch). */
 static double photons_for(const ps_pace_model *m, double d)
 {
-    return fmax(0.0, (d - scene_part(m) - m->unheld) / m->per_photon);
+    double part = fmax(0.0, d - scene_part(m)), at_n0 = m->per_photon * m->photons;
+    if (part <= at_n0 || m->photons <= 0.0)
+        return part / m->per_photon;
+    return m->photons * pow(part / at_n0, 1.0 / (1.0 + PS_PACE_GROWTH)); /* photons_part inverted */
 }
 
 ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, double due, const double *pending,
                           int count)
 {
-    ps_pace_plan p = {fmax(now, due), HUGE_VAL, -1, HUGE_VAL};
+    ps_pace_plan p = {fmax(now, due), HUGE_VAL, -1, HUGE_VAL, false, false};
     if (count <= 0)
         return p;
     p.start = fmax(now, fmin(due, pending[0]));
     if (m->seconds <= 0.0)
         return p;
-    double d_now = ps_pace_seconds(m, photons);
+    double d_now = shown_seconds(m, photons);
     /* The first checkpoint not shown yet. (Letting one out of reach give
      * way to the next, whose frame then showed both, lost the first by up
      * to a refresh and, with 8-bit refreshes varying by a third, as often
@@ -52,7 +70,7 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
     p.target = 0;
     double cp = pending[0];
     double ideal = ideal_start(m, now, d_now, cp);
-    double d_ideal = ps_pace_seconds(m, photons + m->rate * fmax(0.0, ideal - now));
+    double d_ideal = shown_seconds(m, photons + m->rate * fmax(0.0, ideal - now));
     /* A whole refresh longer than its share of the checkpoint's time draws
      * fewer photons, to last that share, started later (pace.h). */
     double cap = m->per_photon > 0.0 ? PS_PACE_FRAME_SHARE * cp : HUGE_VAL;
@@ -66,31 +84,44 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
     double last_end = fmax(cp * (1.0 + PS_PACE_FACES_LATE), aim);
     double last_start = last_end - d_ideal;
     double s0 = now >= ideal ? now : fmax(now, due);
-    double d0 = ps_pace_seconds(m, photons + m->rate * (s0 - now));
+    double d0 = ps_pace_seconds(m, photons + m->rate * (s0 - now)); /* unheld faces in it */
+    double d0_held = d0 - m->unheld;
     /* Whole refreshes no checkpoint shows are only drawn and thrown away
      * (snap is headless): the checkpoint's frame is the next. */
-    if (now >= ideal || s0 + d0 > last_start || m->per_photon > 0.0) {
+    if (now >= ideal || s0 + d0_held > last_start || m->per_photon > 0.0) {
         /* The checkpoint's frame, at its start (a refresh started now
          * would delay it past last_start) or at once when that is past:
          * faces only while it ends by last_end. A whole one started late
-         * draws what ends it by the aim (at least one batch). */
+         * draws what ends it by the aim (at least one batch). Its first
+         * round of faces is held too (an unheld quarter of the design
+         * room's 84 faces, 0.3-0.4 s, landed its 0.5 and 1 s checkpoints
+         * at 0.86 and 1.32 s). */
+        p.shows = p.hold_faces = true;
         p.start = now >= ideal ? now : ideal;
         double n = photons + m->rate * (p.start - now);
-        double d = fmin(ps_pace_seconds(m, n), cap);
+        double d = fmin(shown_seconds(m, n), cap);
         if (m->per_photon > 0.0 && p.start + d > aim)
             d = fmax(aim - p.start, 0.0);
         if (m->per_photon > 0.0 && photons_for(m, d) < n) {
             p.photons = photons_for(m, d);
             n = p.photons;
         }
-        d = ps_pace_seconds(m, n);
+        d = shown_seconds(m, n);
         p.faces_deadline = last_end - d > p.start ? last_end - d + fmin(m->lead, d) : p.start;
     } else {
         /* A refresh that ends before the checkpoint's frame must start:
          * faces only while they keep it so (ending after `ideal`, it is
-         * followed by that frame at once, with what is left). */
+         * followed by that frame at once, with what is left), the first
+         * round's too when its unheld faces would not. (Waiting for the
+         * frame's start instead left the design room 0.4 s without a
+         * refresh before its 1 s checkpoint, its tracer held meanwhile by
+         * the photons not drawn; holding the first round in every refresh
+         * instead let its faces fill whole seconds between checkpoints, a
+         * batch of photons shown for each second of faces.) */
         p.start = s0;
-        p.faces_deadline = last_start - d0 + fmin(m->lead, d0);
+        p.hold_faces = s0 + d0 > last_start;
+        double d = p.hold_faces ? d0_held : d0;
+        p.faces_deadline = last_start - d + fmin(m->lead, d);
     }
     return p;
 }

@@ -13,7 +13,9 @@
  * PS_PACE_MARGIN of its time after it; a refresh that would end after that
  * start waits for it instead (snap is headless: an idle moment only leaves
  * the cores to the tracer), and cube faces run only while the checkpoint's
- * frame still ends within PS_PACE_FACES_LATE of it (or the margin, if later).
+ * frame still ends within PS_PACE_FACES_LATE of it (or the margin, if later):
+ * in that frame, those of the first round too, which the refreshes between
+ * checkpoints draw whatever their time (ps_gl_specular_set_first_round).
  * A whole refresh showing a checkpoint lasts at most PS_PACE_FRAME_SHARE of
  * the checkpoint's time (ps_pace_plan.photons: a prefix of the photons, an
  * unbiased picture of fewer), so that its prediction's error stays within
@@ -47,15 +49,33 @@
  * 3.5-4.7 s and landed it at 7.2-9.6 s). */
 #define PS_PACE_FRAME_SHARE (1.0 / 3.0)
 
+/* Incremental: a checkpoint's frame draws this share of a refresh's budget
+ * of new splats (ps_session_set_budget_share), so that its time varies less
+ * than the budget's error (the splat rate it comes from varied 2x from one
+ * refresh to the next: the default box's 0.5 s checkpoint landed at 0.62-
+ * 0.68 s). What it leaves, the next refreshes draw. */
+#define PS_PACE_SHOWN_BUDGET 0.25
+
+/* Whole refreshes cost more a photon the more they draw (building 4*10^6
+ * photons' splats, their diffusion in screen order, took 0.59 us a photon
+ * against 0.26 at 7.6*10^5): predicted from a smaller one, the photons'
+ * part grows as n^(1 + PS_PACE_GROWTH). Fitted to the default box's 8-bit
+ * runs, 0.7-1.0 us a photon learned at 0.76-1.45*10^6 and 1.08-1.13 us
+ * drawn at 3.3-4.8*10^6 (linear, the 10 s checkpoint's frame took 4.9 s
+ * where 3.3 were planned, and landed at 11.3-12.9 s). */
+#define PS_PACE_GROWTH 0.2
+
 typedef struct ps_pace_model {
     double seconds;    /* the last refresh's time without cube faces (0: nothing known yet) */
     double photons;    /* the photons emitted that it drew */
     double per_photon; /* whole refreshes: seconds a photon costs (0: incremental) */
+    double splats;     /* incremental: of seconds, the new splats' (a whole budget's) */
     double rate;       /* photons emitted a second */
     double lead;       /* of seconds, what comes before the faces (the session's splats) */
     int learned;       /* whole refreshes learned in a row */
     double unheld;     /* the next refresh's cube faces that no deadline holds back, seconds
-                        * (the first round's: ps_gl_specular_unheld_seconds) */
+                        * (the first round's: ps_gl_specular_unheld_seconds), unless it
+                        * shows a checkpoint (ps_pace_plan.shows) */
 } ps_pace_model;
 
 /* After a refresh of `seconds` (no cube faces) drawing `photons`, of which
@@ -71,7 +91,7 @@ void ps_pace_learn(ps_pace_model *m, double seconds, double photons, double phot
  * seconds of it, the last time): the faces deadline is later by that. */
 
 /* A refresh's predicted time when it draws `photons` emitted, its unheld
- * faces included. */
+ * faces included (a checkpoint's frame holds them: it is planned without). */
 double ps_pace_seconds(const ps_pace_model *m, double photons);
 
 typedef struct ps_pace_plan {
@@ -79,6 +99,12 @@ typedef struct ps_pace_plan {
     double faces_deadline;  /* its cube faces end by then (<= start: none); HUGE_VAL: no limit */
     int target;             /* the checkpoint planned for (index into the list: 0), -1: none */
     double photons;         /* whole: the most photons emitted it draws (0: one batch); HUGE_VAL: all */
+    bool shows;             /* planned as the checkpoint's frame: an incremental one draws
+                             * PS_PACE_SHOWN_BUDGET of its budget, and holds its faces */
+    bool hold_faces;        /* the first round's cube faces, otherwise unheld, keep to
+                             * faces_deadline too (ps_gl_specular_hold_first_round): the
+                             * checkpoint's frame, and a refresh before it that would
+                             * delay it with them */
 } ps_pace_plan;
 
 /* The next refresh, at `now` with `photons` emitted, due at `due` (tau's

@@ -283,6 +283,12 @@ static ps_status refresh(snap_run *s, ps_error *err)
     double build_seconds = after.splat_seconds - before.splat_seconds;
     if (!s->layers || s->pace.seconds <= 0.0 || !(s->frame.new_view || s->frame.lights_changed))
     {
+        /* Incremental: the next draws up to its budget's share of tau of
+         * new splats, whatever this one drew (one after a short refresh,
+         * 0.007 s, drew 0.18 s of splats and took the area box's 0.5 s
+         * checkpoint to 0.79 s). */
+        s->pace.splats = s->layers && !after.ended ? SNAP_SPLAT_SHARE * s->o->p.tau : 0.0;
+        plain += fmax(0.0, s->pace.splats - splat_seconds);
         ps_pace_learn(&s->pace, fmax(plain, 1e-6), (double)(s->frame.emitted[0] + s->frame.emitted[1]),
                       build_seconds + splat_seconds, !s->layers);
         s->pace.lead = t0 - t_refresh;
@@ -532,6 +538,10 @@ static ps_pace_plan plan_refresh(snap_run *s, double clock, double due, int cp, 
     if (now > rate->at && photons >= rate->photons)
         s->pace.rate = (photons - rate->photons) / (now - rate->at);
     rate->at = now, rate->photons = photons;
+    /* Float: the first round's faces as a refresh between checkpoints
+     * draws them (held only where the plan says, refine). */
+    if (s->layers)
+        ps_gl_specular_hold_first_round(s->spec, false);
     s->pace.unheld = ps_gl_specular_unheld_seconds(s->spec, s->session);
     return ps_pace_next(&s->pace, now, photons, due, s->o->checkpoints + cp, s->o->checkpoint_count - cp);
 }
@@ -628,6 +638,10 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
         }
         ps_gl_specular_set_deadline(s->spec, isfinite(plan.faces_deadline) ? clock + plan.faces_deadline : 0.0);
+        if (s->layers) {
+            ps_gl_specular_hold_first_round(s->spec, plan.hold_faces);
+            ps_session_set_budget_share(s->session, plan.shows ? PS_PACE_SHOWN_BUDGET : 1.0);
+        }
         sleep_until(clock + plan.start);
         ps_session_counts counts;
         ps_session_get_counts(s->session, &counts);

@@ -38,6 +38,7 @@ struct ps_session {
     uint64_t drawn_emitted[PS_MAP_COUNT];
     double splat_radius[PS_MAP_COUNT];
     double budget;         /* incremental: photons a map per refresh */
+    double budget_share;   /* incremental: of the budget, what a refresh draws (ps_session_set_budget_share) */
     double whole_most[PS_MAP_COUNT]; /* whole: each map's photons emitted a refresh draws at most
                                       * (ps_session_set_whole_most; HUGE_VAL: all) */
     size_t last_splats;    /* built by the last refresh ... */
@@ -301,6 +302,7 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
     s->scene = scene;
     s->set = *set;
     s->budget = PS_SESSION_BUDGET_START;
+    s->budget_share = 1.0;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         s->whole_most[k] = HUGE_VAL;
     s->area_side = set->progressive_lights ? 1 : PS_PREVIEW_AREA_SIDE;
@@ -444,6 +446,7 @@ static size_t prefix(const ps_session *s, int k, size_t from, uint64_t from_emit
     double budget = s->moving     ? s->budget * PS_SESSION_MOVING_SHARE
                     : s->catch_up ? s->budget * (s->still_refreshes > 0 ? PS_SESSION_CATCH_UP_GAIN : 1.0)
                                   : s->budget;
+    budget *= s->budget_share;
     if (s->edit_view && !s->moving && edit_draws_whole(s, s->edit_held))
         budget = HUGE_VAL;
     return prefix_within(s, k, from, from_emitted, budget, emitted);
@@ -918,6 +921,11 @@ void ps_session_set_whole_most(ps_session *s, const double most[PS_MAP_COUNT])
 {
     for (int k = 0; k < PS_MAP_COUNT; k++)
         s->whole_most[k] = most && !(most[k] < 0.0) ? most[k] : HUGE_VAL;
+}
+
+void ps_session_set_budget_share(ps_session *s, double share)
+{
+    s->budget_share = share >= 0.0 && share <= 1.0 ? share : 1.0;
 }
 
 ps_status ps_session_set_global_layer(ps_session *s, ps_global_layer g, ps_error *err)

@@ -323,6 +323,14 @@ void ps_session_set_tau(ps_session *s, double tau);
  * every photon took seconds). The illumination maps keep all theirs.
  * Incremental refreshes ignore it. */
 void ps_session_set_whole_most(ps_session *s, const double most[PS_MAP_COUNT]);
+/* Incremental refreshes draw at most this share of their budget of new
+ * splats (at least one batch a map still), until set again: 1, the default,
+ * is the whole budget. For a refresh that must end by a time with little
+ * room for the budget's error (photosplat-snap's float checkpoints: the
+ * splat rate the budget comes from varied 2x from one refresh to the next,
+ * and a refresh meant to take 0.09 s of splats took 0.15). Whole refreshes
+ * ignore it (ps_session_set_whole_most). */
+void ps_session_set_budget_share(ps_session *s, double share);
 /* Splats or illumination maps for the global layer; the maps are made (and
  * checked against the memory budget) when first asked for. */
 ps_status ps_session_set_global_layer(ps_session *s, ps_global_layer g, ps_error *err);
