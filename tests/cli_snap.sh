@@ -148,6 +148,16 @@ for mode in points triangles; do
     emitted=$(sed -n 's/.*"emitted_caustic": \([0-9]*\).*/\1/p' "$cli_tmp/c.json")
     awk_true "$emitted < $n" && ok || bad "$mode: the counter let all $emitted photons through"
 done
+# Checkpoints after the counter stopped get their own frames at their time
+# (before, the last picture showed them when the counter stopped: the 2 s
+# one at 0.46 s), and the run still ends soon after the last.
+expect_success "counter checkpoints" "$snap" "$mirror" --layers caustic --caustic-photons $n --exposure $exposure \
+    --precision counter --time 60 --tau 0.05 --checkpoints 0.5,2 --checkpoint-prefix "$cli_tmp/ct" --stats "$cli_tmp/ct.json"
+awk -F, 'NR > 1 && ($3 < $2 || $3 > 2 * $2 + 0.5) { print "checkpoint " $2 " s at " $3 " s"; bad = 1 } END { exit bad }' \
+    "$cli_tmp/ct.csv" && ok || bad "counter checkpoints: $(cat "$cli_tmp/ct.csv")"
+grep -q '"counter_stopped": 1,' "$cli_tmp/ct.json" && ok || bad "counter checkpoints: the counter did not stop"
+run_seconds=$(sed -n 's/.*"seconds": \([0-9.]*\).*/\1/p' "$cli_tmp/ct.json")
+awk_true "$run_seconds < 10" && ok || bad "counter checkpoints: the run took $run_seconds s"
 
 # --global-layer maps: the global layer as illumination maps. Its picture is
 # the splats' within the kernels' difference (mean within 5 %), the same

@@ -689,22 +689,23 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             if (st != PS_OK)
                 break;
         }
-        if (ps_session_counter_stopped(s->session, NULL))
-            break;
         next += o->p.tau;
-        /* Every photon traced: checkpoints still to come get their own
-         * frames, on time, and the last picture follows. (An 8-bit redraw of
-         * them all takes seconds; in float the last picture's every virtual
-         * light and cube face did: the area box's 1 s checkpoint, at the
-         * scene's counts, came at 2.7 s.) */
-        if ((counts.ended && cp >= o->checkpoint_count) || ps_now_seconds() >= end)
+        /* Every photon traced, or the error counter stopped the tracer:
+         * checkpoints still to come get their own frames, on time, and the
+         * last picture follows. (An 8-bit redraw of them all takes seconds;
+         * in float the last picture's every virtual light and cube face
+         * did: the area box's 1 s checkpoint, at the scene's counts, came at
+         * 2.7 s; the counter stopped before the area box's 5 s checkpoint,
+         * the last picture showed it at 9.9 s.) */
+        bool done = counts.ended || ps_session_counter_stopped(s->session, NULL);
+        if ((done && cp >= o->checkpoint_count) || ps_now_seconds() >= end)
             break;
     }
     ps_gl_specular_set_deadline(s->spec, 0.0);
     ps_session_set_whole_most(s->session, NULL);
     st = last_picture(s, st, err);
-    /* Checkpoints after the end (every cap reached, or the counter stopped
-     * the tracer) show the final picture, at the time it was done. */
+    /* Checkpoints after the end (--time spent before their frames) show
+     * the final picture, at the time it was done. */
     double done = ps_now_seconds() - t_start - excluded;
     for (; st == PS_OK && cp < o->checkpoint_count; cp++) {
         st = write_checkpoint(s, cp, done, &rows[cp], err);
