@@ -107,6 +107,40 @@ static void wait_ended_within(ps_session *s, int seconds)
 
 static void wait_ended(ps_session *s) { wait_ended_within(s, 10); }
 
+/* A session over scene whose caustic map holds cap_batches batches, all
+ * traced, after a first refresh drawn at the rate (*rate) that makes the
+ * caustic's budget budget_batches batches. tau is long, so that the budget
+ * is a drawing time of seconds, against which building the splats (timed by
+ * the session itself, and taken off: *built) is small even under the
+ * sanitizers. */
+static ps_session *at_budget(ps_scene *scene, int cap_batches, double budget_batches, ps_camera_frame *cam,
+                             ps_session_frame *f, double *rate, double *built);
+
+/* Tells the session the last refresh drew its splats at `rate` a second:
+ * the drawing time that makes it, less the building the session timed
+ * itself since *built (its splat_seconds then; updated). */
+static void drawn_at_rate(ps_session *s, const ps_session_frame *f, double rate, double *built)
+{
+    ps_session_counts c;
+    ps_session_get_counts(s, &c);
+    ps_session_drawn(s, fmax(1e-3, (double)f->splats / rate - (c.splat_seconds - *built)));
+    *built = c.splat_seconds;
+}
+
+static ps_session *at_budget(ps_scene *scene, int cap_batches, double budget_batches, ps_camera_frame *cam,
+                             ps_session_frame *f, double *rate, double *built)
+{
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = (uint64_t)cap_batches * PS_FEED_BATCH;
+    set.tau = 10.0;
+    ps_session *s = start_and_refresh(scene, &set, cam, f);
+    *rate = budget_batches * PS_FEED_BATCH * PS_MAP_COUNT / (set.tau * set.splat_share);
+    *built = 0.0;
+    drawn_at_rate(s, f, *rate, built);
+    wait_ended(s);
+    return s;
+}
+
 /* Whole refreshes: every photon, scaled by exposure N / n into layers cleared
  * first; the direct layer drawn at the exposure. */
 static void whole_refresh_splats_everything(void **state)
@@ -315,30 +349,18 @@ static void budget_share_draws_a_share(void **state)
 {
     (void)state;
     ps_scene *scene = load();
-    ps_session_settings set = settings(scene, true);
-    set.caps[PS_MAP_CAUSTIC] = 12 * PS_FEED_BATCH;
-    set.tau = 10.0; /* the budget a drawing time of seconds: building the splats small beside it */
     ps_camera_frame cam;
     ps_session_frame f;
-    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
-    /* Drawn at the rate that makes the caustic's budget 4.8 batches. */
-    double rate = 4.8 * PS_FEED_BATCH * PS_MAP_COUNT / (set.tau * set.splat_share);
-    ps_session_counts c;
-    ps_session_get_counts(s, &c);
-    double built = c.splat_seconds;
-    ps_session_drawn(s, fmax(1e-3, (double)f.splats / rate - built));
-    wait_ended(s);
+    double rate, built;
+    ps_session *s = at_budget(scene, 12, 4.8, &cam, &f, &rate, &built);
     uint64_t before = f.emitted[PS_MAP_CAUSTIC];
     ps_session_set_budget_share(s, 0.25); /* 1.2 batches: one */
     refresh(s, &cam, &f);
     assert_int_equal(f.emitted[PS_MAP_CAUSTIC], before + PS_FEED_BATCH);
-    ps_session_get_counts(s, &c);
-    ps_session_drawn(s, fmax(1e-3, (double)f.splats / rate - (c.splat_seconds - built)));
-    built = c.splat_seconds;
+    drawn_at_rate(s, &f, rate, &built);
     refresh(s, &cam, &f); /* still a share */
     assert_int_equal(f.emitted[PS_MAP_CAUSTIC], before + 2 * PS_FEED_BATCH);
-    ps_session_get_counts(s, &c);
-    ps_session_drawn(s, fmax(1e-3, (double)f.splats / rate - (c.splat_seconds - built)));
+    drawn_at_rate(s, &f, rate, &built);
     ps_session_set_budget_share(s, 1.0); /* the whole budget again: four */
     refresh(s, &cam, &f);
     assert_true(f.emitted[PS_MAP_CAUSTIC] >= before + 6 * PS_FEED_BATCH);
@@ -787,34 +809,24 @@ static void catch_up_after_the_first_still_refresh(void **state)
 {
     (void)state;
     ps_scene *scene = load();
-    ps_session_settings set = settings(scene, true);
-    set.caps[PS_MAP_CAUSTIC] = 8 * PS_FEED_BATCH;
-    /* A long tau, so that the budget below is a drawing time of seconds,
-     * against which building the splats (timed by the session itself, and
-     * taken off) is small even under the sanitizers. */
-    set.tau = 10.0;
     ps_camera_frame cam;
     ps_session_frame f;
-    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
-    /* Drawn at the rate that makes the caustic's budget 1.6 batches: one
-     * batch a refresh, 4.8 (four) when caught up (two at the gain of 1.6). */
-    double rate = 1.6 * PS_FEED_BATCH * PS_MAP_COUNT / (set.tau * set.splat_share);
-    ps_session_counts c;
-    ps_session_get_counts(s, &c);
-    ps_session_drawn(s, fmax(1e-3, (double)f.splats / rate - c.splat_seconds));
-    wait_ended(s);
+    /* The caustic's budget 1.6 batches: one batch a refresh, 4.8 (four)
+     * when caught up (two at the gain of 1.6). */
+    double rate, built;
+    ps_session *s = at_budget(scene, 8, 1.6, &cam, &f, &rate, &built);
     cam.eye.x += 0.05;
     refresh(s, &cam, &f);
     assert_true(f.moving);
     ps_session_drawn(s, 1.0);
+    ps_session_counts c;
     ps_session_get_counts(s, &c);
-    double built = c.splat_seconds;
+    built = c.splat_seconds;
     refresh(s, &cam, &f); /* the same camera again: still */
     assert_false(f.moving);
     assert_true(f.new_view);
     assert_int_equal(f.emitted[PS_MAP_CAUSTIC], PS_FEED_BATCH);
-    ps_session_get_counts(s, &c);
-    ps_session_drawn(s, fmax(1e-3, (double)f.splats / rate - (c.splat_seconds - built)));
+    drawn_at_rate(s, &f, rate, &built);
     refresh(s, &cam, &f);
     assert_true(f.emitted[PS_MAP_CAUSTIC] >= 4 * PS_FEED_BATCH); /* the first and three more */
     ps_session_destroy(s);
