@@ -290,6 +290,15 @@ static void unheld_faces_stay_out_of_the_checkpoints_frame(void **state)
         }
         assert_true(end >= cp && end <= last_end + 1e-9);
     }
+    /* Faces never drawn (ps_gl_specular_unheld_seconds: HUGE_VAL, not
+     * known): a refresh before the checkpoint holds them to a deadline. */
+    m.unheld = HUGE_VAL;
+    cp = 1.5;
+    p = ps_pace_next(&m, 0.4, 0.0, 0.4, &cp, 1);
+    assert_true(p.hold_faces);
+    assert_false(p.shows);
+    assert_near(p.start, 0.4, 1e-12);
+    assert_true(isfinite(p.faces_deadline) && p.faces_deadline > 1.0 && p.faces_deadline < cp * (1.0 + PS_PACE_FACES_LATE));
 }
 
 int main(void)

@@ -14,16 +14,19 @@ static double photons_part(const ps_pace_model *m, double n)
     return n > m->photons && m->photons > 0.0 ? part * pow(n / m->photons, PS_PACE_GROWTH) : part;
 }
 
-double ps_pace_seconds(const ps_pace_model *m, double photons)
+/* A refresh with its first round of cube faces held to the deadline. */
+static double held_seconds(const ps_pace_model *m, double photons)
 {
-    return scene_part(m) + photons_part(m, photons) + m->unheld;
+    return scene_part(m) + photons_part(m, photons);
 }
+
+double ps_pace_seconds(const ps_pace_model *m, double photons) { return held_seconds(m, photons) + m->unheld; }
 
 /* The checkpoint's frame (ps_pace_plan.shows) holds its first round of cube
  * faces to the deadline like any others, and draws a share of the budget. */
 static double shown_seconds(const ps_pace_model *m, double photons)
 {
-    return ps_pace_seconds(m, photons) - m->unheld - (1.0 - PS_PACE_SHOWN_BUDGET) * m->splats;
+    return held_seconds(m, photons) - (1.0 - PS_PACE_SHOWN_BUDGET) * m->splats;
 }
 
 void ps_pace_learn(ps_pace_model *m, double seconds, double photons, double photon_seconds, bool whole)
@@ -84,8 +87,8 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
     double last_end = fmax(cp * (1.0 + PS_PACE_FACES_LATE), aim);
     double last_start = last_end - d_ideal;
     double s0 = now >= ideal ? now : fmax(now, due);
-    double d0 = ps_pace_seconds(m, photons + m->rate * (s0 - now)); /* unheld faces in it */
-    double d0_held = d0 - m->unheld;
+    double d0_held = held_seconds(m, photons + m->rate * (s0 - now));
+    double d0 = d0_held + m->unheld; /* unheld faces in it (HUGE_VAL: not known) */
     /* Whole refreshes no checkpoint shows are only drawn and thrown away
      * (snap is headless): the checkpoint's frame is the next. */
     if (now >= ideal || s0 + d0_held > last_start || m->per_photon > 0.0) {

@@ -74,8 +74,8 @@ typedef struct ps_pace_model {
     double lead;       /* of seconds, what comes before the faces (the session's splats) */
     int learned;       /* whole refreshes learned in a row */
     double unheld;     /* the next refresh's cube faces that no deadline holds back, seconds
-                        * (the first round's: ps_gl_specular_unheld_seconds), unless it
-                        * shows a checkpoint (ps_pace_plan.shows) */
+                        * (the first round's: ps_gl_specular_unheld_seconds; HUGE_VAL: not
+                        * known yet), unless it shows a checkpoint (ps_pace_plan.shows) */
 } ps_pace_model;
 
 /* After a refresh of `seconds` (no cube faces) drawing `photons`, of which

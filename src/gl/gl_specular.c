@@ -315,7 +315,12 @@ double ps_gl_specular_unheld_seconds(const ps_gl_specular *g, ps_session *s)
     uint64_t arrived;
     if (photons_settled(s, &arrived))
         return 0.0;
-    /* Each face as it took last, or the dearest seen (faces differ several-fold). */
+    /* Each face as it took last, or the dearest seen (faces differ several-fold).
+     * None drawn yet: not known (taken as none, the area box's quarter
+     * round of 0.27 s rode in the refresh before its 0.5 s checkpoint's
+     * frame and landed it at 0.73-0.77 s). */
+    if (g->face_max <= 0.0 && g->face_seconds <= 0.0)
+        return HUGE_VAL;
     int n = (total + g->first_refreshes - 1) / g->first_refreshes;
     double t = 0.0;
     for (int i = 0; i < n; i++) {

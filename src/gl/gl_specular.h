@@ -92,7 +92,8 @@ bool ps_gl_specular_face_fits(double now, double at, double estimate);
 /* The seconds the next refresh's faces (a few a refresh, not a new view's)
  * take whatever the deadline: the first round's (ps_gl_specular_set_first_round)
  * while it lasts and is not held (ps_gl_specular_hold_first_round), each face
- * at its own last time, or the dearest seen (0 before any was drawn). */
+ * at its own last time, or the dearest seen; HUGE_VAL before any was drawn
+ * (not known: a caller that must end by a time holds them). */
 double ps_gl_specular_unheld_seconds(const ps_gl_specular *g, ps_session *s);
 
 /* While the program waits anyway (photosplat-snap before the frame a
