@@ -6,16 +6,19 @@
  * for whole refreshes (8 bits redraw every photon, so their time grows with
  * the run) split into the photons' part (building their splats, and drawing
  * them, finished before and after), which scales with the photons it will
- * draw, and the scene's (the rest); as is for incremental ones.
+ * draw (PS_PACE_GROWTH), and the scene's (the rest); incremental ones at a
+ * whole budget's splats, whatever the last drew.
  * (Fitting the photon's cost from two refreshes' difference was up to 3x
  * low: their scene parts vary as much as the photons' parts differ.) The
  * refresh that will show the checkpoint starts when it would end
- * PS_PACE_MARGIN of its time after it; a refresh that would end after that
- * start waits for it instead (snap is headless: an idle moment only leaves
- * the cores to the tracer), and cube faces run only while the checkpoint's
- * frame still ends within PS_PACE_FACES_LATE of it (or the margin, if later):
- * in that frame, those of the first round too, which the refreshes between
- * checkpoints draw whatever their time (ps_gl_specular_set_first_round).
+ * PS_PACE_MARGIN of its time after it (incremental: drawing
+ * PS_PACE_SHOWN_BUDGET of its budget); a refresh that would end after that
+ * start holds its first round of cube faces if that is enough, and waits
+ * for it otherwise (snap is headless: an idle moment only leaves the cores
+ * to the tracer); cube faces run only while the checkpoint's frame still
+ * ends within PS_PACE_FACES_LATE of it (or the margin, if later): in that
+ * frame, those of the first round too, which the refreshes further from a
+ * checkpoint draw whatever their time (ps_gl_specular_set_first_round).
  * A whole refresh showing a checkpoint lasts at most PS_PACE_FRAME_SHARE of
  * the checkpoint's time (ps_pace_plan.photons: a prefix of the photons, an
  * unbiased picture of fewer), so that its prediction's error stays within
