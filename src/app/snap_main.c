@@ -706,6 +706,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
     }
     ps_gl_specular_set_deadline(s->spec, 0.0);
     ps_session_set_whole_most(s->session, NULL);
+    ps_session_set_budget_share(s->session, 1.0); /* the last picture catches up at the whole budget */
     st = last_picture(s, st, err);
     /* Checkpoints after the end (--time spent before their frames) show
      * the final picture, at the time it was done. */
