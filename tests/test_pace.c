@@ -177,8 +177,9 @@ static double true_fit(double seconds)
  * the frame's time errs by as much as 8-bit frames did from their
  * prediction (-20 % to +27 %), and draws most of what fits. Without the cap
  * the 10 s checkpoint's frame would have lasted some 5 s, its error alone
- * past 20 %; predicted linearly from the smaller frames before it (no
- * PS_PACE_GROWTH), it landed past 12 s. */
+ * past 20 %. (Here the frames before a checkpoint's are near its size, so
+ * the growth's extrapolation is small: `learning` checks it against the
+ * measured case where it was not.) */
 static void capped_frames_land_within_20_percent(void **state)
 {
     (void)state;
