@@ -96,6 +96,13 @@ expect_success "progressive" "$snap" "$scene" --size 32x32 --time 0.6 --tau 0.1 
 frames=$(sed -n 's/.*"frames": \([0-9]*\).*/\1/p' "$cli_tmp/p.json")
 awk_true "$frames >= 2" && ok || bad "progressive mode refreshed $frames times in 0.6 s at tau 0.1"
 grep -q '"first_frame_seconds":' "$cli_tmp/p.json" && ok || bad "no first_frame_seconds"
+# Float checkpoints: the tracer waits for the first picture (which then has
+# every core), so it comes at once, not at tau (here 1.5 s; before, it
+# waited for it).
+expect_success "float first picture at once" "$snap" "$scene" --size 32x32 --color-depth float --time 1.6 --tau 1.5 \
+    --checkpoints 1.6 --checkpoint-prefix "$cli_tmp/fa" --stats "$cli_tmp/fa.json"
+first=$(sed -n 's/.*"first_frame_seconds": \([0-9.e+-]*\).*/\1/p' "$cli_tmp/fa.json")
+awk_true "$first < 1.0" && ok || bad "float checkpoints: the first picture came at $first s, after tau"
 # Progressive in float draws only new photons into layers kept between
 # refreshes (as the window): at the caps the same picture as drawing them all
 # at once, but for the order of float additions.
