@@ -2,6 +2,7 @@
 # cli_bench.sh BIN_DIR: what photosplat-bench is made of, from the outside:
 # snap's per-layer images, checkpoints and radius schedule, compare --clamp,
 # and a tiny photosplat-bench run with its reference cache.
+# run-tests: alone (it times what it runs, or opens windows on Xvfb)
 set -u
 cd "$(dirname "$0")/.."
 bin=${1:-bin}

@@ -10,6 +10,7 @@
 # the maps are large for the view, the full view after it. The window
 # refuses .pfm screenshots (file:line, exit 2), and scripts/bench-window.sh
 # an unknown section.
+# run-tests: alone (it times what it runs, or opens windows on Xvfb)
 set -u
 cd "$(dirname "$0")/.."
 bin=${1:-bin}

@@ -9,6 +9,7 @@
 # (incremental) buffers. And the repair keeps photons: moving the spot keeps
 # the point light's global photons, as the stats count them. The window's
 # dump after edits likewise (under Xvfb).
+# run-tests: alone (it times what it runs, or opens windows on Xvfb)
 set -u
 cd "$(dirname "$0")/.."
 bin=${1:-bin}

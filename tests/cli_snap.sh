@@ -4,6 +4,7 @@
 # of llvmpipe threads, progressive mode, the contract's --stats keys, and the
 # 8-bit precision stress (thesis 5.1): a caustic of millions of faint photons
 # that plain 8-bit loses, error diffusion keeps and the counter stops.
+# run-tests: alone (it times what it runs, or opens windows on Xvfb)
 set -u
 cd "$(dirname "$0")/.."
 bin=${1:-bin}

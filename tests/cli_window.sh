@@ -6,6 +6,7 @@
 # caustic followed the light, and that the first frame after the move came
 # within a few tau; and the same picture as photosplat-snap for the same
 # scene and photons.
+# run-tests: alone (it times what it runs, or opens windows on Xvfb)
 set -u
 cd "$(dirname "$0")/.."
 bin=${1:-bin}

@@ -7,6 +7,7 @@
 # --autosave on, as here); a scripted session without it writes none; starting again on the scene says that its
 # autosave is newer and how to open it; the autosave of a read-only scene
 # directory goes to the current one.
+# run-tests: alone (it times what it runs, or opens windows on Xvfb)
 set -u
 cd "$(dirname "$0")/.."
 bin=${1:-bin}

@@ -6,6 +6,7 @@
 # reached and how much the maps hold (bounded by the caps), and a wait while
 # tracing is paused ends instead of hanging. make soak does the same over a
 # few hundred moves.
+# run-tests: alone (it times what it runs, or opens windows on Xvfb)
 set -u
 cd "$(dirname "$0")/.."
 bin=${1:-bin}

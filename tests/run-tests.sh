@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# run-tests.sh: runs every unit test (cmocka) and the command-line tests, first
-# from the release build, then under AddressSanitizer + UBSan, and ends with
-# one summary line "tests: N passed, N failed".
+# run-tests.sh: runs every unit test (cmocka) and the command-line tests, from
+# the release build and under AddressSanitizer + UBSan, and ends with one
+# summary line "tests: N passed, N failed". PS_TEST_JOBS: how many run at
+# once in the first phase (default 2).
 set -u
 cd "$(dirname "$0")/.."
 
@@ -13,18 +14,15 @@ export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
 passed=0
 failed=0
 failed_names=()
+ran=0 # tests counted, against those listed (a runner that skipped some must fail)
 log_dir=build/test-logs
 mkdir -p "$log_dir"
 
-run_one() { # variant name command...
-    local variant=$1 name=$2
-    shift 2
-    local log="$log_dir/$variant-$name.log"
-    local start=$SECONDS
-    "$@" >"$log" 2>&1
-    local rc=$?
-    # cmocka prints "[  PASSED  ] N test(s)." and "[  FAILED  ] N test(s)"; the
-    # CLI script prints "cli: N passed, N failed".
+# count LOG RC VARIANT NAME SECONDS: adds a finished test's counts to the
+# totals and prints its line. cmocka prints "[  PASSED  ] N test(s)." and
+# "[  FAILED  ] N test(s)"; the CLI scripts print "cli: N passed, N failed".
+count() {
+    local log=$1 rc=$2 variant=$3 name=$4 took=$5
     local p f
     p=$(grep -Eo '\[  PASSED  \] [0-9]+ test' "$log" | grep -Eo '[0-9]+' | tail -1)
     f=$(grep -Eo '\[  FAILED  \] [0-9]+ test' "$log" | grep -Eo '[0-9]+' | tail -1)
@@ -34,32 +32,91 @@ run_one() { # variant name command...
     fi
     p=${p:-0}
     f=${f:-0}
+    ran=$((ran + 1))
     # A crash or sanitizer report ends the binary early: count it as a failure
     # even when no test said so.
-    if [ $rc -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi
+    if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi
     passed=$((passed + p))
     failed=$((failed + f))
-    if [ $rc -ne 0 ]; then
+    if [ "$rc" -ne 0 ]; then
         failed_names+=("$variant/$name")
-        printf '%-8s %-28s FAIL (%ss) — log: %s\n' "$variant" "$name" $((SECONDS - start)) "$log"
+        printf '%-8s %-28s FAIL (%ss) — log: %s\n' "$variant" "$name" "$took" "$log"
         sed -e 's/^/    | /' "$log" | grep -E 'FAIL|ERROR|error|Sanitizer|runtime error|^    \| [^[]' | head -40
     else
-        printf '%-8s %-28s ok   %3d passed (%ss)\n' "$variant" "$name" "$p" $((SECONDS - start))
+        printf '%-8s %-28s ok   %3d passed (%ss)\n' "$variant" "$name" "$p" "$took"
     fi
 }
 
-for variant in release asan; do
-    for t in build/$variant/tests/test_*; do
-        [ -x "$t" ] || continue
-        case "$t" in *.d) continue ;; esac
-        run_one "$variant" "$(basename "$t")" "$t"
+# The tests, as "variant name command..." lines (one word each). Unit tests
+# first: the sanitizer build's, the longer, lead.
+jobs_of() { # PHASE: shared or alone
+    local want=$1 variant t c
+    if [ "$want" = shared ]; then
+        for variant in asan release; do
+            for t in build/$variant/tests/test_*; do
+                [ -x "$t" ] || continue
+                case "$t" in *.d) continue ;; esac
+                echo "$variant $(basename "$t") $t"
+            done
+        done
+    fi
+    for variant in release asan; do
+        for c in tests/cli_*.sh; do
+            [ "$c" = tests/cli_lib.sh ] && continue
+            # A script that times what it runs (a checkpoint's lateness, an
+            # edit's latency, a window's frames) says "run-tests: alone": it
+            # runs with nothing beside it.
+            if grep -q '^# run-tests: alone' "$c"; then
+                [ "$want" = alone ] || continue
+            else
+                [ "$want" = shared ] || continue
+            fi
+            echo "$variant $(basename "$c" .sh) $c build/$variant/bin"
+        done
     done
-    for c in tests/cli_*.sh; do
-        [ "$c" = tests/cli_lib.sh ] && continue
-        run_one "$variant" "$(basename "$c" .sh)" "$c" "build/$variant/bin"
-    done
-done
+}
 
+# Phase 1: the unit tests and the scripts that time nothing, two at a time
+# (on 2 cores the suite took 12-13 minutes one at a time; the unit tests'
+# time bounds are for quadratic blow-ups, far from their times). Each line
+# is printed as its test ends.
+SHARED_JOBS=${PS_TEST_JOBS:-2}
+declare -A job_line=() job_start=()
+reap() { # waits for one running test and counts it
+    local done_pid rc v n
+    wait -n -p done_pid
+    rc=$?
+    if [ -z "${done_pid:-}" ]; then # nothing left to wait for: the rest are not counted, and fail
+        job_line=()
+        return 0
+    fi
+    [ -n "${job_line[$done_pid]+x}" ] || return 0 # not one of ours
+    read -r v n <<<"${job_line[$done_pid]}"
+    count "$log_dir/$v-$n.log" "$rc" "$v" "$n" $((SECONDS - ${job_start[$done_pid]}))
+    unset "job_line[$done_pid]" "job_start[$done_pid]"
+}
+while read -r variant name cmd; do
+    while [ ${#job_line[@]} -ge "$SHARED_JOBS" ]; do reap; done
+    # shellcheck disable=SC2086 # the command's words
+    $cmd >"$log_dir/$variant-$name.log" 2>&1 </dev/null &
+    job_line[$!]="$variant $name"
+    job_start[$!]=$SECONDS
+done < <(jobs_of shared)
+while [ ${#job_line[@]} -gt 0 ]; do reap; done
+
+# Phase 2: the scripts that time what they run, one at a time.
+while read -r variant name cmd; do
+    start=$SECONDS
+    # shellcheck disable=SC2086
+    $cmd >"$log_dir/$variant-$name.log" 2>&1 </dev/null
+    count "$log_dir/$variant-$name.log" $? "$variant" "$name" $((SECONDS - start))
+done < <(jobs_of alone)
+
+listed=$( (jobs_of shared; jobs_of alone) | wc -l)
+if [ "$ran" -ne "$listed" ]; then
+    failed_names+=("runner: $ran of $listed tests ran")
+    failed=$((failed + 1))
+fi
 if [ ${#failed_names[@]} -gt 0 ]; then
     echo "failed: ${failed_names[*]}"
 fi
