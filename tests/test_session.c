@@ -345,25 +345,6 @@ static void budget_bounds_a_refresh(void **state)
 /* ps_session_set_budget_share: the next refreshes draw that share of the
  * budget (at least a batch), until set again (photosplat-snap's float
  * checkpoints' frames: pace.h). */
-/* The first round is traced on every core (nothing draws before it), the
- * rest on the settings' threads: a float session leaves a core to drawing. */
-static void first_round_then_the_settings_threads(void **state)
-{
-    (void)state;
-    ps_scene *scene = load();
-    ps_session_settings set = settings(scene, true);
-    set.threads = 1;
-    ps_session *s = open_session(scene, &set);
-    ps_error err;
-    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
-    ps_session_counts c;
-    ps_session_get_counts(s, &c);
-    assert_true(c.map[PS_MAP_CAUSTIC].emitted > 0); /* the first round, traced in start */
-    assert_int_equal(ps_tracer_threads(ps_session_tracer(s)), 1);
-    ps_session_destroy(s);
-    ps_scene_destroy(scene);
-}
-
 static void budget_share_draws_a_share(void **state)
 {
     (void)state;
@@ -917,7 +898,6 @@ int main(void)
         cmocka_unit_test(incremental_refresh_splats_each_photon_once),
         cmocka_unit_test(budget_bounds_a_refresh),
         cmocka_unit_test(budget_share_draws_a_share),
-        cmocka_unit_test(first_round_then_the_settings_threads),
         cmocka_unit_test(backlog_holds_the_tracer),
         cmocka_unit_test(tracing_threads_leave_a_core_to_drawing),
         cmocka_unit_test(counter_stops_shooting),

@@ -362,12 +362,8 @@ ps_status ps_session_start(ps_session *s, bool held, ps_error *err)
 {
     s->started = true;
     /* After a repair the kept photons are the first picture: the thread
-     * retraces the rest. The first round on every core: nothing draws
-     * before it (a core left to drawing, the default box's took 0.06 s of
-     * a first picture at 0.3 s). */
-    ps_tracer_set_threads(s->tracer, 0);
+     * retraces the rest. */
     ps_status st = s->skip_prime ? PS_OK : ps_feed_prime(s->feed, err);
-    ps_tracer_set_threads(s->tracer, s->set.threads);
     if (st != PS_OK)
         return st;
     s->first_pending = held;
