@@ -574,9 +574,11 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
     const snap_options *o = s->o;
     snap_checkpoint_row rows[SNAP_MAX_CHECKPOINTS];
     /* Float: the tracer waits until the first picture is drawn, which then
-     * has every core (as the window's); 8 bits trace meanwhile, on every
-     * core (session.h), for the first frame that shows a checkpoint. (The
-     * default box's first float picture: 0.36 s, 0.43 s sharing them.) */
+     * has every core (as the window's), and is drawn at once (plan_refresh);
+     * 8 bits trace meanwhile, on every core (session.h), for the first frame
+     * that shows a checkpoint. (The default box's first float picture: 0.35-
+     * 0.36 s; 0.43-0.50 s sharing the cores and waiting for the first
+     * checkpoint or tau.) */
     ps_status st = ps_session_start(s->session, s->layers != NULL, err);
     double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
     pace_rate rate = {0.0, 0.0};
