@@ -81,6 +81,10 @@ jobs_of() { # PHASE: shared or alone
 # time bounds are for quadratic blow-ups, far from their times). Each line
 # is printed as its test ends.
 SHARED_JOBS=${PS_TEST_JOBS:-2}
+if ! [[ $SHARED_JOBS =~ ^[1-9][0-9]*$ ]]; then
+    echo "run-tests.sh: PS_TEST_JOBS must be a whole number of at least 1, not '$SHARED_JOBS'" >&2
+    exit 2
+fi
 declare -A job_line=() job_start=()
 reap() { # waits for one running test and counts it
     local done_pid rc v n
