@@ -99,22 +99,21 @@ reap() { # waits for one running test and counts it
     count "$log_dir/$v-$n.log" "$rc" "$v" "$n" $((SECONDS - ${job_start[$done_pid]}))
     unset "job_line[$done_pid]" "job_start[$done_pid]"
 }
-while read -r variant name cmd; do
-    while [ ${#job_line[@]} -ge "$SHARED_JOBS" ]; do reap; done
-    # shellcheck disable=SC2086 # the command's words
-    $cmd >"$log_dir/$variant-$name.log" 2>&1 </dev/null &
-    job_line[$!]="$variant $name"
-    job_start[$!]=$SECONDS
-done < <(jobs_of shared)
-while [ ${#job_line[@]} -gt 0 ]; do reap; done
-
+# run_phase WIDTH PHASE: the phase's tests, at most WIDTH at a time.
+run_phase() {
+    local width=$1 variant name cmd
+    while read -r variant name cmd; do
+        while [ ${#job_line[@]} -ge "$width" ]; do reap; done
+        # shellcheck disable=SC2086 # the command's words
+        $cmd >"$log_dir/$variant-$name.log" 2>&1 </dev/null &
+        job_line[$!]="$variant $name"
+        job_start[$!]=$SECONDS
+    done < <(jobs_of "$2")
+    while [ ${#job_line[@]} -gt 0 ]; do reap; done
+}
+run_phase "$SHARED_JOBS" shared
 # Phase 2: the scripts that time what they run, one at a time.
-while read -r variant name cmd; do
-    start=$SECONDS
-    # shellcheck disable=SC2086
-    $cmd >"$log_dir/$variant-$name.log" 2>&1 </dev/null
-    count "$log_dir/$variant-$name.log" $? "$variant" "$name" $((SECONDS - start))
-done < <(jobs_of alone)
+run_phase 1 alone
 
 listed=$( (jobs_of shared; jobs_of alone) | wc -l)
 if [ "$ran" -ne "$listed" ]; then
