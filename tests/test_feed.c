@@ -6,6 +6,7 @@
 #include "test.h"
 #include "rig.h"
 
+#include <stdint.h>
 #include <string.h>
 #include <time.h>
 
@@ -179,6 +180,78 @@ static void background_thread_stops(void **state)
     rig_free(&r);
 }
 
+static uint64_t emitted(ps_feed *f, int k)
+{
+    ps_feed_lock(f);
+    uint64_t n = ps_feed_maps(f)[k].counters.emitted;
+    ps_feed_unlock(f);
+    return n;
+}
+
+static void sleep_ms(long ms)
+{
+    struct timespec ts = {ms / 1000, (ms % 1000) * 1000000};
+    nanosleep(&ts, NULL);
+}
+
+/* ps_feed_set_ahead: the thread holds before a round while a map holds its
+ * bound, without anyone calling again (snap's tracer ran 2*10^5 photons past
+ * a bound looked at only as refreshes drew), goes on a round at a time as
+ * the bound rises, to the cap when lifted; ps_feed_run on the calling thread
+ * ignores it (nothing would raise it). */
+static void ahead_bound_holds_the_thread(void **state)
+{
+    (void)state;
+    rig r = feed_rig();
+    const uint64_t caps[PS_MAP_COUNT] = {6 * PS_FEED_BATCH, PS_FEED_BATCH};
+    const bool active[PS_MAP_COUNT] = {true, true};
+    ps_feed *f = NULL;
+    ps_error err;
+    assert_int_equal(ps_feed_create(r.tracer, caps, active, &f, &err), PS_OK);
+    assert_int_equal(ps_feed_prime(f, &err), PS_OK);
+    assert_int_equal(emitted(f, PS_MAP_CAUSTIC), PS_FEED_BATCH);
+    ps_feed_lock(f);
+    size_t first = ps_feed_maps(f)[PS_MAP_CAUSTIC].count;
+    ps_feed_unlock(f);
+    size_t most[PS_MAP_COUNT] = {first, SIZE_MAX};
+    ps_feed_set_ahead(f, most);
+    assert_int_equal(ps_feed_start(f, &err), PS_OK);
+    sleep_ms(300); /* a round takes some 10 ms (more under the sanitizers) */
+    assert_int_equal(emitted(f, PS_MAP_CAUSTIC), PS_FEED_BATCH);
+    /* One photon more allowed: the next round, and no other. */
+    most[PS_MAP_CAUSTIC] = first + 1;
+    ps_feed_set_ahead(f, most);
+    for (int i = 0; i < 3000 && emitted(f, PS_MAP_CAUSTIC) < 2 * PS_FEED_BATCH; i++)
+        sleep_ms(5);
+    sleep_ms(300);
+    assert_int_equal(emitted(f, PS_MAP_CAUSTIC), 2 * PS_FEED_BATCH);
+    /* Lifted: to the caps. */
+    most[PS_MAP_CAUSTIC] = SIZE_MAX;
+    ps_feed_set_ahead(f, most);
+    bool ended = false;
+    for (int i = 0; i < 6000 && !ended; i++) {
+        ps_feed_lock(f);
+        ended = ps_feed_ended(f);
+        ps_feed_unlock(f);
+        if (!ended)
+            sleep_ms(5);
+    }
+    assert_true(ended);
+    ps_feed_stop(f);
+    assert_int_equal(emitted(f, PS_MAP_CAUSTIC), caps[PS_MAP_CAUSTIC]);
+    ps_feed_destroy(f);
+
+    /* On the calling thread: to the caps, bound or not. */
+    assert_int_equal(ps_feed_create(r.tracer, caps, active, &f, &err), PS_OK);
+    const size_t one[PS_MAP_COUNT] = {1, 1};
+    ps_feed_set_ahead(f, one);
+    assert_int_equal(ps_feed_run(f, &err), PS_OK);
+    assert_int_equal(emitted(f, PS_MAP_CAUSTIC), caps[PS_MAP_CAUSTIC]);
+    assert_int_equal(emitted(f, PS_MAP_GLOBAL), caps[PS_MAP_GLOBAL]);
+    ps_feed_destroy(f);
+    rig_free(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -186,6 +259,7 @@ int main(void)
         cmocka_unit_test(ends_at_the_store_limit),
         cmocka_unit_test(ends_at_the_map_memory_cap),
         cmocka_unit_test(background_thread_stops),
+        cmocka_unit_test(ahead_bound_holds_the_thread),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

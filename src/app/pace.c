@@ -21,6 +21,7 @@ static double held_seconds(const ps_pace_model *m, double photons)
 }
 
 double ps_pace_seconds(const ps_pace_model *m, double photons) { return held_seconds(m, photons) + m->unheld; }
+double ps_pace_held_seconds(const ps_pace_model *m, double photons) { return held_seconds(m, photons); }
 
 /* The checkpoint's frame (ps_pace_plan.shows) holds its first round of cube
  * faces to the deadline like any others, and draws a share of the budget. */

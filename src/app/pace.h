@@ -96,6 +96,8 @@ void ps_pace_learn(ps_pace_model *m, double seconds, double photons, double phot
 /* A refresh's predicted time when it draws `photons` emitted, its unheld
  * faces included (a checkpoint's frame holds them: it is planned without). */
 double ps_pace_seconds(const ps_pace_model *m, double photons);
+/* The same without any cube faces. */
+double ps_pace_held_seconds(const ps_pace_model *m, double photons);
 
 typedef struct ps_pace_plan {
     double start;           /* when to start the next refresh (>= now) */

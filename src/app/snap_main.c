@@ -522,6 +522,61 @@ static ps_status last_picture(snap_run *s, ps_status st, ps_error *err)
     return st;
 }
 
+/* --time in 8 bits: the seconds the last picture (last_picture) would take
+ * were the tracer stopped with `photons` emitted: a redraw of them all, every
+ * cube face, and the area lights' virtual lights still to come (their shadow
+ * cubes and lit passes, as the last refresh with new lights took for fewer). */
+static double last_picture_seconds(snap_run *s, double photons)
+{
+    double t = ps_pace_held_seconds(&s->pace, photons) + ps_gl_specular_all_seconds(s->spec);
+    double lights = ps_session_lights_to_come(s->session);
+    return lights > 1.0 ? t + lights * s->lit_seconds : t;
+}
+
+static double photons_emitted(ps_session *session)
+{
+    ps_session_counts counts;
+    ps_session_get_counts(session, &counts);
+    return (double)(counts.map[0].emitted + counts.map[1].emitted);
+}
+
+/* --time in 8 bits, before a refresh planned to start at `start` drawing at
+ * most `most` photons emitted (`start` and `end` on ps_now_seconds' clock):
+ * whether the tracer stops here for the last picture, so that the run ends
+ * by --time rather than long after it. The last picture redraws every
+ * photon, and the tracer went on to --time: the default box at 256^2,
+ * bench's caps and --time 2 ended at 4.6-7.0 s, redrawing 1.4-2.4*10^6
+ * photons (stopping here: 2.0-2.4 s, 0.6-0.7*10^6). It stops when one more
+ * refresh would leave the last picture ending after --time, then traces on
+ * while it still would not (the ring's refreshes of 0.5-0.8 s otherwise
+ * left its --time 2 ending at 1.6 s). Only once every checkpoint is shown:
+ * the last one is most often --time itself (bench's), which keeps its frame,
+ * a prefix planned to land on it (stopping for the last picture, every photon
+ * redrawn with every virtual light's shadows in every cube face, took the
+ * area box 3.6 s, foreseen as less, and showed its 5 s checkpoint at
+ * 6.8-7.0 s). Not in float, whose tracer has a core of its own and whose
+ * last picture draws at most backlog_refreshes' photons besides the cube
+ * faces: stopping it so cost 10-50 % of the photons (the default box at
+ * --time 2: 0.61-0.62*10^6 against 0.67-0.95*10^6; the ring 0.8-0.9*10^6
+ * against 1.2-1.6*10^6, ending at 1.7 s) to end 0.4-0.7 s sooner. */
+static bool time_to_stop(snap_run *s, double start, double most, double end, int cp)
+{
+    if (s->layers || cp < s->o->checkpoint_count || s->frames == 0 || s->pace.seconds <= 0.0)
+        return false;
+    double now = ps_now_seconds(), begin = fmax(now, start), photons = photons_emitted(s->session);
+    double refresh = ps_pace_held_seconds(&s->pace, fmin(most, photons + s->pace.rate * (begin - now)));
+    double after = photons + s->pace.rate * (begin + refresh - now); /* the tracer goes on meanwhile */
+    if (begin + refresh + last_picture_seconds(s, after) < end)
+        return false;
+    while (!ps_cancelled(s->o->cancel)) {
+        double step = fmin(s->o->p.tau, 0.5 * (end - ps_now_seconds()));
+        if (ps_now_seconds() + step + last_picture_seconds(s, photons_emitted(s->session) + s->pace.rate * step) >= end)
+            break;
+        sleep_until(ps_now_seconds() + step);
+    }
+    return true;
+}
+
 /* The photons' arrival rate for the pace: counted at each plan. */
 typedef struct pace_rate {
     double at, photons;
@@ -651,6 +706,8 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
                 break;
             plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
         }
+        if (time_to_stop(s, clock + plan.start, plan.photons, end, cp))
+            break;
         ps_gl_specular_set_deadline(s->spec, isfinite(plan.faces_deadline) ? clock + plan.faces_deadline : 0.0);
         if (s->layers) {
             ps_gl_specular_hold_first_round(s->spec, plan.hold_faces);

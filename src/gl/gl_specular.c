@@ -330,6 +330,15 @@ double ps_gl_specular_unheld_seconds(const ps_gl_specular *g, ps_session *s)
     return t;
 }
 
+double ps_gl_specular_all_seconds(const ps_gl_specular *g)
+{
+    int total = 6 * g->cube_count;
+    double t = 0.0;
+    for (int i = 0; !g->frozen && i < total; i++)
+        t += g->face_time[i] > 0.0 ? g->face_time[i] : g->face_seconds > 0.0 ? g->face_seconds : g->face_max;
+    return t;
+}
+
 ps_status ps_gl_specular_idle(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
                               double deadline, double guess, ps_error *err)
 {

@@ -41,6 +41,7 @@ struct ps_feed {
     bool stop, paused, ended;         /* under lock */
     bool store_limited;               /* under lock: ended at max_stored */
     size_t max_stored;                /* 0: no limit */
+    size_t ahead[PS_MAP_COUNT];       /* under lock: ps_feed_set_ahead's bounds */
     bool started;
     /* Set before the background thread starts: it leaves a repair's merge to
      * ps_feed_merge (the drawing side's moment), see feed_main. */
@@ -114,6 +115,7 @@ ps_status ps_feed_create(ps_tracer *t, const uint64_t caps[PS_MAP_COUNT], const 
         f->cap[k] = caps[k];
         f->active[k] = active[k] && caps[k] > 0;
         ps_photon_map_init(&f->maps[k], (ps_map_kind)k);
+        f->ahead[k] = SIZE_MAX;
     }
     pthread_mutex_init(&f->lock, NULL);
     pthread_cond_init(&f->wake, NULL);
@@ -303,6 +305,18 @@ static bool round_once(ps_feed *f, ps_status *st, ps_error *err)
     return more && *st == PS_OK && !f->store_limited;
 }
 
+/* Under the lock: a map at its ps_feed_set_ahead bound (only the background
+ * thread waits for one: ps_feed_run's caller draws nothing meanwhile). */
+static bool too_far_ahead(const ps_feed *f)
+{
+    if (!f->threaded)
+        return false;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        if (f->maps[k].count >= f->ahead[k])
+            return true;
+    return false;
+}
+
 static void *feed_main(void *arg)
 {
     ps_feed *f = arg;
@@ -312,7 +326,7 @@ static void *feed_main(void *arg)
     bool more = st == PS_OK && !f->ended;
     while (more) {
         pthread_mutex_lock(&f->lock);
-        while (f->paused && !f->stop) {
+        while ((f->paused || too_far_ahead(f)) && !f->stop) {
             f->waiting = true;
             pthread_cond_broadcast(&f->idle);
             pthread_cond_wait(&f->wake, &f->lock);
@@ -436,6 +450,15 @@ void ps_feed_pause(ps_feed *f, bool paused)
 {
     pthread_mutex_lock(&f->lock);
     f->paused = paused;
+    pthread_cond_broadcast(&f->wake);
+    pthread_mutex_unlock(&f->lock);
+}
+
+void ps_feed_set_ahead(ps_feed *f, const size_t most[PS_MAP_COUNT])
+{
+    pthread_mutex_lock(&f->lock);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        f->ahead[k] = most[k];
     pthread_cond_broadcast(&f->wake);
     pthread_mutex_unlock(&f->lock);
 }

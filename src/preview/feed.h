@@ -58,6 +58,13 @@ void ps_feed_stop(ps_feed *f);
 void ps_feed_stop_unmerged(ps_feed *f);
 /* Holds the thread between batches (true) or lets it go on. */
 void ps_feed_pause(ps_feed *f, bool paused);
+/* Holds the thread between batches while some map k holds at least most[k]
+ * photons (SIZE_MAX each, the default: no bound), so that it never runs far
+ * ahead of a picture that draws what it traces (ps_session_settings'
+ * backlog_refreshes). Checked before each round, however long the drawing
+ * side takes to call again: a flag set at each refresh let the mirror box's
+ * tracer run 2x10^5 photons past it while one long refresh was drawn. */
+void ps_feed_set_ahead(ps_feed *f, const size_t most[PS_MAP_COUNT]);
 /* Holds the thread and waits until it is between batches (or done), so that
  * the scene it traces may change (an edit, before ps_feed_stop). */
 void ps_feed_hold_idle(ps_feed *f);

@@ -295,6 +295,9 @@ void ps_session_hold_lights(ps_session *s, bool held);
 /* Twice the virtual lights a side from the next refresh on; false when all
  * are there (or the scene has no area light). */
 bool ps_session_refine_lights(ps_session *s);
+/* Progressive area lights: the virtual lights ps_session_full_lights would
+ * draw, as a multiple of those drawn now (1: all there, or none). */
+double ps_session_lights_to_come(const ps_session *s);
 /* After the refresh's splats were drawn, in draw_seconds (finished, not only
  * queued): the budget for the next, a held feed let go, and the error
  * counter's verdict (which pauses tracing). */
