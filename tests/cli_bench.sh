@@ -78,9 +78,11 @@ awk -F, 'NR > 1 && $3 > 1.5 * $2 { print "checkpoint " $2 " s at " $3 " s"; bad 
 # drawing the rest). The feed holds that bound between refreshes too: looked
 # at only as a refresh drew, the tracer ran 2*10^5 photons past it in one
 # long refresh, and this run ended at 2.5-3.0 s here and 4.3 s in a CI run;
-# now 2.5 s, 2.6-2.8 s under the sanitizers.
+# now 2.5 s, 2.6-2.8 s under the sanitizers, 2.6-3.1 s beside two busy
+# loops (what is left after --time, at most four refreshes' photons and the
+# cube faces' last round, grows with a slower machine, not with the run).
 took=$(sed -n 's/^ *"seconds": \([0-9.]*\),*$/\1/p' "$cli_tmp/ct.json")
-awk_true "${took:-99} < 3.5" && ok || bad "snap --time 2 in float ended at ${took:-?} s"
+awk_true "${took:-99} < 4" && ok || bad "snap --time 2 in float ended at ${took:-?} s"
 # ... and in 8 bits, whose frames redraw every photon shown: the frame a
 # checkpoint shows draws the prefix that fits (app/pace.h; before, a redraw
 # of the 1.8-3*10^6 photons there by then made the 2 s one land at 3.3-3.4 s in
@@ -90,17 +92,23 @@ expect_success "8-bit checkpoints on time" "$snap" "$mirror" --size 64x64 --time
 awk -F, 'NR > 1 && ($3 > 1.5 * $2 || $3 < $2 || $4 < n) { print "checkpoint " $2 " s at " $3 " s, " $4 " photons"; bad = 1 }
          NR > 1 { n = $4 } END { exit bad }' "$cli_tmp/c8.csv" && ok || bad "8-bit checkpoints late: $(cat "$cli_tmp/c8.csv")"
 
-# An 8-bit run without checkpoints ends at --time: its last picture redraws
-# every photon, so the tracer stops when it would otherwise end later
-# (snap_main.c, time_to_stop). The default box at 128^2 with a cap of 2*10^7
-# ended at 6.3-7.2 s, redrawing 2.3-3.3*10^6 photons; now 1.2-1.5 s (the
+# An 8-bit run without checkpoints ends near --time: its last picture
+# redraws every photon, so the tracer stops when that picture would
+# otherwise end later (snap_main.c, time_to_stop). The default box at 128^2
+# with a cap of 2*10^7 traced for 2.9 s and ended at 6.1-7.2 s, redrawing
+# 2.3-3.3*10^6 photons; now it traces for 0.45 s and ends at 1.3-1.4 s (the
 # first frame's llvmpipe compiles make a redraw seem dearer than it is),
-# 2.4-2.5 s under the sanitizers; and not long before it (the first frame
-# alone is 0.3 s).
-expect_success "8-bit --time ends on time" "$snap" data/scenes/cornell-caustic.scn --size 128x128 --time 2 \
-    --caustic-photons 20000000 --color-depth 8 --stats "$cli_tmp/e8.json" -o "$cli_tmp/e8.png"
+# 1.9-3.0 s beside two busy loops; under the sanitizers 0.9 s and 2.3-2.6 s,
+# and beside two busy loops 1.6 s and 4.2-4.6 s (loaded, the first frame
+# alone took 0.7-0.9 s, every core tracing meanwhile, and the tracer stopped
+# right after it: the redraw of what it traced is the rest). So the test is
+# what the tracer did: stopped well before --time (the build before: 3.2 s).
+expect_success "8-bit --time stops tracing for the last picture" "$snap" data/scenes/cornell-caustic.scn \
+    --size 128x128 --time 2 --caustic-photons 20000000 --color-depth 8 --stats "$cli_tmp/e8.json" -o "$cli_tmp/e8.png"
+traced=$(sed -n 's/^ *"trace_seconds": \([0-9.]*\),*$/\1/p' "$cli_tmp/e8.json")
 took=$(sed -n 's/^ *"seconds": \([0-9.]*\),*$/\1/p' "$cli_tmp/e8.json")
-awk_true "${took:-99} < 3.5 && ${took:-0} > 0.8" && ok || bad "snap --time 2 in 8 bits ended at ${took:-?} s"
+awk_true "${traced:-99} < 1.9 && ${took:-0} > 0.8" && ok ||
+    bad "snap --time 2 in 8 bits traced for ${traced:-?} s and ended at ${took:-?} s"
 
 # ... and when every cap is reached in the first round: in float the
 # checkpoints still to come get their own frames, at or after their time

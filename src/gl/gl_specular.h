@@ -98,9 +98,9 @@ double ps_gl_specular_unheld_seconds(const ps_gl_specular *g, ps_session *s);
 
 /* The seconds every face of every cube takes (a snapshot's last picture,
  * `faces` 0), each at its own last time, else as the last refresh's faces
- * took (not the dearest seen: one face's first full render, 0.2 s where
- * the others took 0.03, made the mirror box's --time 2 end at 1.7 s); 0
- * without cubes or before any face was timed (not known). */
+ * took (not the dearest seen: the mirror box's one face's first full render
+ * took 0.2 s where the others took 0.03); 0 without cubes or before any
+ * face was timed (not known). */
 double ps_gl_specular_all_seconds(const ps_gl_specular *g);
 
 /* While the program waits anyway (photosplat-snap before the frame a
