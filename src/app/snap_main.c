@@ -586,10 +586,7 @@ typedef struct pace_rate {
  * tau's schedule, checkpoints cp on not yet shown (pace.h). */
 static ps_pace_plan plan_refresh(snap_run *s, double clock, double due, int cp, pace_rate *rate)
 {
-    double now = ps_now_seconds() - clock;
-    ps_session_counts counts;
-    ps_session_get_counts(s->session, &counts);
-    double photons = (double)(counts.map[0].emitted + counts.map[1].emitted);
+    double now = ps_now_seconds() - clock, photons = photons_emitted(s->session);
     if (now > rate->at && photons >= rate->photons)
         s->pace.rate = (photons - rate->photons) / (now - rate->at);
     rate->at = now, rate->photons = photons;

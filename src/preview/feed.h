@@ -58,7 +58,7 @@ void ps_feed_stop(ps_feed *f);
 void ps_feed_stop_unmerged(ps_feed *f);
 /* Holds the thread between batches (true) or lets it go on. */
 void ps_feed_pause(ps_feed *f, bool paused);
-/* Holds the thread between batches while some map k holds at least most[k]
+/* Holds the thread between batches while some map k stores at least most[k]
  * photons (SIZE_MAX each, the default: no bound), so that it never runs far
  * ahead of a picture that draws what it traces (ps_session_settings'
  * backlog_refreshes). Checked before each round, however long the drawing
