@@ -851,7 +851,7 @@ double ps_session_lights_to_come(const ps_session *s)
 
 bool ps_session_refine_lights(ps_session *s)
 {
-    if (s->area_side >= PS_PREVIEW_AREA_SIDE || !has_area_lights(s))
+    if (ps_session_lights_to_come(s) <= 1.0)
         return false;
     s->area_side *= 2;
     s->lights_pending = true;
