@@ -561,20 +561,27 @@ static double photons_emitted(ps_session *session)
  * against 1.2-1.6*10^6, ending at 1.7 s) to end 0.4-0.7 s sooner. */
 static bool time_to_stop(snap_run *s, double start, double most, double end, int cp)
 {
-    if (s->layers || cp < s->o->checkpoint_count || s->frames == 0 || s->pace.seconds <= 0.0)
+    /* Not from the first frame alone: its llvmpipe compiles made a photon
+     * seem to cost several times what the next frame's did, and a --time 10
+     * at 64^2 stopped tracing at 1.1 s and ended at 3.4 s. */
+    if (s->layers || cp < s->o->checkpoint_count || s->pace.learned < 2 || s->pace.seconds <= 0.0)
         return false;
+    const ps_session_settings *set = ps_session_get_settings(s->session);
+    double cap = (double)set->caps[0] + (double)set->caps[1]; /* the tracer ends there */
     double now = ps_now_seconds(), begin = fmax(now, start), photons = photons_emitted(s->session);
-    double refresh = ps_pace_held_seconds(&s->pace, fmin(most, photons + s->pace.rate * (begin - now)));
-    double after = photons + s->pace.rate * (begin + refresh - now); /* the tracer goes on meanwhile */
+    double refresh = ps_pace_held_seconds(&s->pace, fmin(most, fmin(cap, photons + s->pace.rate * (begin - now))));
+    double after = fmin(cap, photons + s->pace.rate * (begin + refresh - now)); /* the tracer goes on meanwhile */
     if (begin + refresh + last_picture_seconds(s, after) < end)
         return false;
-    while (!ps_cancelled(s->o->cancel)) {
+    for (;;) {
+        if (ps_cancelled(s->o->cancel))
+            return false; /* the loop says so, as for any interrupt */
         double step = fmin(s->o->p.tau, 0.5 * (end - ps_now_seconds()));
-        if (ps_now_seconds() + step + last_picture_seconds(s, photons_emitted(s->session) + s->pace.rate * step) >= end)
-            break;
+        double then = fmin(cap, photons_emitted(s->session) + s->pace.rate * step);
+        if (ps_now_seconds() + step + last_picture_seconds(s, then) >= end)
+            return true;
         sleep_until(ps_now_seconds() + step);
     }
-    return true;
 }
 
 /* The photons' arrival rate for the pace: counted at each plan. */
@@ -705,6 +712,8 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         }
         if (time_to_stop(s, clock + plan.start, plan.photons, end, cp))
             break;
+        if (ps_cancelled(o->cancel))
+            continue; /* interrupted while it waited: said at the loop's top */
         ps_gl_specular_set_deadline(s->spec, isfinite(plan.faces_deadline) ? clock + plan.faces_deadline : 0.0);
         if (s->layers) {
             ps_gl_specular_hold_first_round(s->spec, plan.hold_faces);
