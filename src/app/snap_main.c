@@ -561,10 +561,11 @@ static double photons_emitted(ps_session *session)
  * against 1.2-1.6*10^6, ending at 1.7 s) to end 0.4-0.7 s sooner. */
 static bool time_to_stop(snap_run *s, double start, double most, double end, int cp)
 {
-    /* Not from the first frame alone: its llvmpipe compiles made a photon
-     * seem to cost several times what the next frame's did, and a --time 10
-     * at 64^2 stopped tracing at 1.1 s and ended at 3.4 s. */
-    if (s->layers || cp < s->o->checkpoint_count || s->pace.learned < 2 || s->pace.seconds <= 0.0)
+    /* From the first frame on (waiting for a second made the default box's
+     * 128^2 --time 2 trace 1.9-3.0 s and end at 4.2-5.0 s), though its
+     * llvmpipe compiles make a photon seem dearer than it is: long runs
+     * stop early (issue 20's note). */
+    if (s->layers || cp < s->o->checkpoint_count || s->frames == 0 || s->pace.seconds <= 0.0)
         return false;
     const ps_session_settings *set = ps_session_get_settings(s->session);
     double cap = (double)set->caps[0] + (double)set->caps[1]; /* the tracer ends there */
