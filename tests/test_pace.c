@@ -151,6 +151,23 @@ static void learning(void **state)
     assert_true(fabs(ps_pace_seconds(&b, 4321280) / 4.867 - 1.0) < 0.1);
 }
 
+/* snap's 8-bit last picture, foreseen from a whole refresh: its scene part
+ * and the photons' part scaled linearly, no growth (pace.h: a photon costs
+ * less in larger redraws, measured 1.2-1.4 us at 0.3-0.5*10^6 and 0.9-1.1
+ * at 2-7*10^6; with the growth law, the tracer stopped half way). */
+static void redraw_is_linear(void **state)
+{
+    (void)state;
+    ps_pace_model m = {0};
+    ps_pace_learn(&m, 0.7, 5e5, 0.6, true);
+    assert_near(ps_pace_redraw_seconds(&m, 5e6), 0.1 + 6.0, 1e-9);
+    assert_near(ps_pace_redraw_seconds(&m, 5e4), 0.1 + 0.06, 1e-9);
+    assert_near(ps_pace_redraw_seconds(&m, 0.0), 0.1, 1e-12);
+    assert_true(ps_pace_redraw_seconds(&m, 5e6) < ps_pace_seconds(&m, 5e6) - 2.0); /* the growth law's 9.6 s */
+    m.unheld = 1.0; /* no cube faces in it: the last picture counts them itself */
+    assert_near(ps_pace_redraw_seconds(&m, 5e6), 6.1, 1e-9);
+}
+
 /* A whole refresh's photons' part on the simulated machine: a photon 10^-6 s
  * up to 10^5 of them, dearer a photon beyond as the default box measured
  * (0.76 us a photon at 7.6*10^5, 1.13 at 4.3*10^6: n^1.2 here too). */
@@ -310,6 +327,7 @@ int main(void)
         cmocka_unit_test(a_refresh_in_the_way_waits),
         cmocka_unit_test(out_of_reach_and_defaults),
         cmocka_unit_test(learning),
+        cmocka_unit_test(redraw_is_linear),
         cmocka_unit_test(capped_frames_land_within_20_percent),
         cmocka_unit_test(float_checkpoint_frames_draw_a_share),
         cmocka_unit_test(unheld_faces_stay_out_of_the_checkpoints_frame),

@@ -21,7 +21,10 @@ static double held_seconds(const ps_pace_model *m, double photons)
 }
 
 double ps_pace_seconds(const ps_pace_model *m, double photons) { return held_seconds(m, photons) + m->unheld; }
-double ps_pace_held_seconds(const ps_pace_model *m, double photons) { return held_seconds(m, photons); }
+double ps_pace_redraw_seconds(const ps_pace_model *m, double photons)
+{
+    return scene_part(m) + m->per_photon * fmax(0.0, photons);
+}
 
 /* The checkpoint's frame (ps_pace_plan.shows) holds its first round of cube
  * faces to the deadline like any others, and draws a share of the budget. */

@@ -96,8 +96,18 @@ void ps_pace_learn(ps_pace_model *m, double seconds, double photons, double phot
 /* A refresh's predicted time when it draws `photons` emitted, its unheld
  * faces included (a checkpoint's frame holds them: it is planned without). */
 double ps_pace_seconds(const ps_pace_model *m, double photons);
-/* The same without any cube faces. */
-double ps_pace_held_seconds(const ps_pace_model *m, double photons);
+/* A whole redraw of `photons` emitted with the tracer stopped, no cube
+ * faces (snap's last picture in 8 bits): linear in the photons, without
+ * PS_PACE_GROWTH. Measured on the default box and the ring at 64^2, the
+ * cost of a photon falls as their number grows: 1.5-2.6 us at 2-7*10^4
+ * (the first frame), 1.2-1.4 at 0.3-0.5*10^6 (the tracer held; 1.7-2.1 at
+ * 0.2*10^6), 0.9-1.1 at 2-7*10^6; the ring 0.55 at 0.6*10^6, 0.44-0.47 at
+ * 8-13*10^6. So this foresees a redraw from a model learned at 0.3-0.6*10^6
+ * 1.2-1.4x long, and the run ends early by about that, where the growth law
+ * (checkpoints' pacing) foresaw 2x; a power of the photons fitted through
+ * the first frame and such a model foresaw 1.3-2x short, and a line through
+ * two refreshes of n/4 and n photons no better than n's alone. */
+double ps_pace_redraw_seconds(const ps_pace_model *m, double photons);
 
 typedef struct ps_pace_plan {
     double start;           /* when to start the next refresh (>= now) */

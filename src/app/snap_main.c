@@ -94,6 +94,20 @@ static const char usage[] =
  * 8 bits redraw whatever is there). */
 #define SNAP_BACKLOG_REFRESHES 4.0
 
+/* --time in 8 bits: of the time left once every checkpoint is shown, the
+ * most the redraw that teaches the last picture's cost (probe_redraw) is
+ * foreseen to take, from a first frame that foresees it 2-3x long (5 us a
+ * photon under the sanitizers against 1.9). */
+#define SNAP_PROBE_SHARE 0.25
+/* ... and the fewest photons it draws to be worth it: a photon costs 1.5-
+ * 2.6 us in the first frame's 2-7*10^4, 1.7-2.1 in 0.2*10^6, 1.2-1.4 in
+ * 0.3-0.5*10^6, 0.9-1.1 in the last picture's 2-7*10^6 (pace.h). Smaller,
+ * it would foresee no better than the first frame. */
+#define SNAP_PROBE_MIN 3e5
+/* ... and the most: a photon costs little less in larger ones, which hold
+ * the tracer and an interrupt longer (at --time 60, 3*10^6 photons, 3 s). */
+#define SNAP_PROBE_MOST 1e6
+
 /* Enough checkpoints for a log-spaced curve from milliseconds to hours. */
 #define SNAP_MAX_CHECKPOINTS 64
 
@@ -198,6 +212,7 @@ typedef struct snap_run {
     double shadow_per_light;    /* ... and a virtual light's shadow cube, seconds (0: not timed) */
     bool lights_held;           /* area lights refined in the waits (ps_session_hold_lights) */
     double lit_seconds;         /* the last refresh with new lights, less its cube faces (0: none yet) */
+    bool probed;                /* --time, 8 bits: the last picture's cost learned (probe_redraw) */
 } snap_run;
 
 /* One refresh: what the session says, drawn into the layers (the new
@@ -259,8 +274,6 @@ static ps_status refresh(snap_run *s, ps_error *err)
     shadows += gst.shadow_seconds_last;
     if (shadows > 0.0 && gst.virtual_lights > 0)
         s->shadow_per_light = shadows / gst.virtual_lights;
-    if (s->frame.lights_changed || s->frames == 0)
-        s->lit_seconds = t1 - t_refresh - faces_seconds;
     ps_latency_add(&s->lat, PS_LAT_SHADOWS, gst.shadow_seconds_last);
     ps_latency_add_faces(&s->lat, gst.shadow_faces_last);
     ps_latency_add(&s->lat, PS_LAT_DRAW, t1 - t_draw - gst.shadow_seconds_last);
@@ -281,6 +294,13 @@ static ps_status refresh(snap_run *s, ps_error *err)
     ps_session_counts after;
     ps_session_get_counts(s->session, &after);
     double build_seconds = after.splat_seconds - before.splat_seconds;
+    /* 8 bits: less the photons' part too, which a whole refresh has whatever
+     * its lights (the redraw that teaches the --time stop, probe_redraw, of
+     * 10^6 photons, came with new lights, and the area box's last picture
+     * was foreseen with those photons four times over: 64^2, --time 10,
+     * ended at 5.5 s). */
+    if (s->frame.lights_changed || s->frames == 1)
+        s->lit_seconds = t1 - t_refresh - faces_seconds - (s->layers ? 0.0 : build_seconds + splat_seconds);
     if (!s->layers || s->pace.seconds <= 0.0 || !(s->frame.new_view || s->frame.lights_changed))
     {
         /* Incremental: the next draws up to its budget's share of tau of
@@ -528,7 +548,7 @@ static ps_status last_picture(snap_run *s, ps_status st, ps_error *err)
  * cubes and lit passes, as the last refresh with new lights took for fewer). */
 static double last_picture_seconds(snap_run *s, double photons)
 {
-    double t = ps_pace_held_seconds(&s->pace, photons) + ps_gl_specular_all_seconds(s->spec);
+    double t = ps_pace_redraw_seconds(&s->pace, photons) + ps_gl_specular_all_seconds(s->spec);
     double lights = ps_session_lights_to_come(s->session);
     return lights > 1.0 ? t + lights * s->lit_seconds : t;
 }
@@ -540,48 +560,109 @@ static double photons_emitted(ps_session *session)
     return (double)(counts.map[0].emitted + counts.map[1].emitted);
 }
 
+/* --time in 8 bits, every checkpoint shown: a whole refresh, not shown,
+ * drawing a prefix of the photons that the pace's model says takes
+ * SNAP_PROBE_SHARE of the time left, so that time_to_stop foresees the last
+ * picture from more than the first frame. That one draws 1.6-6.6*10^4
+ * photons, llvmpipe's first compiles in it: 1.2-2.8 us a photon, against
+ * 0.4-1.3 us for the last picture's 0.5-7*10^6; foreseen from it, the
+ * tracer stopped right after the first frame whatever --time (the default
+ * box's --time 10 at 64^2 ended at 2.7 s). Made once the photons are there
+ * (s->probed then, or once it would not be worth it); the tracer is held
+ * meanwhile, as the last picture has every core (sharing them, a probe of
+ * 0.38*10^6 photons cost 1.6 us a photon, the last picture 0.95). */
+static ps_status probe_redraw(snap_run *s, double end, ps_error *err)
+{
+    ps_session_counts counts;
+    ps_session_get_counts(s->session, &counts);
+    double there = (double)(counts.map[0].emitted + counts.map[1].emitted), left = end - ps_now_seconds();
+    double scene = ps_pace_redraw_seconds(&s->pace, 0.0); /* it redraws the scene too */
+    double n = s->pace.per_photon > 0.0 ? fmin((SNAP_PROBE_SHARE * left - scene) / s->pace.per_photon, SNAP_PROBE_MOST)
+                                        : 0.0;
+    if (n < SNAP_PROBE_MIN || n < 2.0 * s->pace.photons) { /* it would teach little more than the model's refresh */
+        s->probed = true;
+        return PS_OK;
+    }
+    if (there < n && !counts.ended)
+        return PS_OK; /* not yet */
+    s->probed = true;
+    double most[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        most[k] = there > n ? n * (double)counts.map[k].emitted / there : HUGE_VAL;
+    ps_session_set_whole_most(s->session, most);
+    ps_session_hold(s->session, true);
+    ps_session_hold_lights(s->session, true); /* drawn, it asks for no more: lights_to_come stays true */
+    ps_status st = refresh(s, err);
+    ps_session_hold_lights(s->session, s->lights_held);
+    ps_session_hold(s->session, false);
+    ps_session_set_whole_most(s->session, NULL);
+    return st;
+}
+
 /* --time in 8 bits, before a refresh planned to start at `start` drawing at
  * most `most` photons emitted (`start` and `end` on ps_now_seconds' clock):
- * whether the tracer stops here for the last picture, so that the run ends
- * by --time rather than long after it. The last picture redraws every
+ * *stop, whether the tracer stops here for the last picture, so that the
+ * run ends by --time rather than long after it (false also when interrupted
+ * meanwhile); the redraw that teaches its cost (probe_redraw) on the way. The last picture redraws every
  * photon, and the tracer went on to --time: the default box at 256^2,
  * bench's caps and --time 2 ended at 4.6-7.0 s, redrawing 1.4-2.4*10^6
- * photons (stopping here: 2.0-2.4 s, 0.6-0.7*10^6). It stops when one more
- * refresh would leave the last picture ending after --time, then traces on
- * while it still would not (the ring's refreshes of 0.5-0.8 s otherwise
- * left its --time 2 ending at 1.6 s). Only once every checkpoint is shown:
- * the last one is most often --time itself (bench's), which keeps its frame,
- * a prefix planned to land on it (stopping for the last picture, every photon
- * redrawn with every virtual light's shadows in every cube face, took the
- * area box 3.6 s, foreseen as less, and showed its 5 s checkpoint at
- * 6.8-7.0 s). Not in float, whose tracer has a core of its own and whose
- * last picture draws at most backlog_refreshes' photons besides the cube
- * faces: stopping it so cost 10-50 % of the photons (the default box at
- * --time 2: 0.61-0.62*10^6 against 0.67-0.95*10^6; the ring 0.8-0.9*10^6
- * against 1.2-1.6*10^6, ending at 1.7 s) to end 0.4-0.7 s sooner. */
-static bool time_to_stop(snap_run *s, double start, double most, double end, int cp)
+ * photons. Only once every checkpoint is shown: the last one is most often
+ * --time itself (bench's), which keeps its frame, a prefix planned to land
+ * on it (stopping for the last picture, every photon redrawn with every
+ * virtual light's shadows in every cube face, took the area box 3.6 s,
+ * foreseen as less, and showed its 5 s checkpoint at 6.8-7.0 s). Then no
+ * more refreshes, which would only be drawn and thrown away (snap is
+ * headless) while the tracer shares the cores with them (each redraws
+ * everything, as long as the run so far): the tracer traces alone until
+ * one more step would leave the last picture ending after --time, or it
+ * ends. With the error counter (--precision counter), whose verdict comes
+ * from refreshes, they go on while one more still leaves the last picture
+ * on time. Not in float, whose tracer has a core of its own and whose last
+ * picture draws at most backlog_refreshes' photons besides the cube faces:
+ * stopping it so cost 10-50 % of the photons (the default box at --time 2:
+ * 0.61-0.62*10^6 against 0.67-0.95*10^6; the ring 0.8-0.9*10^6 against
+ * 1.2-1.6*10^6, ending at 1.7 s) to end 0.4-0.7 s sooner. */
+static ps_status time_to_stop(snap_run *s, double start, double most, double end, int cp, bool *stop, ps_error *err)
 {
-    /* From the first frame on (waiting for a second made the default box's
-     * 128^2 --time 2 trace 1.9-3.0 s and end at 4.2-5.0 s), though its
-     * llvmpipe compiles make a photon seem dearer than it is: long runs
-     * stop early (issue 20's note). */
+    *stop = false;
     if (s->layers || cp < s->o->checkpoint_count || s->frames == 0 || s->pace.seconds <= 0.0)
-        return false;
+        return PS_OK;
     const ps_session_settings *set = ps_session_get_settings(s->session);
     double cap = (double)set->caps[0] + (double)set->caps[1]; /* the tracer ends there */
-    double now = ps_now_seconds(), begin = fmax(now, start), photons = photons_emitted(s->session);
-    double refresh = ps_pace_held_seconds(&s->pace, fmin(most, fmin(cap, photons + s->pace.rate * (begin - now))));
-    double after = fmin(cap, photons + s->pace.rate * (begin + refresh - now)); /* the tracer goes on meanwhile */
-    if (begin + refresh + last_picture_seconds(s, after) < end)
-        return false;
+    double now = ps_now_seconds(), photons = photons_emitted(s->session), rate = s->pace.rate;
+    if (set->precision == PS_PRECISION_COUNTER) {
+        double begin = fmax(now, start);
+        double refresh = ps_pace_redraw_seconds(&s->pace, fmin(most, fmin(cap, photons + rate * (begin - now))));
+        double after = fmin(cap, photons + rate * (begin + refresh - now)); /* the tracer goes on meanwhile */
+        if (begin + refresh + last_picture_seconds(s, after) < end)
+            return PS_OK;
+    }
     for (;;) {
         if (ps_cancelled(s->o->cancel))
-            return false; /* the loop says so, as for any interrupt */
-        double step = fmin(s->o->p.tau, 0.5 * (end - ps_now_seconds()));
-        double then = fmin(cap, photons_emitted(s->session) + s->pace.rate * step);
-        if (ps_now_seconds() + step + last_picture_seconds(s, then) >= end)
-            return true;
-        sleep_until(ps_now_seconds() + step);
+            return PS_OK; /* the loop says so, as for any interrupt */
+        ps_session_counts counts;
+        ps_session_get_counts(s->session, &counts);
+        if (counts.ended || ps_session_counter_stopped(s->session, NULL)) {
+            *stop = true;
+            return PS_OK;
+        }
+        if (!s->probed) {
+            ps_status st = probe_redraw(s, end, err);
+            if (st != PS_OK)
+                return st;
+            now = ps_now_seconds(), photons = photons_emitted(s->session);
+        }
+        double step = fmin(s->o->p.tau, 0.5 * (end - now));
+        if (now + step + last_picture_seconds(s, fmin(cap, photons + rate * step)) >= end) {
+            *stop = true;
+            return PS_OK;
+        }
+        sleep_until(now + step);
+        /* Alone, the tracer goes faster than while refreshes shared the cores. */
+        double t = ps_now_seconds(), p = photons_emitted(s->session);
+        if (t > now && p >= photons)
+            rate = (p - photons) / (t - now);
+        now = t, photons = p;
     }
 }
 
@@ -711,7 +792,9 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
                 break;
             plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
         }
-        if (time_to_stop(s, clock + plan.start, plan.photons, end, cp))
+        bool stop;
+        st = time_to_stop(s, clock + plan.start, plan.photons, end, cp, &stop, err);
+        if (st != PS_OK || stop)
             break;
         if (ps_cancelled(o->cancel))
             continue; /* interrupted while it waited: said at the loop's top */
