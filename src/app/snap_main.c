@@ -583,12 +583,12 @@ static ps_status probe_redraw(snap_run *s, double end, ps_error *err)
         s->probed = true;
         return PS_OK;
     }
-    if (there < n && !counts.ended)
-        return PS_OK; /* not yet */
+    if (there < n)
+        return PS_OK; /* not yet (time_to_stop stops at once if the tracer ends first) */
     s->probed = true;
     double most[PS_MAP_COUNT];
     for (int k = 0; k < PS_MAP_COUNT; k++)
-        most[k] = there > n ? n * (double)counts.map[k].emitted / there : HUGE_VAL;
+        most[k] = n * (double)counts.map[k].emitted / there;
     ps_session_set_whole_most(s->session, most);
     ps_session_hold(s->session, true);
     ps_session_hold_lights(s->session, true); /* drawn, it asks for no more: lights_to_come stays true */
@@ -603,10 +603,10 @@ static ps_status probe_redraw(snap_run *s, double end, ps_error *err)
  * most `most` photons emitted (`start` and `end` on ps_now_seconds' clock):
  * *stop, whether the tracer stops here for the last picture, so that the
  * run ends by --time rather than long after it (false also when interrupted
- * meanwhile); the redraw that teaches its cost (probe_redraw) on the way. The last picture redraws every
- * photon, and the tracer went on to --time: the default box at 256^2,
- * bench's caps and --time 2 ended at 4.6-7.0 s, redrawing 1.4-2.4*10^6
- * photons. Only once every checkpoint is shown: the last one is most often
+ * meanwhile), the redraw that teaches that picture's cost (probe_redraw) on
+ * the way. The last picture redraws every photon, and the tracer went on to
+ * --time: the default box at 256^2, bench's caps and --time 2 ended at
+ * 4.6-7.0 s, redrawing 1.4-2.4*10^6 photons. Only once every checkpoint is shown: the last one is most often
  * --time itself (bench's), which keeps its frame, a prefix planned to land
  * on it (stopping for the last picture, every photon redrawn with every
  * virtual light's shadows in every cube face, took the area box 3.6 s,
