@@ -154,7 +154,7 @@ static void learning(void **state)
 /* snap's 8-bit last picture, foreseen from a whole refresh: its scene part
  * and the photons' part scaled linearly, no growth (pace.h: a photon costs
  * less in larger redraws, measured 1.2-1.4 us at 0.3-0.5*10^6 and 0.9-1.1
- * at 2-7*10^6; with the growth law, the tracer stopped half way). */
+ * at 2-7*10^6; the growth law foresaw such a redraw 2x long). */
 static void redraw_is_linear(void **state)
 {
     (void)state;
