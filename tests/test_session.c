@@ -8,6 +8,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "core/clock.h"
 #include "photon/tracer.h"
 #include "preview/feed.h"
 #include "preview/session.h"
@@ -433,8 +434,11 @@ static void backlog_holds_the_tracer(void **state)
              * by that round alone ... */
             assert_false(c.ended);
             assert_int_equal(c.map[PS_MAP_CAUSTIC].emitted, f.emitted[PS_MAP_CAUSTIC] + PS_FEED_BATCH);
-            /* ... and going on as the refreshes draw what waits. */
-            for (int i = 0; i < 4000 && !c.ended; i++) {
+            /* ... and going on as the refreshes draw what waits (for up to
+             * 60 s: 4000 refreshes were too few under the sanitizers beside
+             * two busy loops). */
+            double until = ps_now_seconds() + 60.0;
+            while (!c.ended && ps_now_seconds() < until) {
                 refresh(s, &cam, &f);
                 ps_session_drawn(s, (double)f.splats);
                 struct timespec ts = {0, 1000000};
