@@ -606,11 +606,12 @@ static ps_status probe_redraw(snap_run *s, double end, ps_error *err)
  * meanwhile), the redraw that teaches that picture's cost (probe_redraw) on
  * the way. The last picture redraws every photon, and the tracer went on to
  * --time: the default box at 256^2, bench's caps and --time 2 ended at
- * 4.6-7.0 s, redrawing 1.4-2.4*10^6 photons. Only once every checkpoint is shown: the last one is most often
- * --time itself (bench's), which keeps its frame, a prefix planned to land
- * on it (stopping for the last picture, every photon redrawn with every
- * virtual light's shadows in every cube face, took the area box 3.6 s,
- * foreseen as less, and showed its 5 s checkpoint at 6.8-7.0 s). Then no
+ * 4.6-7.0 s, redrawing 1.4-2.4*10^6 photons. Only once every checkpoint is
+ * shown: the last one is most often --time itself (bench's), which keeps
+ * its frame, a prefix planned to land on it (stopping for the last
+ * picture, every photon redrawn with every virtual light's shadows in every
+ * cube face, took the area box 3.6 s, foreseen as less, and showed its 5 s
+ * checkpoint at 6.8-7.0 s). Then no
  * more refreshes, which would only be drawn and thrown away (snap is
  * headless) while the tracer shares the cores with them (each redraws
  * everything, as long as the run so far): the tracer traces alone until
