@@ -232,6 +232,38 @@ static void capped_frames_land_within_20_percent(void **state)
     }
 }
 
+/* 8 bits, the ring at 256^2 as measured: the model learned from one batch
+ * (19 660 photons in 0.023 s), the arrival rate measured at 6*10^5 a second
+ * while frames shared the cores. The 0.5 s checkpoint's frame is planned at
+ * 0.319 s with 39 321 photons there: the photons it foresees fit, so the
+ * plan sets no bound; alone, the tracer went 1.6*10^6 a second and 2.4*10^5
+ * were there at its start. Drawn all (as before), the frame ends after 20 %
+ * even where the model is exact; re-planned at its start
+ * (ps_pace_photons_at_start), it draws the prefix that ends it by the aim. */
+static void a_frame_draws_what_fits_from_its_start(void **state)
+{
+    (void)state;
+    ps_pace_model m = {.rate = 6e5};
+    ps_pace_learn(&m, 0.023, 19660.0, 0.023 - 0.0136, true);
+    const double cp = 0.5, true_rate = 1.6e6, now = 0.319, photons = 39321.0;
+    ps_pace_plan p = ps_pace_next(&m, now, photons, now, &cp, 1);
+    assert_true(p.shows);
+    assert_true(p.start > now && p.start < cp);
+    assert_true(isinf(p.photons)); /* what it foresees fits */
+    double there = photons + true_rate * (p.start - now);
+    assert_true(p.start + ps_pace_seconds(&m, fmin(there, p.photons)) > 1.2 * cp); /* all of them: late */
+    double drawn = fmin(there, ps_pace_photons_at_start(&m, &p, p.start, there, p.start, &cp, 1));
+    assert_true(drawn < there && drawn > 0.4 * there);
+    double end = p.start + ps_pace_seconds(&m, drawn);
+    assert_true(end >= cp && end <= 1.2 * cp);
+    /* Fewer there than foreseen: all of them, as planned. */
+    assert_true(ps_pace_photons_at_start(&m, &p, p.start, photons, p.start, &cp, 1) >= photons);
+    /* Float's frames and those not planned as a checkpoint's keep their plan. */
+    ps_pace_plan other = p;
+    other.shows = false;
+    assert_true(isinf(ps_pace_photons_at_start(&m, &other, p.start, there, p.start, &cp, 1)));
+}
+
 /* Float: an incremental refresh costs 0.03 s and up to a budget's 0.09 s of
  * new splats, which the splat rate's error makes anything from half to
  * twice that. The checkpoint's frame is planned (shows) and drawn with
@@ -329,6 +361,7 @@ int main(void)
         cmocka_unit_test(learning),
         cmocka_unit_test(redraw_is_linear),
         cmocka_unit_test(capped_frames_land_within_20_percent),
+        cmocka_unit_test(a_frame_draws_what_fits_from_its_start),
         cmocka_unit_test(float_checkpoint_frames_draw_a_share),
         cmocka_unit_test(unheld_faces_stay_out_of_the_checkpoints_frame),
     };

@@ -132,3 +132,12 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
     }
     return p;
 }
+
+double ps_pace_photons_at_start(const ps_pace_model *m, const ps_pace_plan *planned, double now, double photons,
+                                double due, const double *pending, int count)
+{
+    if (!planned->shows || m->per_photon <= 0.0)
+        return planned->photons;
+    ps_pace_plan again = ps_pace_next(m, now, photons, due, pending, count);
+    return again.shows ? fmin(planned->photons, again.photons) : planned->photons;
+}

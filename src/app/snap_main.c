@@ -672,14 +672,20 @@ typedef struct pace_rate {
     double at, photons;
 } pace_rate;
 
+/* The pace's arrival rate, from the last count to `photons` at `now`. */
+static void measure_rate(snap_run *s, double now, double photons, pace_rate *rate)
+{
+    if (now > rate->at && photons >= rate->photons)
+        s->pace.rate = (photons - rate->photons) / (now - rate->at);
+    rate->at = now, rate->photons = photons;
+}
+
 /* The next refresh on snap's clock (starting at `clock`), due at `due` by
  * tau's schedule, checkpoints cp on not yet shown (pace.h). */
 static ps_pace_plan plan_refresh(snap_run *s, double clock, double due, int cp, pace_rate *rate)
 {
     double now = ps_now_seconds() - clock, photons = photons_emitted(s->session);
-    if (now > rate->at && photons >= rate->photons)
-        s->pace.rate = (photons - rate->photons) / (now - rate->at);
-    rate->at = now, rate->photons = photons;
+    measure_rate(s, now, photons, rate);
     /* Float: the first round's faces as a refresh between checkpoints
      * draws them (held only where the plan says, refine). */
     if (s->layers)
@@ -805,6 +811,14 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             ps_session_set_budget_share(s->session, plan.shows ? PS_PACE_SHOWN_BUDGET : 1.0);
         }
         sleep_until(clock + plan.start);
+        /* 8 bits: the checkpoint's frame draws what fits from its start,
+         * the photons there then (pace.h). */
+        if (!s->layers && plan.shows) {
+            double now = ps_now_seconds() - clock;
+            measure_rate(s, now, photons_emitted(s->session), &rate);
+            plan.photons = ps_pace_photons_at_start(&s->pace, &plan, now, rate.photons, fmin(next, end) - clock,
+                                                    o->checkpoints + cp, o->checkpoint_count - cp);
+        }
         ps_session_counts counts;
         ps_session_get_counts(s->session, &counts);
         /* A whole refresh showing a checkpoint draws the photons it has time
