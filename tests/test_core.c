@@ -452,16 +452,19 @@ static void interrupt_flag(void **state)
     signal(SIGPIPE, SIG_DFL);
 }
 
-/* ps_memory_map_large_blocks: a large block is mapped on its own even after
- * a bigger one was freed (glibc would have raised its threshold to that
+/* ps_memory_set_drawing_policy: a large block is mapped on its own even
+ * after a bigger one was freed (glibc would have raised its threshold to that
  * size and served the next from the heap, where freed blocks stay resident:
- * the soak's memory grew 10-15 MiB). Counted by glibc's mapped blocks; not
- * under ASan, whose allocator is its own. */
-static void large_blocks_mapped(void **state)
+ * the soak's memory grew 10-15 MiB), and small blocks freed at the heap's top
+ * stay with the process up to PS_MEMORY_TRIM_THRESHOLD (the trim threshold
+ * fixed at 128 KiB gave them back to the kernel after every llvmpipe scene,
+ * and the next faulted them in again). Counted by glibc's mapped blocks and
+ * the top's releasable bytes; not under ASan, whose allocator is its own. */
+static void drawing_policy(void **state)
 {
     (void)state;
 #if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
-    ps_memory_map_large_blocks();
+    ps_memory_set_drawing_policy();
     void *big = malloc(8u << 20);
     assert_non_null(big);
     free(big);
@@ -471,6 +474,17 @@ static void large_blocks_mapped(void **state)
     size_t after = mallinfo2().hblks;
     free(mid);
     assert_int_equal(after, before + 1);
+    /* 16 MiB of 64 KiB blocks, as llvmpipe's bins, freed top down: kept. */
+    enum { BLOCKS = 256, BLOCK = 64 << 10 };
+    static void *blocks[BLOCKS];
+    for (int i = 0; i < BLOCKS; i++) {
+        blocks[i] = malloc(BLOCK);
+        assert_non_null(blocks[i]);
+        memset(blocks[i], 1, BLOCK);
+    }
+    for (int i = BLOCKS - 1; i >= 0; i--)
+        free(blocks[i]);
+    assert_true(mallinfo2().keepcost >= (size_t)BLOCKS * BLOCK * 3 / 4);
 #else
     skip();
 #endif
@@ -490,7 +504,7 @@ int main(void)
         cmocka_unit_test(line_lengths),
         cmocka_unit_test(error_messages_are_one_line), cmocka_unit_test(errors_carry_their_line),
         cmocka_unit_test(memory_budget),
-        cmocka_unit_test(large_blocks_mapped),
+        cmocka_unit_test(drawing_policy),
         cmocka_unit_test(output_checks),
         cmocka_unit_test(cancel_flag_across_threads), cmocka_unit_test(interrupt_flag),
     };

@@ -1290,7 +1290,7 @@ static ps_status check_prefixed_outputs(const snap_options *o, ps_error *err)
 
 int main(int argc, char **argv)
 {
-    ps_memory_map_large_blocks(); /* a script's session, as the window's (core/memory.h) */
+    ps_memory_set_drawing_policy(); /* as the window's (core/memory.h) */
     ps_error err;
     ps_error_clear(&err);
     snap_options o;

@@ -1192,7 +1192,7 @@ static ps_status write_stats(app *a, ps_error *err)
 int main(int argc, char **argv)
 {
     static app a; /* large, and the callbacks reach it through the window */
-    ps_memory_map_large_blocks(); /* a long session's memory stays flat (core/memory.h) */
+    ps_memory_set_drawing_policy(); /* flat memory, llvmpipe's bins kept (core/memory.h) */
     ps_error err;
     ps_error_clear(&err);
     bool help = false;

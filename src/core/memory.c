@@ -11,11 +11,12 @@
 #define BYTES_PER_MIB (1024.0 * 1024.0)
 #define BYTES_PER_GIB (1024.0 * BYTES_PER_MIB)
 
-void ps_memory_map_large_blocks(void)
+void ps_memory_set_drawing_policy(void)
 {
 #ifdef __GLIBC__
-    /* Setting it turns glibc's own adjustment of it off. */
+    /* Setting either turns glibc's own adjustment of both off. */
     (void)mallopt(M_MMAP_THRESHOLD, PS_MEMORY_MAP_THRESHOLD);
+    (void)mallopt(M_TRIM_THRESHOLD, PS_MEMORY_TRIM_THRESHOLD);
 #endif
 }
 

@@ -36,16 +36,32 @@ uint64_t ps_memory_mul(uint64_t a, uint64_t b);
  * the thing. */
 ps_status ps_memory_check(uint64_t bytes, const char *who, const char *what, ps_error *err);
 
-/* For long sessions (the window, snap --script): blocks from this size up
- * are mapped on their own and unmapped when freed, whatever their history.
- * glibc raises that threshold to the size of each large block freed (up to
- * 32 MiB), after which a session's maps, repair tables and splat arrays came
- * from the heap and stayed there: `make soak`'s resident memory grew 10-15
- * MiB over 187 s (limit 12.5) with the repair's arrays of 2026-12-03, 1.4
- * MiB with the threshold fixed, at the cost of first-touch faults on each
- * new large block (a move's update 0.017-0.038 -> 0.029-0.049 s at 10^6 photons).
- * Elsewhere (no glibc) nothing. */
+/* The allocator's policy for the programs that draw (the window and snap),
+ * two settings (glibc; elsewhere nothing):
+ *
+ * Blocks from PS_MEMORY_MAP_THRESHOLD up are mapped on their own and
+ * unmapped when freed, whatever their history. glibc raises that threshold
+ * to the size of each large block freed (up to 32 MiB), after which a
+ * session's maps, repair tables and splat arrays came from the heap and
+ * stayed there: `make soak`'s resident memory grew 10-15 MiB over 187 s
+ * (limit 12.5) with the repair's arrays of 2026-12-03, 1.4 MiB with the
+ * threshold fixed, at the cost of first-touch faults on each new large block
+ * (a move's update 0.017-0.038 -> 0.029-0.049 s at 10^6 photons).
+ *
+ * Up to PS_MEMORY_TRIM_THRESHOLD of freed memory at the heap's top stays
+ * with the process. Fixing the first setting fixes glibc's trim threshold
+ * too, at 128 KiB, and llvmpipe frees the bins of every scene it draws
+ * (blocks under the map threshold, from the heap): the heap's top went back
+ * to the kernel after each draw and the next faulted it in again, zeroed.
+ * The window orbiting over 1.25*10^6 photons at 512^2 (scripts/bench-window.sh
+ * orbit): a moving frame 58-68 ms, the full picture 2.0-2.2 s after the stop;
+ * with 64 MiB kept 31-40 ms and 1.20-1.48 s (4 MiB: 34-36 ms, 1.6-1.8 s).
+ * What is kept is reused by the next draw: `make soak` stays flat (-0.3 and
+ * +3.7 MiB over 181 s) about 60 MiB higher (275-280 MiB at the end against
+ * 214). At 16 MiB the kept top filled over the session and the soak failed,
+ * +16.4 MiB. */
 #define PS_MEMORY_MAP_THRESHOLD (128 * 1024)
-void ps_memory_map_large_blocks(void);
+#define PS_MEMORY_TRIM_THRESHOLD (64 * 1024 * 1024)
+void ps_memory_set_drawing_policy(void);
 
 #endif
