@@ -814,9 +814,9 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         /* 8 bits: the checkpoint's frame draws what fits from its start,
          * the photons there then (pace.h). */
         if (!s->layers && plan.shows) {
-            double now = ps_now_seconds() - clock;
-            measure_rate(s, now, photons_emitted(s->session), &rate);
-            plan.photons = ps_pace_photons_at_start(&s->pace, &plan, now, rate.photons, fmin(next, end) - clock,
+            double now = ps_now_seconds() - clock, photons = photons_emitted(s->session);
+            measure_rate(s, now, photons, &rate);
+            plan.photons = ps_pace_photons_at_start(&s->pace, &plan, now, photons, fmin(next, end) - clock,
                                                     o->checkpoints + cp, o->checkpoint_count - cp);
         }
         ps_session_counts counts;

@@ -54,8 +54,9 @@ ps_status ps_memory_check(uint64_t bytes, const char *who, const char *what, ps_
  * (blocks under the map threshold, from the heap): the heap's top went back
  * to the kernel after each draw and the next faulted it in again, zeroed.
  * The window orbiting over 1.25*10^6 photons at 512^2 (scripts/bench-window.sh
- * orbit): a moving frame 58-68 ms, the full picture 2.0-2.2 s after the stop;
- * with 64 MiB kept 31-40 ms and 1.20-1.48 s (4 MiB: 34-36 ms, 1.6-1.8 s).
+ * orbit, six runs each, alternating): a moving frame 47-83 ms, the full
+ * picture 1.70-2.02 s after the stop; with 64 MiB kept 31-40 ms and
+ * 1.20-1.48 s (4 MiB, set from outside: 34-36 ms, 1.6-1.8 s).
  * What is kept is reused by the next draw: `make soak` stays flat (-0.3 and
  * +3.7 MiB over 181 s) about 60 MiB higher (275-280 MiB at the end against
  * 214). At 16 MiB the kept top filled over the session and the soak failed,
