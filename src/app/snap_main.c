@@ -553,6 +553,13 @@ static double last_picture_seconds(snap_run *s, double photons)
     return lights > 1.0 ? t + lights * s->lit_seconds : t;
 }
 
+/* Photons a second from (t0, p0) to (t1, p1); `otherwise` when that says
+ * nothing (no time between, or the counts went back: a new feed). */
+static double arrival_rate(double t0, double p0, double t1, double p1, double otherwise)
+{
+    return t1 > t0 && p1 >= p0 ? (p1 - p0) / (t1 - t0) : otherwise;
+}
+
 static double photons_emitted(ps_session *session)
 {
     ps_session_counts counts;
@@ -661,8 +668,7 @@ static ps_status time_to_stop(snap_run *s, double start, double most, double end
         sleep_until(now + step);
         /* Alone, the tracer goes faster than while refreshes shared the cores. */
         double t = ps_now_seconds(), p = photons_emitted(s->session);
-        if (t > now && p >= photons)
-            rate = (p - photons) / (t - now);
+        rate = arrival_rate(now, photons, t, p, rate);
         now = t, photons = p;
     }
 }
@@ -675,8 +681,7 @@ typedef struct pace_rate {
 /* The pace's arrival rate, from the last count to `photons` at `now`. */
 static void measure_rate(snap_run *s, double now, double photons, pace_rate *rate)
 {
-    if (now > rate->at && photons >= rate->photons)
-        s->pace.rate = (photons - rate->photons) / (now - rate->at);
+    s->pace.rate = arrival_rate(rate->at, rate->photons, now, photons, s->pace.rate);
     rate->at = now, rate->photons = photons;
 }
 
