@@ -262,12 +262,168 @@ static void sources_in_parts(void **state)
     rig_free(&same);
 }
 
+/* Lights past the two, so that the caustic map has a dozen strata with
+ * cuts everywhere. */
+#define MORE_LIGHTS                                                       \
+    "light point position -0.5 1.8 0 power 7 7 7\n"                      \
+    "light point position 0.2 1.7 -0.5 power 30 20 10\n"                 \
+    "light point position 0.6 1.8 0.6 power 0.5 0.5 0.5\n"
+#define WALK_LIGHTS 5
+#define WALK_STRATA 64
+
+/* The index whose choice of stratum reads m: Halton dimension 0 is the
+ * reversal of an index's low 53 bits. */
+static uint64_t index_of_m(uint64_t m)
+{
+    uint64_t i = 0;
+    for (int b = 0; b < 53; b++)
+        i |= ((m >> b) & 1) << (52 - b);
+    return i;
+}
+
+static uint32_t stratum_at_m(rig *a, ps_map_kind k, uint64_t m, uint64_t *rank)
+{
+    uint32_t s;
+    uint64_t r;
+    assert_true(ps_tracer_photon_rank(a->tracer, k, index_of_m(m), (uint64_t)1 << 54, &s, &r));
+    if (rank)
+        *rank = r;
+    return s;
+}
+
+/* Index i (far out, choice m) is counted in its own stratum: the next index
+ * of that stratum ranks one above it. */
+static void counted_in_own_stratum(rig *a, ps_map_kind k, uint64_t m)
+{
+    uint64_t i = index_of_m(m), rank, next_rank;
+    uint32_t s = stratum_at_m(a, k, m, &rank), t;
+    for (uint64_t j = i + 1;; j++) {
+        assert_true(ps_tracer_photon_rank(a->tracer, k, j, (uint64_t)1 << 54, &t, &next_rank));
+        if (t == s)
+            break;
+        assert_true(j - i < 100000);
+    }
+    if (next_rank != rank + 1)
+        fail_msg("m %llu (index %llu): stratum %u, rank %llu; its next photon ranks %llu", (unsigned long long)m,
+                 (unsigned long long)i, s, (unsigned long long)rank, (unsigned long long)next_rank);
+}
+
+/* The strata's cuts found from outside, exactly: where the stratum of m
+ * changes along a grid of 4096 m, bisected to the m where it changes; both
+ * indices beside each cut are counted in their own strata. */
+static int cuts_counted_exactly(rig *a, ps_map_kind k)
+{
+    enum { GRID_BITS = 12 };
+    const uint64_t step = (uint64_t)1 << (53 - GRID_BITS);
+    int cuts = 0;
+    uint32_t prev = stratum_at_m(a, k, 0, NULL);
+    for (uint64_t g = 1; g <= (uint64_t)1 << GRID_BITS; g++) {
+        uint64_t hi = g == (uint64_t)1 << GRID_BITS ? ((uint64_t)1 << 53) - 1 : g * step;
+        uint32_t here = stratum_at_m(a, k, hi, NULL);
+        if (here != prev) {
+            uint64_t lo = (g - 1) * step; /* stratum(lo) != stratum(hi): the first m after lo that differs */
+            while (hi - lo > 1) {
+                uint64_t mid = lo + (hi - lo) / 2;
+                if (stratum_at_m(a, k, mid, NULL) == prev)
+                    lo = mid;
+                else
+                    hi = mid;
+            }
+            counted_in_own_stratum(a, k, lo);
+            counted_in_own_stratum(a, k, hi);
+            cuts++;
+        }
+        prev = here;
+    }
+    return cuts;
+}
+
+/* The photons of each light below index n, walked: lights[l] below `at`. */
+static void walk_far(rig *a, ps_map_kind k, uint64_t n0)
+{
+    enum { WALK = 3000 };
+    uint64_t lights[WALK_LIGHTS] = {0}, sum = 0;
+    for (uint32_t l = 0; l < WALK_LIGHTS; l++)
+        sum += lights[l] = ps_tracer_light_photons(a->tracer, k, l, n0);
+    assert_true(sum == n0);
+    uint64_t next[WALK_STRATA];
+    bool seen[WALK_STRATA] = {false};
+    for (uint64_t i = n0; i < n0 + WALK; i++) {
+        uint32_t s;
+        uint64_t rank;
+        assert_true(ps_tracer_photon_rank(a->tracer, k, i, n0 + WALK, &s, &rank));
+        assert_true(s < WALK_STRATA);
+        /* consecutive photons of a stratum: ranks one apart */
+        if (seen[s] && rank != next[s])
+            fail_msg("index %llu: rank %llu, %llu expected", (unsigned long long)i, (unsigned long long)rank,
+                     (unsigned long long)next[s]);
+        seen[s] = true;
+        next[s] = rank + 1;
+        lights[ps_tracer_photon_light(a->tracer, k, i, n0 + WALK)]++;
+    }
+    for (uint32_t l = 0; l < WALK_LIGHTS; l++)
+        assert_true(ps_tracer_light_photons(a->tracer, k, l, n0 + WALK) == lights[l]);
+}
+
+/* Each stratum's photons below an index come in closed form, from where the
+ * cuts between strata fall (tracer.c, count_below), not from a walk over
+ * every index: against such a walk, for three seeds (the choice's rotation)
+ * and three shares, the rank of every index below 2^16 + 1000 is its
+ * stratum's photons below it, and each light's photons below n are those
+ * counted, at n on and beside powers of two and every 997th; far out (n
+ * about 2^40 and 2^54, past the 53 bits of the choice) they add up to n and
+ * a walk of 3000 indices agrees with the counts at both ends; and the
+ * indices beside every cut (found from outside) are counted exactly. */
+static void counts_in_closed_form(void **state)
+{
+    (void)state;
+    enum { N = (1 << 16) + 1000 };
+    static const char *const spot[] = {"60 50 40", "1 1 1", "300 300 300"};
+    for (uint64_t seed = 0; seed < 3; seed++)
+        for (size_t p = 0; p < sizeof spot / sizeof *spot; p++) {
+            char t[4096];
+            snprintf(t, sizeof t, TWO_LIGHTS_SCENE "%s\n" MORE_LIGHTS, spot[p]);
+            ps_tracer_options o = ps_tracer_default_options();
+            o.seed = seed;
+            o.threads = 1;
+            rig a = rig_make(t, "", &o, PS_ACCEL_AUTO);
+            for (int k = 0; k < PS_MAP_COUNT; k++) {
+                uint64_t below[WALK_STRATA] = {0}, lights[WALK_LIGHTS] = {0};
+                for (uint64_t i = 0; i < N; i++) {
+                    uint32_t s;
+                    uint64_t rank;
+                    assert_true(ps_tracer_photon_rank(a.tracer, (ps_map_kind)k, i, N, &s, &rank));
+                    assert_true(s < WALK_STRATA);
+                    if (rank != below[s])
+                        fail_msg("seed %llu, map %d, index %llu: rank %llu, %llu walked",
+                                 (unsigned long long)seed, k, (unsigned long long)i, (unsigned long long)rank,
+                                 (unsigned long long)below[s]);
+                    below[s]++;
+                    uint32_t l = ps_tracer_photon_light(a.tracer, (ps_map_kind)k, i, N);
+                    assert_true(l < WALK_LIGHTS);
+                    lights[l]++;
+                    uint64_t n = i + 1;
+                    bool beside_power = ((n - 1) & (n - 2)) == 0 || (n & (n - 1)) == 0 || ((n + 1) & n) == 0;
+                    if (beside_power || n % 997 == 0 || n == N)
+                        for (uint32_t m = 0; m < WALK_LIGHTS; m++)
+                            assert_true(ps_tracer_light_photons(a.tracer, (ps_map_kind)k, m, n) == lights[m]);
+                }
+                walk_far(&a, (ps_map_kind)k, ((uint64_t)1 << 40) + 123457);
+                walk_far(&a, (ps_map_kind)k, ((uint64_t)1 << 54) + 99991);
+                /* the caustic map: a dozen strata, the global one five */
+                assert_true(cuts_counted_exactly(&a, (ps_map_kind)k) >= (k == PS_MAP_GLOBAL ? 4 : 8));
+            }
+            rig_free(&a);
+        }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(paths_survive_a_share_change),
         cmocka_unit_test(ranks_are_in_index_order),
         cmocka_unit_test(sources_in_parts),
+        cmocka_unit_test(counts_in_closed_form),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
