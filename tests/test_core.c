@@ -490,6 +490,71 @@ static void drawing_policy(void **state)
 #endif
 }
 
+#if defined(__linux__) && !defined(__SANITIZE_ADDRESS__)
+/* The VmFlags of the mapping that holds p, from /proc/self/smaps ("" when
+ * not found). */
+static void vm_flags_of(const void *p, char *out, size_t size)
+{
+    out[0] = '\0';
+    FILE *f = fopen("/proc/self/smaps", "r");
+    if (!f)
+        return;
+    char line[512];
+    bool in = false;
+    uintptr_t at = (uintptr_t)p;
+    while (fgets(line, sizeof line, f)) {
+        unsigned long lo, hi;
+        if (sscanf(line, "%lx-%lx ", &lo, &hi) == 2 && strchr(line, '-') < strchr(line, ' ')) {
+            in = at >= lo && at < hi;
+            continue;
+        }
+        if (in && strncmp(line, "VmFlags:", 8) == 0) {
+            snprintf(out, size, "%s", line + 8);
+            break;
+        }
+    }
+    fclose(f);
+}
+#endif
+
+/* ps_memory_large_realloc: growth keeps the contents through every step,
+ * from malloc's sizes into mappings of their own; a large array starts at a
+ * 2 MiB boundary and its mapping is advised for huge pages (VmFlags "hg"),
+ * through a growth in place or moved (not under ASan, where the arrays are
+ * malloc's). */
+static void large_arrays(void **state)
+{
+    (void)state;
+    size_t cap = 0;
+    unsigned char *a = NULL;
+    const size_t sizes[] = {100, 1u << 20, PS_MEMORY_LARGE_MIN, 3 * PS_MEMORY_LARGE_MIN + 12345,
+                            8 * PS_MEMORY_LARGE_MIN};
+    for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++) {
+        unsigned char *q = ps_memory_large_realloc(a, cap, sizes[k]);
+        assert_non_null(q);
+        for (size_t i = 0; i < cap; i += 4093)
+            assert_int_equal(q[i], (unsigned char)(i * 7 + 1));
+        for (size_t i = 0; i < sizes[k]; i++)
+            q[i] = (unsigned char)(i * 7 + 1);
+        a = q;
+        cap = sizes[k];
+#if defined(__linux__) && !defined(__SANITIZE_ADDRESS__)
+        if (cap >= PS_MEMORY_LARGE_MIN) {
+            assert_int_equal((uintptr_t)a % (2u << 20), 0);
+            char flags[512];
+            vm_flags_of(a, flags, sizeof flags);
+            /* (a kernel without huge pages refuses the advice) */
+            if (access("/sys/kernel/mm/transparent_hugepage/enabled", F_OK) == 0 && !strstr(flags, " hg"))
+                fail_msg("a large array of %zu bytes: VmFlags%s", cap, flags);
+        }
+#endif
+    }
+    /* the same size again: the same array */
+    assert_ptr_equal(ps_memory_large_realloc(a, cap, cap), a);
+    ps_memory_large_free(a, cap);
+    ps_memory_large_free(NULL, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -505,6 +570,7 @@ int main(void)
         cmocka_unit_test(error_messages_are_one_line), cmocka_unit_test(errors_carry_their_line),
         cmocka_unit_test(memory_budget),
         cmocka_unit_test(drawing_policy),
+        cmocka_unit_test(large_arrays),
         cmocka_unit_test(output_checks),
         cmocka_unit_test(cancel_flag_across_threads), cmocka_unit_test(interrupt_flag),
     };

@@ -7,6 +7,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "core/memory.h"
+
 /* Makes room for at least `need` elements of `elem` bytes in *p (capacity in
  * *cap, grown geometrically). False, with *p untouched, when the size would
  * overflow or realloc fails: callers report PS_ERR_NOMEM and keep a valid
@@ -33,5 +35,29 @@ static inline bool ps_array_reserve(void **p, size_t *cap, size_t need, size_t e
 
 /* ps_array_reserve for a typed pointer: PS_RESERVE(arr, cap, need). */
 #define PS_RESERVE(ptr, cap, need) ps_array_reserve((void **)&(ptr), &(cap), (need), sizeof *(ptr))
+
+/* ps_array_reserve for arrays that grow large and are written soon after
+ * (core/memory.h: ps_memory_large_realloc); freed with
+ * ps_memory_large_free(p, cap * elem). */
+static inline bool ps_array_reserve_large(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap)
+        return true;
+    size_t n = *cap ? *cap : 16;
+    while (n < need) {
+        if (n > SIZE_MAX / 2)
+            return false;
+        n *= 2;
+    }
+    if (elem && n > SIZE_MAX / elem)
+        return false;
+    void *q = ps_memory_large_realloc(*p, *cap * elem, n * elem);
+    if (!q)
+        return false;
+    *p = q;
+    *cap = n;
+    return true;
+}
+#define PS_RESERVE_LARGE(ptr, cap, need) ps_array_reserve_large((void **)&(ptr), &(cap), (need), sizeof *(ptr))
 
 #endif

@@ -1,12 +1,16 @@
 /* memory.c: the memory budget (see memory.h). */
+/* mremap, MAP_ANONYMOUS and MADV_HUGEPAGE are Linux's, past POSIX. */
+#define _GNU_SOURCE
 #include "core/memory.h"
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <unistd.h>
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
+#include <sys/mman.h>
 
 #define BYTES_PER_MIB (1024.0 * 1024.0)
 #define BYTES_PER_GIB (1024.0 * BYTES_PER_MIB)
@@ -19,6 +23,77 @@ void ps_memory_set_drawing_policy(void)
     (void)mallopt(M_TRIM_THRESHOLD, PS_MEMORY_TRIM_THRESHOLD);
 #endif
 }
+
+/* Not under ASan: mappings of our own would hide these arrays' bounds from it. */
+#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(__SANITIZE_ADDRESS__)
+#define LARGE_PAGE ((size_t)2 * 1024 * 1024)
+
+static size_t large_span(size_t bytes) { return (bytes + LARGE_PAGE - 1) / LARGE_PAGE * LARGE_PAGE; }
+
+/* span bytes (whole large pages) at a large page's boundary, advised: mapped
+ * one page longer, the ends beside the boundary given back. */
+static void *map_large(size_t span)
+{
+    if (span > SIZE_MAX - LARGE_PAGE)
+        return NULL;
+    size_t over = span + LARGE_PAGE;
+    char *m = mmap(NULL, over, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m == MAP_FAILED)
+        return NULL;
+    char *a = (char *)(((uintptr_t)m + LARGE_PAGE - 1) & ~(uintptr_t)(LARGE_PAGE - 1));
+    if (a > m)
+        munmap(m, (size_t)(a - m));
+    if (m + over > a + span)
+        munmap(a + span, (size_t)(m + over - (a + span)));
+    (void)madvise(a, span, MADV_HUGEPAGE); /* advice: without it, small pages */
+    return a;
+}
+
+void *ps_memory_large_realloc(void *p, size_t old_bytes, size_t new_bytes)
+{
+    if (new_bytes < PS_MEMORY_LARGE_MIN)
+        return realloc(p, new_bytes);
+    size_t span = large_span(new_bytes);
+    if (old_bytes >= PS_MEMORY_LARGE_MIN) {
+        size_t old_span = large_span(old_bytes);
+        if (span <= old_span)
+            return p;
+        /* In place where the addresses after it are free: no copy, and the
+         * mapping keeps its advice and alignment. */
+        void *q = mremap(p, old_span, span, 0);
+        if (q != MAP_FAILED)
+            return q;
+    }
+    void *q = map_large(span);
+    if (!q)
+        return NULL;
+    if (p)
+        memcpy(q, p, old_bytes);
+    ps_memory_large_free(p, old_bytes);
+    return q;
+}
+
+void ps_memory_large_free(void *p, size_t bytes)
+{
+    if (!p)
+        return;
+    if (bytes >= PS_MEMORY_LARGE_MIN)
+        munmap(p, large_span(bytes));
+    else
+        free(p);
+}
+#else
+void *ps_memory_large_realloc(void *p, size_t old_bytes, size_t new_bytes)
+{
+    return p && new_bytes <= old_bytes ? p : realloc(p, new_bytes);
+}
+
+void ps_memory_large_free(void *p, size_t bytes)
+{
+    (void)bytes;
+    free(p);
+}
+#endif
 
 int ps_memory_parse_size(const char *text, uint64_t *out)
 {

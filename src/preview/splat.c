@@ -98,9 +98,9 @@ void ps_splat_batch_free(ps_splat_batch *b)
 {
     if (!b)
         return;
-    free(b->positions);
-    free(b->colors);
-    free(b->texcoords);
+    ps_memory_large_free(b->positions, b->cap_pos * sizeof *b->positions);
+    ps_memory_large_free(b->colors, b->cap_col * sizeof *b->colors);
+    ps_memory_large_free(b->texcoords, b->cap_tex * sizeof *b->texcoords);
     free(b->group);
     free(b->order);
     free(b->order_tmp);
@@ -127,7 +127,10 @@ double ps_splat_batch_carry(const ps_splat_batch *b, int ch)
 
 /* Reorders the splats [first, splats) by stencil value (a stable counting
  * sort, so error diffusion's order within a group is kept) and records where
- * each group starts. */
+ * each group starts. The copy it sorts from is as large as the splats'
+ * arrays (108 bytes a triangle splat), made for each call and freed after
+ * it: in large pages (core/memory.h), as its pages are all new each time.
+ * (Kept in the batch instead, the window held some 40 MiB more.) */
 static bool group_splats(ps_splat_batch *b, size_t first, size_t per)
 {
     size_t n = b->splats - first;
@@ -142,12 +145,11 @@ static bool group_splats(ps_splat_batch *b, size_t first, size_t per)
         count[b->group[first + i] + 1]++;
     for (int g = 0; g < PS_SPLAT_GROUPS; g++)
         count[g + 1] += count[g];
-    float *pos = malloc(n * per * 3 * sizeof *pos), *col = malloc(n * per * 4 * sizeof *col);
-    float *tex = per == 3 ? malloc(n * per * 2 * sizeof *tex) : NULL;
-    if (!pos || !col || (per == 3 && !tex)) {
-        free(pos), free(col), free(tex);
+    size_t nv = n * per, bytes = nv * (per == 3 ? 9 : 7) * sizeof(float);
+    float *pos = ps_memory_large_realloc(NULL, 0, bytes);
+    if (!pos)
         return false;
-    }
+    float *col = pos + 3 * nv, *tex = per == 3 ? col + 4 * nv : NULL;
     size_t v0 = first * per;
     memcpy(pos, b->positions + 3 * v0, n * per * 3 * sizeof *pos);
     memcpy(col, b->colors + 4 * v0, n * per * 4 * sizeof *col);
@@ -166,7 +168,7 @@ static bool group_splats(ps_splat_batch *b, size_t first, size_t per)
         if (tex)
             memcpy(b->texcoords + 2 * to, tex + 2 * from, per * 2 * sizeof *tex);
     }
-    free(pos), free(col), free(tex);
+    ps_memory_large_free(pos, bytes);
     b->grouped = true;
     return true;
 }
@@ -605,9 +607,9 @@ ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, si
 {
     size_t per = p->mode == PS_SPLAT_TRIANGLES ? 3 : 1;
     if (count > (SIZE_MAX / 4 - b->vertex_count) / per ||
-        !PS_RESERVE(b->positions, b->cap_pos, 3 * (b->vertex_count + per * count)) ||
-        !PS_RESERVE(b->colors, b->cap_col, 4 * (b->vertex_count + per * count)) ||
-        (per == 3 && !PS_RESERVE(b->texcoords, b->cap_tex, 2 * (b->vertex_count + per * count))) ||
+        !PS_RESERVE_LARGE(b->positions, b->cap_pos, 3 * (b->vertex_count + per * count)) ||
+        !PS_RESERVE_LARGE(b->colors, b->cap_col, 4 * (b->vertex_count + per * count)) ||
+        (per == 3 && !PS_RESERVE_LARGE(b->texcoords, b->cap_tex, 2 * (b->vertex_count + per * count))) ||
         (p->objects && !PS_RESERVE(b->group, b->cap_group, b->splats + count)) || (count && !decode_normals(b)))
         return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
     size_t first_splat = b->splats;
