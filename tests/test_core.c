@@ -520,7 +520,7 @@ static void vm_flags_of(const void *p, char *out, size_t size)
 /* ps_memory_large_realloc: growth keeps the contents through every step,
  * from malloc's sizes into mappings of their own; a large array starts at a
  * 2 MiB boundary and its mapping is advised for huge pages (VmFlags "hg"),
- * through a growth in place or moved (not under ASan, where the arrays are
+ * after each growth (not under ASan, where the arrays are
  * malloc's). */
 static void large_arrays(void **state)
 {

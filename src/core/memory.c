@@ -1,5 +1,5 @@
 /* memory.c: the memory budget (see memory.h). */
-/* mremap, MAP_ANONYMOUS and MADV_HUGEPAGE are Linux's, past POSIX. */
+/* MAP_ANONYMOUS and MADV_HUGEPAGE are Linux's, past POSIX. */
 #define _GNU_SOURCE
 #include "core/memory.h"
 
@@ -54,16 +54,10 @@ void *ps_memory_large_realloc(void *p, size_t old_bytes, size_t new_bytes)
     if (new_bytes < PS_MEMORY_LARGE_MIN)
         return realloc(p, new_bytes);
     size_t span = large_span(new_bytes);
-    if (old_bytes >= PS_MEMORY_LARGE_MIN) {
-        size_t old_span = large_span(old_bytes);
-        if (span <= old_span)
-            return p;
-        /* In place where the addresses after it are free: no copy, and the
-         * mapping keeps its advice and alignment. */
-        void *q = mremap(p, old_span, span, 0);
-        if (q != MAP_FAILED)
-            return q;
-    }
+    if (old_bytes >= PS_MEMORY_LARGE_MIN && span <= large_span(old_bytes))
+        return p;
+    /* A new mapping and a copy: growing one in place (mremap) found the
+     * addresses after it taken, mappings being placed downwards. */
     void *q = map_large(span);
     if (!q)
         return NULL;

@@ -307,6 +307,9 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
     s->area_side = set->progressive_lights ? 1 : PS_PREVIEW_AREA_SIDE;
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_splat_batch_init(&s->batch[k]);
+        /* Whole refreshes' batches grow with the maps; incremental ones hold
+         * a budget's splats and are reused (splat.h). */
+        s->batch[k].large_pages = !(set->incremental && set->float_buffer);
         s->splat_radius[k] = set->radius[k];
     }
     s->record_box = ps_repair_record_box(scene);

@@ -98,9 +98,15 @@ void ps_splat_batch_free(ps_splat_batch *b)
 {
     if (!b)
         return;
-    ps_memory_large_free(b->positions, b->cap_pos * sizeof *b->positions);
-    ps_memory_large_free(b->colors, b->cap_col * sizeof *b->colors);
-    ps_memory_large_free(b->texcoords, b->cap_tex * sizeof *b->texcoords);
+    if (b->large_pages) {
+        ps_memory_large_free(b->positions, b->cap_pos * sizeof *b->positions);
+        ps_memory_large_free(b->colors, b->cap_col * sizeof *b->colors);
+        ps_memory_large_free(b->texcoords, b->cap_tex * sizeof *b->texcoords);
+    } else {
+        free(b->positions);
+        free(b->colors);
+        free(b->texcoords);
+    }
     free(b->group);
     free(b->order);
     free(b->order_tmp);
@@ -129,8 +135,8 @@ double ps_splat_batch_carry(const ps_splat_batch *b, int ch)
  * sort, so error diffusion's order within a group is kept) and records where
  * each group starts. The copy it sorts from is as large as the splats'
  * arrays (108 bytes a triangle splat), made for each call and freed after
- * it: in large pages (core/memory.h), as its pages are all new each time.
- * (Kept in the batch instead, the window held some 40 MiB more.) */
+ * it: with large_pages in 2 MiB pages too, as its pages are all new each
+ * time. (Kept in the batch instead, the window held some 40 MiB more.) */
 static bool group_splats(ps_splat_batch *b, size_t first, size_t per)
 {
     size_t n = b->splats - first;
@@ -146,7 +152,7 @@ static bool group_splats(ps_splat_batch *b, size_t first, size_t per)
     for (int g = 0; g < PS_SPLAT_GROUPS; g++)
         count[g + 1] += count[g];
     size_t nv = n * per, bytes = nv * (per == 3 ? 9 : 7) * sizeof(float);
-    float *pos = ps_memory_large_realloc(NULL, 0, bytes);
+    float *pos = b->large_pages ? ps_memory_large_realloc(NULL, 0, bytes) : malloc(bytes);
     if (!pos)
         return false;
     float *col = pos + 3 * nv, *tex = per == 3 ? col + 4 * nv : NULL;
@@ -168,7 +174,10 @@ static bool group_splats(ps_splat_batch *b, size_t first, size_t per)
         if (tex)
             memcpy(b->texcoords + 2 * to, tex + 2 * from, per * 2 * sizeof *tex);
     }
-    ps_memory_large_free(pos, bytes);
+    if (b->large_pages)
+        ps_memory_large_free(pos, bytes);
+    else
+        free(pos);
     b->grouped = true;
     return true;
 }
@@ -602,14 +611,23 @@ static bool decode_normals(ps_splat_batch *b)
     return true;
 }
 
+/* Room for count more splats of per vertices each. */
+static bool reserve_vertices(ps_splat_batch *b, size_t per, size_t count)
+{
+    size_t n = b->vertex_count + per * count;
+    if (b->large_pages)
+        return PS_RESERVE_LARGE(b->positions, b->cap_pos, 3 * n) && PS_RESERVE_LARGE(b->colors, b->cap_col, 4 * n) &&
+               (per != 3 || PS_RESERVE_LARGE(b->texcoords, b->cap_tex, 2 * n));
+    return PS_RESERVE(b->positions, b->cap_pos, 3 * n) && PS_RESERVE(b->colors, b->cap_col, 4 * n) &&
+           (per != 3 || PS_RESERVE(b->texcoords, b->cap_tex, 2 * n));
+}
+
 ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
                          ps_splat_batch *b, ps_error *err)
 {
     size_t per = p->mode == PS_SPLAT_TRIANGLES ? 3 : 1;
     if (count > (SIZE_MAX / 4 - b->vertex_count) / per ||
-        !PS_RESERVE_LARGE(b->positions, b->cap_pos, 3 * (b->vertex_count + per * count)) ||
-        !PS_RESERVE_LARGE(b->colors, b->cap_col, 4 * (b->vertex_count + per * count)) ||
-        (per == 3 && !PS_RESERVE_LARGE(b->texcoords, b->cap_tex, 2 * (b->vertex_count + per * count))) ||
+        !reserve_vertices(b, per, count) ||
         (p->objects && !PS_RESERVE(b->group, b->cap_group, b->splats + count)) || (count && !decode_normals(b)))
         return ps_error_set(err, PS_ERR_NOMEM, "splats: out of memory for %zu photons", count);
     size_t first_splat = b->splats;

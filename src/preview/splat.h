@@ -139,6 +139,12 @@ static inline unsigned ps_splat_stencil(uint32_t object) { return object % (PS_S
  * that went in. The carry persists across batches of the same map (clear it
  * when the map restarts); wanted/lost add up until cleared. */
 typedef struct ps_splat_batch {
+    /* The vertex arrays from 4 MiB up in 2 MiB pages (core/memory.h), for
+     * batches that grow with the maps: a whole refresh's, every photon drawn
+     * again, where a refresh with more photons than any before wrote its
+     * splats into pages never touched. Set after ps_splat_batch_init, before
+     * the first build. */
+    bool large_pages;
     size_t vertex_count; /* 3 a photon for triangles, 1 otherwise */
     float *positions;    /* xyz */
     float *colors;       /* rgba, a = 1 */
