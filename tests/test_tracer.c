@@ -103,11 +103,11 @@ static void photons_per_light(void **state)
     rig_free(&r);
 }
 
-/* The rank tables (made in jobs of 2048 granules of 256 indices, on every
- * core), which a trace finds photon i's rank in and the photon sources start
- * their jobs from, against ranks counted here from index 0: 1.5*10^6
+/* The ranks a trace finds for photon i and the photon sources' jobs start
+ * from (each stratum's indices below, in closed form; the jobs 2^19 indices
+ * long, on every core), against ranks counted here from index 0: 1.5*10^6
  * indices, three jobs, three strata, for one thread and two. */
-static void ranks_from_the_table(void **state)
+static void ranks_across_job_seams(void **state)
 {
     (void)state;
     char text[2048];
@@ -138,7 +138,7 @@ static void ranks_from_the_table(void **state)
                 uint64_t rt;
                 assert_true(ps_tracer_photon_rank(r.tracer, PS_MAP_GLOBAL, i, total, &kt, &rt));
                 if (kt != k || rt != rank)
-                    fail_msg("photon %llu: stratum %u rank %llu from the table, %u %llu counted", (unsigned long long)i,
+                    fail_msg("photon %llu: stratum %u rank %llu from the tracer, %u %llu counted", (unsigned long long)i,
                              kt, (unsigned long long)rt, k, (unsigned long long)rank);
                 checked++;
             }
@@ -606,7 +606,7 @@ static void traced_range_and_join(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(furnace_box),    cmocka_unit_test(photons_per_light), cmocka_unit_test(ranks_from_the_table),
+        cmocka_unit_test(furnace_box),    cmocka_unit_test(photons_per_light), cmocka_unit_test(ranks_across_job_seams),
         cmocka_unit_test(mirror_caustic),
         cmocka_unit_test(overlapping_cones), cmocka_unit_test(no_leaks),      cmocka_unit_test(determinism),
         cmocka_unit_test(scale_invariance), cmocka_unit_test(skips),

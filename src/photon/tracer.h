@@ -189,8 +189,8 @@ void ps_source_map_destroy(ps_source_map *m);
 void ps_tracer_repower(ps_tracer *t, ps_map_kind kind, const ps_photon_source *src, const ps_path_thr *thr,
                        size_t n, ps_photon *ph);
 /* Photon i's stratum and rank among that stratum's photons of [0, total),
- * as the trace finds them (from the rank table: count_strata's, made on
- * every core); false when the map is off, i >= total or out of memory. */
+ * as the trace finds them (the stratum's indices below i, counted in closed
+ * form); false when the map is off, i >= total or out of memory. */
 bool ps_tracer_photon_rank(ps_tracer *t, ps_map_kind kind, uint64_t i, uint64_t total, uint32_t *in_stratum,
                            uint64_t *rank);
 /* The light photon i of map kind leaves (UINT32_MAX when the map is off). */
