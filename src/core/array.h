@@ -11,9 +11,11 @@
 
 /* Makes room for at least `need` elements of `elem` bytes in *p (capacity in
  * *cap, grown geometrically). False, with *p untouched, when the size would
- * overflow or realloc fails: callers report PS_ERR_NOMEM and keep a valid
- * structure, never a half-grown one. */
-static inline bool ps_array_reserve(void **p, size_t *cap, size_t need, size_t elem)
+ * overflow or the allocation fails: callers report PS_ERR_NOMEM and keep a
+ * valid structure, never a half-grown one. `large`: for arrays that grow
+ * large and are written soon after, grown by ps_memory_large_realloc
+ * (core/memory.h) and freed with ps_memory_large_free(p, cap * elem). */
+static inline bool ps_array_reserve_as(void **p, size_t *cap, size_t need, size_t elem, bool large)
 {
     if (need <= *cap)
         return true;
@@ -25,39 +27,22 @@ static inline bool ps_array_reserve(void **p, size_t *cap, size_t need, size_t e
     }
     if (elem && n > SIZE_MAX / elem)
         return false;
-    void *q = realloc(*p, n * elem);
+    void *q = large ? ps_memory_large_realloc(*p, *cap * elem, n * elem) : realloc(*p, n * elem);
     if (!q)
         return false;
     *p = q;
     *cap = n;
     return true;
+}
+
+static inline bool ps_array_reserve(void **p, size_t *cap, size_t need, size_t elem)
+{
+    return ps_array_reserve_as(p, cap, need, elem, false);
 }
 
 /* ps_array_reserve for a typed pointer: PS_RESERVE(arr, cap, need). */
 #define PS_RESERVE(ptr, cap, need) ps_array_reserve((void **)&(ptr), &(cap), (need), sizeof *(ptr))
-
-/* ps_array_reserve for arrays that grow large and are written soon after
- * (core/memory.h: ps_memory_large_realloc); freed with
- * ps_memory_large_free(p, cap * elem). */
-static inline bool ps_array_reserve_large(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return true;
-    size_t n = *cap ? *cap : 16;
-    while (n < need) {
-        if (n > SIZE_MAX / 2)
-            return false;
-        n *= 2;
-    }
-    if (elem && n > SIZE_MAX / elem)
-        return false;
-    void *q = ps_memory_large_realloc(*p, *cap * elem, n * elem);
-    if (!q)
-        return false;
-    *p = q;
-    *cap = n;
-    return true;
-}
-#define PS_RESERVE_LARGE(ptr, cap, need) ps_array_reserve_large((void **)&(ptr), &(cap), (need), sizeof *(ptr))
+/* ... for a large one. */
+#define PS_RESERVE_LARGE(ptr, cap, need) ps_array_reserve_as((void **)&(ptr), &(cap), (need), sizeof *(ptr), true)
 
 #endif
