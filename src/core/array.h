@@ -42,7 +42,7 @@ static inline bool ps_array_reserve(void **p, size_t *cap, size_t need, size_t e
 
 /* ps_array_reserve for a typed pointer: PS_RESERVE(arr, cap, need). */
 #define PS_RESERVE(ptr, cap, need) ps_array_reserve((void **)&(ptr), &(cap), (need), sizeof *(ptr))
-/* ... for a large one. */
-#define PS_RESERVE_LARGE(ptr, cap, need) ps_array_reserve_as((void **)&(ptr), &(cap), (need), sizeof *(ptr), true)
+/* ... and ps_array_reserve_as: PS_RESERVE_AS(arr, cap, need, large). */
+#define PS_RESERVE_AS(ptr, cap, need, large) ps_array_reserve_as((void **)&(ptr), &(cap), (need), sizeof *(ptr), (large))
 
 #endif

@@ -615,11 +615,9 @@ static bool decode_normals(ps_splat_batch *b)
 static bool reserve_vertices(ps_splat_batch *b, size_t per, size_t count)
 {
     size_t n = b->vertex_count + per * count;
-    if (b->large_pages)
-        return PS_RESERVE_LARGE(b->positions, b->cap_pos, 3 * n) && PS_RESERVE_LARGE(b->colors, b->cap_col, 4 * n) &&
-               (per != 3 || PS_RESERVE_LARGE(b->texcoords, b->cap_tex, 2 * n));
-    return PS_RESERVE(b->positions, b->cap_pos, 3 * n) && PS_RESERVE(b->colors, b->cap_col, 4 * n) &&
-           (per != 3 || PS_RESERVE(b->texcoords, b->cap_tex, 2 * n));
+    bool large = b->large_pages;
+    return PS_RESERVE_AS(b->positions, b->cap_pos, 3 * n, large) && PS_RESERVE_AS(b->colors, b->cap_col, 4 * n, large) &&
+           (per != 3 || PS_RESERVE_AS(b->texcoords, b->cap_tex, 2 * n, large));
 }
 
 ps_status ps_splat_build(const ps_photon *photons, const uint16_t *materials, size_t count, const ps_splat_params *p,
