@@ -42,7 +42,7 @@ typedef struct inputs {
     ps_preview_lights lights;
 } inputs;
 
-static void inputs_make(const ps_scene *s, inputs *in)
+static void inputs_make_sized(const ps_scene *s, int shadow_size, inputs *in)
 {
     ps_error err;
     memset(in, 0, sizeof *in);
@@ -50,10 +50,12 @@ static void inputs_make(const ps_scene *s, inputs *in)
     assert_int_equal(ps_preview_mesh_build(s, &mo, &in->mesh, &err), PS_OK);
     mo.max_edge = HUGE_VAL;
     assert_int_equal(ps_preview_mesh_build(s, &mo, &in->coarse, &err), PS_OK);
-    assert_int_equal(ps_preview_lights_build(s, NULL, &in->coarse, PS_GL_SHADOW_SIZE, PS_PREVIEW_AREA_SIDE,
-                                             &in->lights, &err),
+    assert_int_equal(ps_preview_lights_build(s, NULL, &in->coarse, shadow_size, PS_PREVIEW_AREA_SIDE, &in->lights, &err),
                      PS_OK);
+    assert_int_equal(in->lights.shadow_size, shadow_size);
 }
+
+static void inputs_make(const ps_scene *s, inputs *in) { inputs_make_sized(s, PS_GL_SHADOW_SIZE, in); }
 
 static void inputs_free(inputs *in)
 {
@@ -273,6 +275,46 @@ static void culled_faces_draw_the_same(void **state)
     }
 }
 
+/* Lights planned at another side (a session's coarse first shadows refined,
+ * preview/session.h): the renderer draws every face again at that side,
+ * the same picture as a fresh renderer's made with them, and not the coarse
+ * one (32 texels a side here, so that the occluder's shadow edge moves by
+ * pixels); the renderer's own option gives way to the lights' side. */
+static void resized_shadows_render_every_face(void **state)
+{
+    (void)state;
+    ps_error err;
+    gl_rig g = gl_rig_open(scene_text);
+    ps_gl_options go = {true, true, 0, false};
+    inputs coarse, full;
+    inputs_make_sized(g.s, 32, &coarse);
+    inputs_make(g.s, &full);
+    ps_gl_scene gs = gl_scene(g.s, &coarse);
+    ps_gl_renderer *r, *fresh;
+    assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &r, &err), PS_OK);
+    ps_gl_clear_shadow_timing(r);
+    ps_image coarse_pic = draw(r, g.s);
+    assert_int_equal(ps_gl_get_stats(r).shadow_faces_last, 6);
+    gs = gl_scene(g.s, &full);
+    assert_int_equal(ps_gl_renderer_set_scene(r, &gs, &err), PS_OK);
+    ps_gl_clear_shadow_timing(r);
+    ps_image full_pic = draw(r, g.s);
+    assert_int_equal(ps_gl_get_stats(r).shadow_faces_last, 6);
+    go.shadow_size = 64; /* the lights' side wins */
+    assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &fresh, &err), PS_OK);
+    ps_image fresh_pic = draw(fresh, g.s);
+    assert_true(same_pixels(&full_pic, &fresh_pic));
+    assert_false(same_pixels(&full_pic, &coarse_pic));
+    ps_image_destroy(&coarse_pic);
+    ps_image_destroy(&full_pic);
+    ps_image_destroy(&fresh_pic);
+    ps_gl_renderer_destroy(fresh);
+    ps_gl_renderer_destroy(r);
+    inputs_free(&coarse);
+    inputs_free(&full);
+    gl_rig_close(&g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -281,6 +323,7 @@ int main(void)
         cmocka_unit_test(power_renders_no_face),
         cmocka_unit_test(moved_light_renders_its_cube),
         cmocka_unit_test(culled_faces_draw_the_same),
+        cmocka_unit_test(resized_shadows_render_every_face),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -458,6 +458,77 @@ static void refined_lights_mid_first_round(void **state)
     refined_lights(true);
 }
 
+/* A progressive start's coarse shadow maps refined mid-way through the
+ * first round (the same lights: ps_session_frame.shadows_refined) keep the
+ * round: its faces drawn before count, and the cube is shown once all six
+ * are drawn, after which faces come a budgeted one a refresh. (A new round
+ * there lost the default box's drawn faces, and its mirror stayed black
+ * past the 1 s checkpoint.) */
+static void refined_shadows_keep_the_round(void **state)
+{
+    (void)state;
+    ps_scene *scene = load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
+                                "material white diffuse albedo 0.5 0.5 0.5\n"
+                                "material mirror mirror reflectance 1 1 1\n"
+                                "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0 material white\n"
+                                "sphere center 0 0.5 -0.5 radius 0.3 material mirror\n"
+                                "light point position 0 1.5 -0.5 power 50 50 50\n");
+    ps_error err;
+    ps_session_settings set = ps_session_default_settings(scene);
+    set.caps[0] = 1000000, set.caps[1] = 100000; /* never all there: not settled */
+    set.float_buffer = set.incremental = true;
+    set.progressive_lights = true;
+    ps_session *s;
+    assert_int_equal(ps_session_create(scene, &set, &s, &err), PS_OK);
+    ps_session_hold_lights(s, true);
+    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
+    ps_session_hold(s, true);
+    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    float *buffer = malloc(sizeof(float) * 4 * 48 * 48);
+    assert_true(OSMesaMakeCurrent(ctx, buffer, GL_FLOAT, 48, 48));
+    ps_gl_options go = {true, true, 0, false};
+    ps_gl_scene gs = ps_gl_scene_of(s);
+    ps_gl_renderer *gl;
+    ps_gl_specular *spec;
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_create(0, &spec, &err), PS_OK);
+    ps_gl_specular_set_first_round(spec, PS_GL_SPECULAR_FIRST_REFRESHES);
+    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 48, 48);
+    ps_session_frame f;
+    const unsigned quick = (6 + PS_GL_SPECULAR_FIRST_REFRESHES - 1) / PS_GL_SPECULAR_FIRST_REFRESHES;
+    /* The first round's first quick faces (once the cubes are known). */
+    for (int i = 0; i < 3 && ps_gl_specular_faces_rendered(spec) == 0; i++) {
+        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
+    }
+    assert_int_equal(ps_gl_specular_faces_rendered(spec), quick);
+    assert_int_equal(ps_session_lights(s)->shadow_size, PS_SHADOW_SIZE_DEFAULT / PS_SESSION_COARSE_SHADOW_DIVISOR);
+    assert_true(ps_session_refine_lights(s));
+    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+    assert_true(f.lights_changed && f.shadows_refined);
+    gs = ps_gl_scene_of(s);
+    assert_int_equal(ps_gl_renderer_set_scene(gl, &gs, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
+    unsigned faces = 2 * quick;
+    assert_int_equal(ps_gl_specular_faces_rendered(spec), faces);
+    while (faces < 6) { /* the rest of the round */
+        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
+        faces += quick;
+        assert_int_equal(ps_gl_specular_faces_rendered(spec), faces);
+    }
+    /* Shown: budgeted from here. */
+    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
+    assert_true(ps_gl_specular_faces_rendered(spec) <= faces + 1);
+    ps_gl_specular_destroy(spec);
+    ps_gl_renderer_destroy(gl);
+    OSMesaDestroyContext(ctx);
+    free(buffer);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -469,6 +540,7 @@ int main(void)
         cmocka_unit_test(a_settled_round_ends_whole),
         cmocka_unit_test(refined_lights_keep_the_cubes),
         cmocka_unit_test(refined_lights_mid_first_round),
+        cmocka_unit_test(refined_shadows_keep_the_round),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -864,10 +864,16 @@ static void area_lights_refine(void **state)
     ps_camera_frame cam = camera(scene);
     ps_session_frame f;
     const size_t want[3] = {1, 4, PS_PREVIEW_AREA_SAMPLES};
+    /* The first level's shadow maps coarse, the full side with the next
+     * virtual lights (the same level: no level of shadows alone). */
+    const int side = PS_SHADOW_SIZE_DEFAULT, coarse = side / PS_SESSION_COARSE_SHADOW_DIVISOR;
+    const int sides[3] = {coarse, side, side};
     for (int i = 0; i < 3; i++) {
         refresh(s, &cam, &f);
         assert_int_equal(f.lights_changed, i > 0);
+        assert_false(f.shadows_refined);
         assert_int_equal(ps_session_lights(s)->count, want[i]);
+        assert_int_equal(ps_session_lights(s)->shadow_size, sides[i]);
         ps_session_drawn(s, 0.001);
     }
     refresh(s, &cam, &f);
@@ -877,6 +883,7 @@ static void area_lights_refine(void **state)
     ps_session_changes ch;
     assert_int_equal(ps_session_update(s, &ch, &err), PS_OK);
     assert_int_equal(ps_session_lights(s)->count, 1);
+    assert_int_equal(ps_session_lights(s)->shadow_size, side); /* the faces an edit leaves are kept */
     ps_session_destroy(s);
     /* Held (photosplat-snap's 8-bit checkpoints): refreshes keep the level;
      * each ps_session_refine_lights brings the next, until all are there. */
@@ -888,19 +895,95 @@ static void area_lights_refine(void **state)
         assert_int_equal(ps_session_lights(s)->count, 1);
         ps_session_drawn(s, 0.001);
     }
+    const double levels[2] = {4.0 * PS_SESSION_COARSE_SHADOW_COST, 4.0}; /* next_level_cost */
     for (int i = 1; i < 3; i++) {
+        assert_true(ps_session_next_level_lights(s) == 4.0);
+        assert_true(ps_session_next_level_cost(s) == levels[i - 1]);
         assert_true(ps_session_refine_lights(s));
         refresh(s, &cam, &f);
         assert_true(f.lights_changed);
         assert_int_equal(ps_session_lights(s)->count, want[i]);
+        assert_int_equal(ps_session_lights(s)->shadow_size, side);
         ps_session_drawn(s, 0.001);
     }
+    assert_true(ps_session_lights_to_come(s) == 1.0);
+    assert_true(ps_session_next_level_cost(s) == 1.0);
     assert_false(ps_session_refine_lights(s));
     ps_session_destroy(s);
     set.progressive_lights = false;
     s = open_session(scene, &set);
     assert_int_equal(ps_session_lights(s)->count, PS_PREVIEW_AREA_SAMPLES);
     ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
+/* A point light's progressive lights: the first picture's shadow maps at
+ * PS_SESSION_COARSE_SHADOW_DIVISOR fewer texels a side, then the full side
+ * as a level of its own (lights_changed with shadows_refined: the same
+ * lights), a level a drawn refresh or, held, when asked; the last picture's
+ * ps_session_full_lights brings it too. A side too small to halve, and
+ * lights that are not progressive, start whole. */
+static void coarse_shadows_first(void **state)
+{
+    (void)state;
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    const int sides[3] = {1024, 512, PS_SESSION_COARSE_SHADOW_MIN};
+    const int firsts[3] = {1024 / PS_SESSION_COARSE_SHADOW_DIVISOR, 512 / PS_SESSION_COARSE_SHADOW_DIVISOR,
+                           PS_SESSION_COARSE_SHADOW_MIN};
+    for (int k = 0; k < 3; k++) {
+        ps_session_settings set = settings(scene, k != 1);
+        set.progressive_lights = true;
+        set.shadow_size = sides[k];
+        for (int held = 0; held < 2; held++) {
+            ps_session *s = open_session(scene, &set);
+            ps_session_hold_lights(s, held != 0);
+            assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+            refresh(s, &cam, &f);
+            assert_int_equal(ps_session_lights(s)->count, 1);
+            assert_int_equal(ps_session_lights(s)->shadow_size, firsts[k]);
+            bool coarse = firsts[k] < sides[k];
+            assert_true(ps_session_lights_to_come(s) == (coarse ? PS_SESSION_COARSE_SHADOW_COST : 1.0));
+            assert_true(ps_session_next_level_lights(s) == 1.0); /* no area light */
+            assert_true(ps_session_next_level_cost(s) == (coarse ? PS_SESSION_COARSE_SHADOW_COST : 1.0));
+            ps_session_drawn(s, 0.001);
+            if (held) { /* held: the level stays until asked for */
+                refresh(s, &cam, &f);
+                assert_false(f.lights_changed);
+                assert_int_equal(ps_session_lights(s)->shadow_size, firsts[k]);
+                assert_true(ps_session_refine_lights(s) == coarse);
+            }
+            refresh(s, &cam, &f);
+            assert_true(f.lights_changed == coarse && f.shadows_refined == coarse);
+            assert_int_equal(ps_session_lights(s)->shadow_size, sides[k]);
+            assert_true(ps_session_lights_to_come(s) == 1.0);
+            assert_false(ps_session_refine_lights(s));
+            ps_session_drawn(s, 0.001);
+            refresh(s, &cam, &f);
+            assert_false(f.lights_changed);
+            ps_session_destroy(s);
+        }
+        /* The last picture's: every level at once. */
+        ps_session *s = open_session(scene, &set);
+        ps_session_hold_lights(s, true);
+        assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+        refresh(s, &cam, &f);
+        ps_session_full_lights(s);
+        refresh(s, &cam, &f);
+        assert_int_equal(ps_session_lights(s)->shadow_size, sides[k]);
+        ps_session_destroy(s);
+        /* Not progressive: the full side from the first picture. */
+        set.progressive_lights = false;
+        s = open_session(scene, &set);
+        assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+        refresh(s, &cam, &f);
+        assert_int_equal(ps_session_lights(s)->shadow_size, sides[k]);
+        ps_session_destroy(s);
+    }
     ps_scene_destroy(scene);
 }
 
@@ -920,6 +1003,7 @@ int main(void)
         cmocka_unit_test(radius_follows_the_schedule),
         cmocka_unit_test(catch_up_after_the_first_still_refresh),
         cmocka_unit_test(area_lights_refine),
+        cmocka_unit_test(coarse_shadows_first),
         cmocka_unit_test(moving_camera_level_of_detail),
         cmocka_unit_test(moving_growth_held),
         cmocka_unit_test(moving_global_layer_shrunk),

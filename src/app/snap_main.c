@@ -697,9 +697,13 @@ static ps_pace_plan plan_refresh(snap_run *s, double clock, double due, int cp, 
         ps_gl_specular_hold_first_round(s->spec, false);
     s->pace.unheld = ps_gl_specular_unheld_seconds(s->spec, s->session);
     ps_pace_plan plan = ps_pace_next(&s->pace, now, photons, due, s->o->checkpoints + cp, s->o->checkpoint_count - cp);
-    /* Float: the tracer is held until the first picture (refine), so
-     * waiting for it would only idle. */
-    if (s->layers && s->frames == 0)
+    /* The first picture at once. Float: the tracer is held until it is
+     * drawn (refine), so waiting would only idle. 8 bits: waiting for the
+     * first checkpoint let the tracer add photons to it, which it then drew
+     * whole: the default box's first frame (bench's caps, 256^2) drew
+     * 7.7*10^4 splats from 0.05 s and came at 0.34 s; at once, the first
+     * round's 1.9*10^4 at 0.27 s. */
+    if (s->frames == 0)
         plan.start = now;
     return plan;
 }
@@ -758,15 +762,17 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
                 break;
             plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
         }
-        /* The next level of an area light's virtual lights, only when it
-         * keeps the next checkpoint on time. 8 bits: when its shadow cubes
-         * fit in the wait (from the last level's, a light as long), drawn
-         * in a batch not shown; in a checkpoint's frame they made the area
-         * box's 1 s checkpoint land at 1.5-2.3 s. */
+        /* The lights' next level (the full shadow maps, an area light's
+         * next virtual lights: ps_session_next_level_cost), only when it
+         * keeps the next checkpoint on time. 8 bits: when its
+         * shadow cubes fit in the wait (from the last level's, a light as
+         * long), drawn in a batch not shown; in a checkpoint's frame they
+         * made the area box's 1 s checkpoint land at 1.5-2.3 s. */
         if (s->lights_held && s->shadow_per_light > 0.0 && cp < o->checkpoint_count) {
             unsigned lights = ps_gl_get_stats(s->gl).virtual_lights;
             double wait = clock + plan.start - ps_now_seconds();
-            if (!s->layers && wait > 4.0 * lights * s->shadow_per_light + s->pace.seconds &&
+            double cost = ps_session_next_level_cost(s->session), shadows = lights * s->shadow_per_light;
+            if (!s->layers && wait > cost * shadows + s->pace.seconds &&
                 ps_session_refine_lights(s->session)) {
                 st = unseen_batch(s, err);
                 if (st != PS_OK)
@@ -774,15 +780,20 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
                 plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);
             }
             /* Float: the next refresh draws them when it ends before the
-             * next checkpoint, taken as 4x the last refresh with new lights
-             * (4x the lights: their shadow cubes and lit passes; its cube
-             * faces left out). A refresh that took the area box's lights
+             * next checkpoint, taken as the last refresh with new lights
+             * (its cube faces left out), its shadow maps at the level's cost
+             * and the rest at its virtual lights' multiple (4x the lights:
+             * their shadow cubes and lit passes; the full shadows alone
+             * cost their maps, the default box's 0.05 s more, not a
+             * refresh more). A refresh that took the area box's lights
              * from 4 to 16 ended 0.3-0.4 s after a 0.5 s checkpoint at 64^2;
              * the shadow cubes alone, predicted, left the 1 s one 14-17 % late.
              * Never in the checkpoint's frame: with points, whose first frame
              * was quick, the refinement from 1 to 4 rode in it and its 0.5 s
              * checkpoint landed at 0.69-0.73 s. */
-            if (s->layers && !plan.shows && ps_now_seconds() + 4.0 * s->lit_seconds < clock + o->checkpoints[cp])
+            double next_lit = ps_session_next_level_lights(s->session) * fmax(0.0, s->lit_seconds - shadows) +
+                              cost * shadows;
+            if (s->layers && !plan.shows && ps_now_seconds() + next_lit < clock + o->checkpoints[cp])
                 ps_session_refine_lights(s->session);
         }
         /* Every checkpoint shown: the lights grow a level a refresh again. */

@@ -253,10 +253,17 @@ ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err)
     ps_gl_object_sig *old = r->object_sigs;
     size_t old_count = r->object_sig_count;
     r->object_sigs = object_sigs(r->in.coarse, &r->object_sig_count);
-    /* The same number of GL lights: their textures are kept, and so are the
-     * faces no change can reach. Otherwise (or without the signatures, out
-     * of memory) every face is rendered again. */
-    if (n > 0 && n == r->shadow_lights && old && r->object_sigs) {
+    /* The side the lights were planned at: a session's first picture has
+     * coarse shadows, and its lights come again at the full side
+     * (preview/session.h). */
+    int size = lights_of(r)->shadow_size > 0 ? lights_of(r)->shadow_size
+                                              : r->opt.shadow_size > 0 ? r->opt.shadow_size : PS_GL_SHADOW_SIZE;
+    bool resized = size != r->shadow_size;
+    r->shadow_size = size;
+    /* The same number of GL lights at the same side: their textures are
+     * kept, and so are the faces no change can reach. Otherwise (or without
+     * the signatures, out of memory) every face is rendered again. */
+    if (n > 0 && n == r->shadow_lights && old && r->object_sigs && !resized) {
         keep_fresh_faces(r, old, old_count);
     } else {
         free_shadows(r);

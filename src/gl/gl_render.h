@@ -47,7 +47,8 @@ typedef struct ps_gl_renderer ps_gl_renderer;
 typedef struct ps_gl_options {
     bool shadows;      /* default true */
     bool float_buffer; /* the colour buffer keeps floats: no clamping anywhere */
-    int shadow_size;   /* shadow maps' side in texels; 0: PS_GL_SHADOW_SIZE */
+    int shadow_size;   /* shadow maps' side in texels where the lights plan none
+                          (ps_preview_lights.shadow_size 0); 0: PS_GL_SHADOW_SIZE */
     bool whole_face_passes; /* tests: every object in every shadowed face's lit
                              * pass, and mirrors and glass in every lit pass
                              * (default false: those outside the face's

@@ -378,7 +378,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     /* What the cubes show changed: a new round. */
     unsigned layers = ps_session_get_settings(s)->layers;
     bool other = layers != g->layers || ps_session_edits(s) != g->edits || ps_session_maps_epoch(s) != g->epoch;
-    if (other || f->lights_changed) {
+    if (other || (f->lights_changed && !f->shadows_refined)) {
         if (other)
             g->shown = 0;
         g->layers = layers;

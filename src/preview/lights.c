@@ -230,6 +230,7 @@ ps_status ps_preview_lights_build(const ps_scene *s, const ps_accel *accel, cons
                                   int shadow_size, int area_side, ps_preview_lights *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
+    out->shadow_size = shadow_size > 0 ? shadow_size : 0;
     int side = area_side < 1 ? 1 : area_side > PS_PREVIEW_AREA_SIDE ? PS_PREVIEW_AREA_SIDE : area_side;
     builder b = {s, out, 0, side};
     size_t n;

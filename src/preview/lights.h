@@ -100,6 +100,7 @@ typedef struct ps_preview_lights {
     ps_preview_profile *profiles;
     size_t profile_count;
     uint64_t shadow_faces; /* lit faces of all lights: the shadow maps drawn */
+    int shadow_size;       /* their side in texels, as planned (0: no shadows) */
 } ps_preview_lights;
 
 /* The near plane of a shadow cube: this share of the distance from the light
@@ -124,7 +125,8 @@ typedef struct ps_preview_lights {
  * scene's ray accelerator, ps_accel_nearest_distance: exact spheres, which
  * lie nearer than their tessellation, so nothing the depth pass draws is
  * clipped) or, given NULL, from brute force over `coarse` (its depth-only
- * mesh). shadow_size: the shadow maps' side in texels, 0 for none;
+ * mesh). shadow_size: the shadow maps' side in texels (src/gl draws them
+ * at out->shadow_size), 0 for none;
  * their memory and the sphere meshes' are planned against the budget first
  * (PS_ERR_LIMIT names the scene). out is overwritten; on error it is empty. */
 ps_status ps_preview_lights_build(const ps_scene *s, const ps_accel *accel, const ps_preview_mesh *coarse,

@@ -29,8 +29,10 @@ struct ps_session {
     ps_splat_batch batch[PS_MAP_COUNT];
     bool illuminance;      /* white Lambertian, exposure 1, float (ps_session_set_illuminance) */
     int area_side;         /* an area light's virtual lights a side, refined up to PS_PREVIEW_AREA_SIDE */
-    bool lights_pending;   /* area_side grew: lights to rebuild at the next refresh */
-    bool lights_held;      /* area_side grows only by ps_session_refine_lights */
+    bool coarse_shadows;   /* the lights' shadow maps at the first picture's side (session.h) */
+    int built_side;        /* the area_side the lights were last built at */
+    bool lights_pending;   /* a level refined: lights to rebuild at the next refresh */
+    bool lights_held;      /* the levels grow only by ps_session_refine_lights */
     ps_material *white;    /* as many as the scene's, for illuminance mode */
     /* Invariant: drawn[k] photons of map k (a prefix ending at a feed mark,
      * drawn_emitted[k] emitted) are in the layers since the last new view. */
@@ -181,11 +183,25 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
     return st;
 }
 
+/* A progressive start's first shadow side (session.h): size itself where
+ * it is no larger than the least. */
+static int coarse_shadow_size(int size)
+{
+    int coarse = size / PS_SESSION_COARSE_SHADOW_DIVISOR;
+    if (coarse >= PS_SESSION_COARSE_SHADOW_MIN)
+        return coarse;
+    return size < PS_SESSION_COARSE_SHADOW_MIN ? size : PS_SESSION_COARSE_SHADOW_MIN;
+}
+
 static ps_status build_lights(ps_session *s, ps_error *err)
 {
     ps_preview_lights_free(&s->lights);
-    return ps_preview_lights_build(s->scene, ps_world_accel(s->world), &s->coarse, s->set.shadow_size, s->area_side,
-                                   &s->lights, err);
+    int size = s->set.shadow_size;
+    if (s->coarse_shadows)
+        size = coarse_shadow_size(size);
+    s->built_side = s->area_side;
+    return ps_preview_lights_build(s->scene, ps_world_accel(s->world), &s->coarse, size, s->area_side, &s->lights,
+                                   err);
 }
 
 static void free_maps(ps_session *s)
@@ -305,6 +321,8 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
     for (int k = 0; k < PS_MAP_COUNT; k++)
         s->whole_most[k] = HUGE_VAL;
     s->area_side = set->progressive_lights ? 1 : PS_PREVIEW_AREA_SIDE;
+    s->coarse_shadows = set->progressive_lights && set->shadow_size > 0 &&
+                        coarse_shadow_size(set->shadow_size) < set->shadow_size;
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_splat_batch_init(&s->batch[k]);
         /* Whole refreshes' batches grow with the maps; incremental ones hold
@@ -636,10 +654,12 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     ps_feed_unlock(s->feed);
     if (s->lights_pending) {
         s->lights_pending = false;
+        int side = s->built_side;
         ps_status lst = build_lights(s, err);
         if (lst != PS_OK)
             return lst;
         out->lights_changed = true;
+        out->shadows_refined = s->built_side == side;
     }
     s->last_lit = out->lights_changed;
     out->new_view = s->view_dirty;
@@ -786,8 +806,9 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
 
 void ps_session_full_lights(ps_session *s)
 {
-    if (s->area_side < PS_PREVIEW_AREA_SIDE) {
+    if (ps_session_lights_to_come(s) > 1.0) {
         s->area_side = PS_PREVIEW_AREA_SIDE;
+        s->coarse_shadows = false;
         s->lights_pending = true;
     }
 }
@@ -835,28 +856,49 @@ void ps_session_drawn(ps_session *s, double draw_seconds)
     }
     s->first_pending = false;
     apply_pause(s);
-    /* Progressive area lights: a refresh drawn, the next one with twice as
-     * many virtual lights a side, until all (only when the scene has an area
-     * light: the others' GL lights do not change). */
+    /* Progressive lights: a refresh drawn, the next one a level further
+     * (twice as many virtual lights a side where the scene has an area
+     * light, the full shadow maps), until all. */
     if (!s->lights_held)
         ps_session_refine_lights(s);
 }
 
 void ps_session_hold_lights(ps_session *s, bool held) { s->lights_held = held; }
 
+/* Whether the next level brings twice the virtual lights a side. */
+static bool more_virtual_lights(const ps_session *s)
+{
+    return s->area_side < PS_PREVIEW_AREA_SIDE && has_area_lights(s);
+}
+
 double ps_session_lights_to_come(const ps_session *s)
 {
-    if (s->area_side >= PS_PREVIEW_AREA_SIDE || !has_area_lights(s))
-        return 1.0;
+    double shadows = s->coarse_shadows ? PS_SESSION_COARSE_SHADOW_COST : 1.0;
+    if (!more_virtual_lights(s))
+        return shadows;
     double ratio = (double)PS_PREVIEW_AREA_SIDE / (double)s->area_side;
-    return ratio * ratio;
+    return shadows * ratio * ratio;
+}
+
+double ps_session_next_level_lights(const ps_session *s) { return more_virtual_lights(s) ? 4.0 : 1.0; }
+
+double ps_session_next_level_cost(const ps_session *s)
+{
+    double cost = ps_session_next_level_lights(s);
+    return s->coarse_shadows ? cost * PS_SESSION_COARSE_SHADOW_COST : cost;
 }
 
 bool ps_session_refine_lights(ps_session *s)
 {
     if (ps_session_lights_to_come(s) <= 1.0)
         return false;
-    s->area_side *= 2;
+    /* The full shadows come with the first new virtual lights, in the same
+     * level: a level of its own held an area light's next one back a refresh,
+     * and that one starts the specular cubes' round over (gl_specular.c),
+     * which the area box's 8-bit 1 s checkpoint then showed black. */
+    if (more_virtual_lights(s))
+        s->area_side *= 2;
+    s->coarse_shadows = false;
     s->lights_pending = true;
     return true;
 }
@@ -1084,7 +1126,8 @@ ps_status ps_session_update(ps_session *s, ps_session_changes *changes, ps_error
         if (st == PS_OK && s->set.global_layer == PS_GLOBAL_MAPS)
             st = imap_make(s, err);
     }
-    /* The first picture after the edit as soon as after loading. */
+    /* The first picture after the edit as soon as after loading (its shadow
+     * maps at the side they have: faces the edit cannot reach are kept). */
     s->area_side = s->set.progressive_lights ? 1 : PS_PREVIEW_AREA_SIDE;
     s->lights_pending = false;
     if (st == PS_OK)

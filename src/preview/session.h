@@ -169,11 +169,13 @@ typedef struct ps_session_settings {
                                     * waits, as in photosplat-snap) */
     int shadow_size;               /* the GL lights' shadow maps (texels a side), 0: none;
                                     * only planned here, against the memory budget */
-    bool progressive_lights;       /* area lights start as one virtual light each and
-                                    * refine to PS_PREVIEW_AREA_SAMPLES over the first
-                                    * refreshes (after loading and after each edit), so
-                                    * that the first picture does not wait for all their
-                                    * shadow cubes; else all from the start */
+    bool progressive_lights;       /* the first picture sooner: its shadow maps coarse
+                                    * (PS_SESSION_COARSE_SHADOW_DIVISOR), area lights as
+                                    * one virtual light each, refined a level a refresh
+                                    * (the full shadows, with 2 x 2 virtual lights, then
+                                    * PS_PREVIEW_AREA_SAMPLES; area lights again after each
+                                    * edit), so that the first picture does not wait
+                                    * for every shadow cube; else all from the start */
     ps_global_layer global_layer;  /* the global layer as splats or as illumination maps
                                     * (illummap.h) with only the glossy lobes splatted */
     bool repair;                   /* edits keep the photons they cannot change (repair.h):
@@ -188,6 +190,24 @@ typedef struct ps_session_settings {
                                     * hold at most this many at 256^2, in proportion to the
                                     * view's pixels (PS_SESSION_EDIT_SPLATS_WHOLE) */
 } ps_session_settings;
+
+/* A progressive start's first shadow maps: this many times fewer texels a
+ * side than settings.shadow_size, never fewer than
+ * PS_SESSION_COARSE_SHADOW_MIN (snap's 1024 as 512, the window's 512 as
+ * 256). A shadow face is a depth texture faulted in page by page (about
+ * 10 us a 4 KiB page here): the default box's six 1024^2 faces took 0.10 s
+ * of its first float picture at 256^2, which came at 0.26 s; at 512^2 it came
+ * at 0.18 s, its direct layer at relMSE 0.0039 against the reference
+ * (0.0036 at 1024^2); at 256^2 0.17 s, but the ring's direct layer went from
+ * 0.026 to 0.11 (0.041 at 512^2). Refined at the next level
+ * (ps_session_refine_lights), once: after an edit the lights keep the full
+ * side, so that the faces the edit cannot reach are kept (src/gl). */
+#define PS_SESSION_COARSE_SHADOW_DIVISOR 2
+#define PS_SESSION_COARSE_SHADOW_MIN 128
+/* The full shadow maps' time against the coarse ones' (the default box:
+ * 0.097 s against 0.05 s at 512^2): the next level's cost
+ * (ps_session_next_level_cost), and ps_session_lights_to_come's factor. */
+#define PS_SESSION_COARSE_SHADOW_COST 2.0
 
 /* Defaults: the scene's photon counts and radii, every layer, triangles, the
  * cone kernel, 8 bits with error diffusion, fixed radius, exposure 1, whole
@@ -255,6 +275,11 @@ typedef struct ps_session_frame {
      * renderer ps_gl_scene_of again; the direct layer is to be drawn again
      * (implied by new_view), the map layers kept. */
     bool lights_changed;
+    /* ... by their shadow maps' side alone (a progressive start's coarse
+     * shadows refined): the same lights, so the specular layer's cube faces
+     * keep their round (a new round lost the default box's 9 faces of 12
+     * drawn, and its mirror stayed black past the 1 s checkpoint). */
+    bool shadows_refined;
     bool direct;             /* the direct layer is shown (else the scene is drawn black) */
     bool specular;           /* the specular layer is shown and the scene has mirrors or glass:
                               * its lookups are traced for this camera (ps_session_specular) */
@@ -283,8 +308,8 @@ typedef struct ps_session_frame {
 /* Builds this refresh's splats for camera cam (a camera unlike the last
  * refresh's starts a new view). Briefly holds the feed's lock. */
 ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_session_frame *out, ps_error *err);
-/* Progressive area lights: all their virtual lights from the next refresh on
- * (a snapshot's last picture). */
+/* Progressive lights: the full shadow maps and every virtual light from the
+ * next refresh on (a snapshot's last picture). */
 void ps_session_full_lights(ps_session *s);
 /* Whether progressive area lights grow only when asked (ps_session_refine_lights)
  * instead of a level a refresh: photosplat-snap's checkpoints refine them
@@ -292,12 +317,20 @@ void ps_session_full_lights(ps_session *s);
  * 256^2) keep the next checkpoint on time (8 bits: in the waits between
  * frames), not in a checkpoint's frame. */
 void ps_session_hold_lights(ps_session *s, bool held);
-/* Twice the virtual lights a side from the next refresh on; false when all
- * are there (or the scene has no area light). */
+/* The next level from the next refresh on: twice the virtual lights a side
+ * (area lights), and the full shadow maps if they are coarse; false when
+ * all are there. */
 bool ps_session_refine_lights(ps_session *s);
-/* Progressive area lights: the virtual lights ps_session_full_lights would
- * draw, as a multiple of those drawn now (1: all there, or none). */
+/* Progressive lights: what ps_session_full_lights would draw, as a multiple
+ * of what is drawn now (virtual lights, times PS_SESSION_COARSE_SHADOW_COST
+ * while the shadows are coarse; 1: all there). */
 double ps_session_lights_to_come(const ps_session *s);
+/* The next level's virtual lights as a multiple of those drawn now (4 for
+ * twice as many a side, else 1), and what its shadow maps cost as a
+ * multiple of the current ones' (that, times PS_SESSION_COARSE_SHADOW_COST
+ * while the shadows are coarse). */
+double ps_session_next_level_lights(const ps_session *s);
+double ps_session_next_level_cost(const ps_session *s);
 /* After the refresh's splats were drawn, in draw_seconds (finished, not only
  * queued): the budget for the next, a held feed let go, and the error
  * counter's verdict (which pauses tracing). */
