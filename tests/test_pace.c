@@ -351,6 +351,26 @@ static void unheld_faces_stay_out_of_the_checkpoints_frame(void **state)
     assert_true(isfinite(p.faces_deadline) && p.faces_deadline > 1.0 && p.faces_deadline < cp * (1.0 + PS_PACE_FACES_LATE));
 }
 
+/* tau's schedule (ps_pace_next_due): refreshes on time keep it (due + tau),
+ * late ones catch up on it, and a burst of refreshes that take no time
+ * (empty ones aimed at a checkpoint still ahead) leaves the next due at
+ * most tau from now, not tau times their number (the ring's next refresh
+ * after such a burst was due at the run's end). */
+static void the_schedule_stays_within_tau(void **state)
+{
+    (void)state;
+    const double tau = 0.1;
+    assert_true(fabs(ps_pace_next_due(1.0, 1.05, tau) - 1.1) < 1e-12); /* on time: the schedule */
+    assert_true(fabs(ps_pace_next_due(1.0, 1.35, tau) - 1.1) < 1e-12); /* late: catches up */
+    double due = 0.3, now = 0.1992;
+    for (int i = 0; i < 500; i++) {
+        due = ps_pace_next_due(due, now, tau);
+        now += 1e-6;
+        assert_true(due <= now + tau);
+    }
+    assert_true(due > now);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -364,6 +384,7 @@ int main(void)
         cmocka_unit_test(a_frame_draws_what_fits_from_its_start),
         cmocka_unit_test(float_checkpoint_frames_draw_a_share),
         cmocka_unit_test(unheld_faces_stay_out_of_the_checkpoints_frame),
+        cmocka_unit_test(the_schedule_stays_within_tau),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

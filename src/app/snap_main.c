@@ -881,7 +881,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             if (st != PS_OK)
                 break;
         }
-        next += o->p.tau;
+        next = ps_pace_next_due(next, ps_now_seconds(), o->p.tau);
         /* Every photon traced, or the error counter stopped the tracer:
          * checkpoints still to come get their own frames, on time, and the
          * last picture follows. (An 8-bit redraw of them all takes seconds;
