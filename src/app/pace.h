@@ -136,6 +136,9 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
  * went 2-3x faster, and the frame drew all it found: the ring's 0.5 s
  * checkpoint, planned at 1.1-2.0*10^5 photons, drew 2.4-4.1*10^5 and landed
  * at 0.68-0.90 s. */
+double ps_pace_photons_at_start(const ps_pace_model *m, const ps_pace_plan *planned, double now, double photons,
+                                double due, const double *pending, int count);
+
 /* tau's schedule: the refresh after one that ended at `now`, the last due at
  * `due`: tau after that, never more than tau after now. (Adding tau at every
  * refresh let a burst of refreshes run the schedule ahead: the ring's first
@@ -145,8 +148,5 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
  * checkpoints, the tracer waited for a picture that did not come, and the
  * 3 s checkpoint showed 1.3*10^5 photons where other runs showed 2.3*10^6.) */
 double ps_pace_next_due(double due, double now, double tau);
-
-double ps_pace_photons_at_start(const ps_pace_model *m, const ps_pace_plan *planned, double now, double photons,
-                                double due, const double *pending, int count);
 
 #endif

@@ -784,8 +784,8 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
              * (its cube faces left out), its shadow maps at the level's cost
              * and the rest at its virtual lights' multiple (4x the lights:
              * their shadow cubes and lit passes; the full shadows alone
-             * cost their maps, the default box's 0.05 s more, not a
-             * refresh more). A refresh that took the area box's lights
+             * cost their maps, the default box's six faces 0.10 s at
+             * 1024^2, not four refreshes). A refresh that took the area box's lights
              * from 4 to 16 ended 0.3-0.4 s after a 0.5 s checkpoint at 64^2;
              * the shadow cubes alone, predicted, left the 1 s one 14-17 % late.
              * Never in the checkpoint's frame: with points, whose first frame
