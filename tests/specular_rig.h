@@ -26,18 +26,34 @@ typedef struct rig {
     int w, h;
 } rig;
 
-static void rig_make(rig *r, ps_scene *scene, int w, int h)
+/* refining: a session with progressive lights, held (refined only when
+ * asked), its tracer started and held but not paused (photons still to
+ * come: never settled), the specular layer's first round over
+ * PS_GL_SPECULAR_FIRST_REFRESHES refreshes, for the rounds of cube faces as
+ * lights are refined; else no photons at all. */
+static void rig_make_as(rig *r, ps_scene *scene, int w, int h, bool refining)
 {
     memset(r, 0, sizeof *r);
     ps_error err;
     r->scene = scene;
     r->w = w, r->h = h;
     ps_session_settings set = ps_session_default_settings(scene);
-    set.caps[0] = set.caps[1] = 0; /* no photons */
     set.float_buffer = true;
-    set.precision = PS_PRECISION_NONE;
+    if (refining) {
+        set.caps[0] = 1000000, set.caps[1] = 100000;
+        set.incremental = set.progressive_lights = true;
+    } else {
+        set.caps[0] = set.caps[1] = 0;
+        set.precision = PS_PRECISION_NONE;
+    }
     assert_int_equal(ps_session_create(scene, &set, &r->session, &err), PS_OK);
-    assert_int_equal(ps_session_trace_all(r->session, &err), PS_OK);
+    if (refining) {
+        ps_session_hold_lights(r->session, true);
+        assert_int_equal(ps_session_start(r->session, true, &err), PS_OK);
+        ps_session_hold(r->session, true);
+    } else {
+        assert_int_equal(ps_session_trace_all(r->session, &err), PS_OK);
+    }
     r->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
     assert_non_null(r->ctx);
     r->buffer = malloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
@@ -46,8 +62,12 @@ static void rig_make(rig *r, ps_scene *scene, int w, int h)
     ps_gl_scene gs = ps_gl_scene_of(r->session);
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(r->session), &go, &r->gl, &err), PS_OK);
     assert_int_equal(ps_gl_specular_create(0, &r->spec, &err), PS_OK);
+    if (refining)
+        ps_gl_specular_set_first_round(r->spec, PS_GL_SPECULAR_FIRST_REFRESHES);
     r->cam = ps_camera_frame_make(ps_scene_camera(scene), w, h);
 }
+
+static void rig_make(rig *r, ps_scene *scene, int w, int h) { rig_make_as(r, scene, w, h, false); }
 
 static void rig_free(rig *r)
 {

@@ -391,59 +391,38 @@ static void refined_lights(bool mid_round)
                                             "sphere center 0 0.5 -0.5 radius 0.3 material mirror\n"
                                             "light quad corner -0.25 1.5 -0.75 edge1 0.5 0 0 edge2 0 0 0.5 power 50 50 50\n");
     ps_error err;
-    ps_session_settings set = ps_session_default_settings(scene);
-    set.caps[0] = 1000000, set.caps[1] = 100000; /* never all there: not settled */
-    set.float_buffer = set.incremental = true;
-    set.progressive_lights = true;
-    ps_session *s;
-    assert_int_equal(ps_session_create(scene, &set, &s, &err), PS_OK);
-    ps_session_hold_lights(s, true);
-    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
-    ps_session_hold(s, true); /* held, not paused: photons still to come */
-    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    float *buffer = malloc(sizeof(float) * 4 * 48 * 48);
-    assert_true(OSMesaMakeCurrent(ctx, buffer, GL_FLOAT, 48, 48));
-    ps_gl_options go = {true, true, 0, false};
-    ps_gl_scene gs = ps_gl_scene_of(s);
-    ps_gl_renderer *gl;
-    ps_gl_specular *spec;
-    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_create(0, &spec, &err), PS_OK);
-    ps_gl_specular_set_first_round(spec, PS_GL_SPECULAR_FIRST_REFRESHES);
-    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 48, 48);
+    rig r;
+    rig_make_as(&r, scene, 48, 48, true);
+    ps_session *s = r.session;
     ps_session_frame f;
+    ps_gl_scene gs;
     /* The first round: the one cube, quick, over the first refreshes. */
-    for (int i = 0; i < 2 + PS_GL_SPECULAR_FIRST_REFRESHES && ps_gl_specular_faces_rendered(spec) < 6; i++) {
-        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
-        assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
+    for (int i = 0; i < 2 + PS_GL_SPECULAR_FIRST_REFRESHES && ps_gl_specular_faces_rendered(r.spec) < 6; i++) {
+        assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
     }
-    unsigned before = ps_gl_specular_faces_rendered(spec);
+    unsigned before = ps_gl_specular_faces_rendered(r.spec);
     assert_int_equal(before, 6);
     /* Four virtual lights: a budgeted face at most, not a first round's
      * (mid_round: the second cube's faces, 3 a refresh, until it is shown). */
     assert_true(ps_session_refine_lights(s));
-    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+    assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
     assert_true(f.lights_changed && !f.new_view);
     gs = ps_gl_scene_of(s);
-    assert_int_equal(ps_gl_renderer_set_scene(gl, &gs, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
+    assert_int_equal(ps_gl_renderer_set_scene(r.gl, &gs, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
     if (!mid_round) {
-        assert_true(ps_gl_specular_faces_rendered(spec) <= before + 1);
+        assert_true(ps_gl_specular_faces_rendered(r.spec) <= before + 1);
     } else {
-        assert_int_equal(ps_gl_specular_faces_rendered(spec), before + 3);
-        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
-        assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
-        assert_int_equal(ps_gl_specular_faces_rendered(spec), before + 6); /* shown: the round is over */
-        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
-        assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
-        assert_true(ps_gl_specular_faces_rendered(spec) <= before + 7); /* budgeted from here */
+        assert_int_equal(ps_gl_specular_faces_rendered(r.spec), before + 3);
+        assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_faces_rendered(r.spec), before + 6); /* shown: the round is over */
+        assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
+        assert_true(ps_gl_specular_faces_rendered(r.spec) <= before + 7); /* budgeted from here */
     }
-    ps_gl_specular_destroy(spec);
-    ps_gl_renderer_destroy(gl);
-    OSMesaDestroyContext(ctx);
-    free(buffer);
-    ps_session_destroy(s);
-    ps_scene_destroy(scene);
+    rig_free(&r);
 }
 
 static void refined_lights_keep_the_cubes(void **state)
@@ -473,60 +452,38 @@ static void refined_shadows_keep_the_round(void **state)
                                 "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0 material white\n"
                                 "sphere center 0 0.5 -0.5 radius 0.3 material mirror\n"
                                 "light point position 0 1.5 -0.5 power 50 50 50\n");
-    ps_error err;
-    ps_session_settings set = ps_session_default_settings(scene);
-    set.caps[0] = 1000000, set.caps[1] = 100000; /* never all there: not settled */
-    set.float_buffer = set.incremental = true;
-    set.progressive_lights = true;
-    ps_session *s;
-    assert_int_equal(ps_session_create(scene, &set, &s, &err), PS_OK);
-    ps_session_hold_lights(s, true);
-    assert_int_equal(ps_session_start(s, true, &err), PS_OK);
-    ps_session_hold(s, true);
-    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    float *buffer = malloc(sizeof(float) * 4 * 48 * 48);
-    assert_true(OSMesaMakeCurrent(ctx, buffer, GL_FLOAT, 48, 48));
-    ps_gl_options go = {true, true, 0, false};
-    ps_gl_scene gs = ps_gl_scene_of(s);
-    ps_gl_renderer *gl;
-    ps_gl_specular *spec;
-    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_create(0, &spec, &err), PS_OK);
-    ps_gl_specular_set_first_round(spec, PS_GL_SPECULAR_FIRST_REFRESHES);
-    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 48, 48);
-    ps_session_frame f;
     const unsigned quick = (6 + PS_GL_SPECULAR_FIRST_REFRESHES - 1) / PS_GL_SPECULAR_FIRST_REFRESHES;
+    rig r;
+    rig_make_as(&r, scene, 48, 48, true);
+    ps_session *s = r.session;
+    ps_session_frame f;
+    ps_error err;
     /* The first round's first quick faces (once the cubes are known). */
-    for (int i = 0; i < 3 && ps_gl_specular_faces_rendered(spec) == 0; i++) {
-        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
-        assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
+    for (int i = 0; i < 3 && ps_gl_specular_faces_rendered(r.spec) == 0; i++) {
+        assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
     }
-    assert_int_equal(ps_gl_specular_faces_rendered(spec), quick);
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), quick);
     assert_int_equal(ps_session_lights(s)->shadow_size, PS_SHADOW_SIZE_DEFAULT / PS_SESSION_COARSE_SHADOW_DIVISOR);
     assert_true(ps_session_refine_lights(s));
-    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+    assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
     assert_true(f.lights_changed && f.shadows_refined);
-    gs = ps_gl_scene_of(s);
-    assert_int_equal(ps_gl_renderer_set_scene(gl, &gs, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
+    ps_gl_scene gs = ps_gl_scene_of(s);
+    assert_int_equal(ps_gl_renderer_set_scene(r.gl, &gs, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
     unsigned faces = 2 * quick;
-    assert_int_equal(ps_gl_specular_faces_rendered(spec), faces);
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), faces);
     while (faces < 6) { /* the rest of the round */
-        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
-        assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
+        assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
         faces += quick;
-        assert_int_equal(ps_gl_specular_faces_rendered(spec), faces);
+        assert_int_equal(ps_gl_specular_faces_rendered(r.spec), faces);
     }
     /* Shown: budgeted from here. */
-    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_refresh(spec, gl, s, &f, 1, &err), PS_OK);
-    assert_true(ps_gl_specular_faces_rendered(spec) <= faces + 1);
-    ps_gl_specular_destroy(spec);
-    ps_gl_renderer_destroy(gl);
-    OSMesaDestroyContext(ctx);
-    free(buffer);
-    ps_session_destroy(s);
-    ps_scene_destroy(scene);
+    assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
+    assert_true(ps_gl_specular_faces_rendered(r.spec) <= faces + 1);
+    rig_free(&r);
 }
 
 int main(void)
