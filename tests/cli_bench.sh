@@ -96,7 +96,7 @@ awk -F, 'NR > 1 && ($3 > 1.5 * $2 || $3 < $2 || $4 < n) { print "checkpoint " $2
 # first checkpoint (app/snap_main.c, plan_refresh): waiting let the tracer
 # add photons that the first frame then drew whole, and the default box's
 # came at 0.34 s with 7.7*10^4 of them (0.27 s at once, 2*10^4). With tau
-# 3 s the build before drew it at 3 s; under the sanitizers beside two busy
+# 3 s the build before drew it at 3.6 s; under the sanitizers beside two busy
 # loops a first frame took up to 1.9 s.
 expect_success "8-bit first picture at once" "$snap" "$mirror" --size 32x32 --time 3.2 --tau 3 --color-depth 8 \
     --stats "$cli_tmp/f8.json" -o "$cli_tmp/f8.png"
