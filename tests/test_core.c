@@ -555,6 +555,38 @@ static void large_arrays(void **state)
     ps_memory_large_free(NULL, 0);
 }
 
+/* ps_memory_reserve_large_heap: the heap grown at once by what was asked,
+ * clamped to a quarter of the memory budget (256 MiB here, so 64 of the
+ * 1024 asked), kept at its top (glibc's releasable top, keepcost); a 16 MiB
+ * block then comes from the heap, not a mapping of its own (glibc's mapped
+ * blocks), inside the part advised for huge pages (VmFlags "hg"). */
+static void large_heap(void **state)
+{
+    (void)state;
+#if defined(__GLIBC__) && defined(__linux__) && !defined(__SANITIZE_ADDRESS__)
+    const size_t mib = (size_t)1 << 20;
+    setenv(PS_MEMORY_LIMIT_ENV, "256M", 1);
+    ps_memory_reserve_large_heap(1024 * mib);
+    unsetenv(PS_MEMORY_LIMIT_ENV);
+    size_t kept = mallinfo2().keepcost;
+    assert_true(kept >= 64 * mib);
+    assert_true(kept < 128 * mib); /* clamped: not the 1 GiB asked */
+    size_t mapped = mallinfo2().hblks;
+    unsigned char *b = malloc(16 * mib);
+    assert_non_null(b);
+    assert_int_equal(mallinfo2().hblks, mapped);
+    memset(b, 1, 16 * mib);
+    char flags[512];
+    vm_flags_of(b + 8 * mib, flags, sizeof flags);
+    if (access("/sys/kernel/mm/transparent_hugepage/enabled", F_OK) == 0 && !strstr(flags, " hg"))
+        fail_msg("a block from the reserved heap: VmFlags%s", flags);
+    free(b);
+    ps_memory_set_drawing_policy(); /* the other tests' allocator as before */
+#else
+    skip();
+#endif
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -571,6 +603,7 @@ int main(void)
         cmocka_unit_test(memory_budget),
         cmocka_unit_test(drawing_policy),
         cmocka_unit_test(large_arrays),
+        cmocka_unit_test(large_heap),
         cmocka_unit_test(output_checks),
         cmocka_unit_test(cancel_flag_across_threads), cmocka_unit_test(interrupt_flag),
     };

@@ -440,7 +440,8 @@ static void refined_lights_mid_first_round(void **state)
 /* A progressive start's coarse shadow maps refined mid-way through the
  * first round (the same lights: ps_session_frame.shadows_refined) keep the
  * round: its faces drawn before count, and the cube is shown once all six
- * are drawn, after which faces come a budgeted one a refresh. (A new round
+ * are drawn (ps_gl_specular_all_shown, false until then), after which faces
+ * come a budgeted one a refresh. (A new round
  * there lost the default box's drawn faces, and its mirror stayed black
  * past the 1 s checkpoint.) */
 static void refined_shadows_keep_the_round(void **state)
@@ -464,6 +465,7 @@ static void refined_shadows_keep_the_round(void **state)
         assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
     }
     assert_int_equal(ps_gl_specular_faces_rendered(r.spec), quick);
+    assert_false(ps_gl_specular_all_shown(r.spec, s)); /* the mirror still black */
     assert_int_equal(ps_session_lights(s)->shadow_size, PS_SHADOW_SIZE_DEFAULT / PS_SESSION_COARSE_SHADOW_DIVISOR);
     assert_true(ps_session_refine_lights(s));
     assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
@@ -474,11 +476,13 @@ static void refined_shadows_keep_the_round(void **state)
     unsigned faces = 2 * quick;
     assert_int_equal(ps_gl_specular_faces_rendered(r.spec), faces);
     while (faces < 6) { /* the rest of the round */
+        assert_false(ps_gl_specular_all_shown(r.spec, s));
         assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
         assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
         faces += quick;
         assert_int_equal(ps_gl_specular_faces_rendered(r.spec), faces);
     }
+    assert_true(ps_gl_specular_all_shown(r.spec, s)); /* its six faces: the map shown */
     /* Shown: budgeted from here. */
     assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
     assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);

@@ -847,6 +847,63 @@ static void catch_up_after_the_first_still_refresh(void **state)
     ps_scene_destroy(scene);
 }
 
+/* The refreshes after a stop wait for no tau (ps_session_catching_up) only
+ * while the view is drawn again and nothing is traced: not while moving, not
+ * once the view is whole, not while the tracer runs (unless paused). */
+static void catching_up_only_when_nothing_is_traced(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_camera_frame cam;
+    ps_session_frame f;
+    double rate, built;
+    ps_session *s = at_budget(scene, 8, 1.6, &cam, &f, &rate, &built); /* traced to the end */
+    assert_false(ps_session_catching_up(s));
+    cam.eye.x += 0.05;
+    refresh(s, &cam, &f);
+    assert_true(f.moving);
+    assert_false(ps_session_catching_up(s));
+    ps_session_drawn(s, 1.0);
+    int refreshes = 0;
+    for (; refreshes < 100 && !ps_session_settled(s); refreshes++) {
+        refresh(s, &cam, &f); /* the same camera: still, the view drawn again */
+        assert_false(f.moving);
+        bool whole = ps_session_settled(s);
+        assert_true(ps_session_catching_up(s) == !whole);
+        drawn_at_rate(s, &f, rate, &built);
+    }
+    assert_true(refreshes > 1); /* it did catch up over refreshes */
+    assert_false(ps_session_catching_up(s));
+    ps_session_destroy(s);
+
+    /* Still tracing: the tau schedule leaves the tracer its time. */
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = 8000000; /* seconds of tracing: never ended by the checks below */
+    set.caps[PS_MAP_GLOBAL] = 2000000;
+    s = start_and_refresh(scene, &set, &cam, &f);
+    ps_session_drawn(s, 1e3); /* drawn slowly: a budget of the least, one batch */
+    cam.eye.x += 0.05;
+    refresh(s, &cam, &f);
+    ps_session_drawn(s, 1e3);
+    ps_session_counts c;
+    for (int i = 0; i < 2000; i++) { /* more stored than one still refresh draws */
+        ps_session_get_counts(s, &c);
+        if (c.map[PS_MAP_CAUSTIC].emitted >= 8 * PS_FEED_BATCH)
+            break;
+        struct timespec ts = {0, 5000000};
+        nanosleep(&ts, NULL);
+    }
+    refresh(s, &cam, &f);
+    assert_false(f.moving);
+    assert_true(f.new_view);
+    assert_false(ps_session_settled(s));
+    assert_false(ps_session_catching_up(s));
+    ps_session_set_paused(s, true); /* held: nothing traced meanwhile */
+    assert_true(ps_session_catching_up(s));
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 /* Progressive area lights: the first refresh with one virtual light an area
  * light, then 2 x 2, then all 16, each change said (lights_changed); an
  * edit starts over at one; without the setting, 16 from the start. */
@@ -1002,6 +1059,7 @@ int main(void)
         cmocka_unit_test(hidden_layers_are_skipped),
         cmocka_unit_test(radius_follows_the_schedule),
         cmocka_unit_test(catch_up_after_the_first_still_refresh),
+        cmocka_unit_test(catching_up_only_when_nothing_is_traced),
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(coarse_shadows_first),
         cmocka_unit_test(moving_camera_level_of_detail),

@@ -1132,8 +1132,15 @@ static ps_status session(app *a, ps_error *err)
             }
             if (st == PS_OK)
                 ps_platform_present(a->platform);
-            /* An edit's level of detail shown: its full view at once. */
-            next = a->frame.edit_lod ? 0.0 : now + ps_session_get_settings(a->session)->tau;
+            /* An edit's level of detail shown: its full view at once. The
+             * view drawn again after the camera stopped, nothing traced
+             * meanwhile: refresh after refresh, events polled between them
+             * (waiting for tau between them, the full picture came 1.12-1.46 s
+             * after an orbit over 1.25*10^6 photons stopped; without, 0.85-
+             * 0.95 s: scripts/bench-window.sh orbit). */
+            next = a->frame.edit_lod || ps_session_catching_up(a->session)
+                       ? 0.0
+                       : now + ps_session_get_settings(a->session)->tau;
         }
     }
     if (st == PS_OK && a->session)

@@ -3,6 +3,8 @@
 #define _GNU_SOURCE
 #include "core/memory.h"
 
+#include <limits.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,6 +29,49 @@ void ps_memory_set_drawing_policy(void)
 /* Not under ASan: mappings of our own would hide these arrays' bounds from it. */
 #if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(__SANITIZE_ADDRESS__)
 #define LARGE_PAGE ((size_t)2 * 1024 * 1024)
+#define HAVE_LARGE_PAGES 1
+#endif
+
+/* glibc's default pad of a heap's growth (M_TOP_PAD), put back afterwards. */
+#define GLIBC_TOP_PAD (128 * 1024)
+
+void ps_memory_reserve_large_heap(size_t bytes)
+{
+#if defined(__GLIBC__) && defined(HAVE_LARGE_PAGES)
+    uint64_t quarter = ps_memory_budget() / 4;
+    if (bytes > quarter)
+        bytes = (size_t)quarter;
+    if (bytes > (size_t)INT_MAX - PS_MEMORY_TRIM_THRESHOLD) /* mallopt's int */
+        bytes = (size_t)INT_MAX - PS_MEMORY_TRIM_THRESHOLD;
+    (void)mallopt(M_MMAP_THRESHOLD, PS_MEMORY_HEAP_MAP_THRESHOLD);
+    (void)mallopt(M_TRIM_THRESHOLD, (int)(bytes + PS_MEMORY_TRIM_THRESHOLD));
+    /* A block larger than the heap's free top makes glibc grow the heap by
+     * what it lacks and the pad (sbrk); freed, the block joins the top. */
+    size_t top = mallinfo2().keepcost, want = top + LARGE_PAGE;
+    if (want >= PS_MEMORY_HEAP_MAP_THRESHOLD)
+        want = PS_MEMORY_HEAP_MAP_THRESHOLD - LARGE_PAGE; /* the top holds most of it already */
+    (void)mallopt(M_TOP_PAD, (int)bytes);
+    char *block = malloc(want);
+    if (block) /* used, so that the compiler keeps the malloc and free it sees paired */
+        *(volatile char *)block = 0;
+    char *end = sbrk(0);
+    (void)mallopt(M_TOP_PAD, GLIBC_TOP_PAD);
+    /* Only the heap's end just grown (glibc may map a heap elsewhere when
+     * sbrk fails: the block is then not below the break). */
+    if (block && end != (char *)-1 && end > block && (size_t)(end - block) <= want + bytes + LARGE_PAGE) {
+        uintptr_t from = ((uintptr_t)block + LARGE_PAGE - 1) & ~(uintptr_t)(LARGE_PAGE - 1);
+        uintptr_t to = (uintptr_t)end & ~(uintptr_t)(LARGE_PAGE - 1);
+        if (to > from)
+            (void)madvise((void *)from, to - from, MADV_HUGEPAGE); /* advice: without it, small pages */
+    }
+    free(block);
+#else
+    (void)bytes;
+    ps_memory_set_drawing_policy();
+#endif
+}
+
+#ifdef HAVE_LARGE_PAGES
 
 static size_t large_span(size_t bytes) { return (bytes + LARGE_PAGE - 1) / LARGE_PAGE * LARGE_PAGE; }
 

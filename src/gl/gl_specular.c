@@ -514,6 +514,16 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     return st;
 }
 
+bool ps_gl_specular_all_shown(const ps_gl_specular *g, ps_session *s)
+{
+    unsigned layers = ps_session_get_settings(s)->layers;
+    int cubes = ps_specular_cube_count(ps_session_specular(s));
+    if (!(layers & PS_LAYER_SPECULAR) || ps_session_illuminance(s) || cubes == 0)
+        return true;
+    unsigned all = (1u << cubes) - 1u;
+    return g->cube_count == cubes && g->layers == layers && g->edits == ps_session_edits(s) && (g->shown & all) == all;
+}
+
 bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s)
 {
     unsigned layers = ps_session_get_settings(s)->layers;

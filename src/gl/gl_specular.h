@@ -138,6 +138,12 @@ void ps_gl_specular_set_gain(ps_gl_specular *g, ps_gl_layers *l, double gain);
  * too. */
 bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s);
 
+/* Whether every cube has been shown since the last change, so that no
+ * mirror or glass is black for want of its first map (true without cubes,
+ * or with the layer off). New virtual lights discard the faces of a map
+ * still being rendered: photosplat-snap refines an area light only then. */
+bool ps_gl_specular_all_shown(const ps_gl_specular *g, ps_session *s);
+
 /* For tests: every face of every cube filled with radiance `value` (a
  * furnace), marked fresh so that refreshes keep it. */
 void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value);

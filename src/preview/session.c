@@ -903,6 +903,18 @@ bool ps_session_refine_lights(ps_session *s)
     return true;
 }
 
+bool ps_session_catching_up(ps_session *s)
+{
+    if (!s->catch_up || !incremental(s))
+        return false;
+    if (s->user_paused || s->counter_stopped)
+        return true;
+    ps_feed_lock(s->feed);
+    bool ended = ps_feed_ended(s->feed);
+    ps_feed_unlock(s->feed);
+    return ended;
+}
+
 bool ps_session_settled(ps_session *s)
 {
     if (s->edited || s->view_dirty || !s->have_cam || s->lights_pending)

@@ -337,6 +337,12 @@ double ps_session_next_level_cost(const ps_session *s);
  * counter's verdict (which pauses tracing). */
 void ps_session_drawn(ps_session *s, double draw_seconds);
 
+/* Whether the refreshes are drawing a view again after the camera stopped
+ * (PS_SESSION_CATCH_UP_GAIN) with nothing traced meanwhile (the maps at
+ * their end, or tracing held): the next refresh need not wait for tau, as
+ * no tracer shares the cores and the user waits for the full picture. */
+bool ps_session_catching_up(ps_session *s);
+
 /* Whether everything is shown: no edit or new view pending, and every map at
  * its end and drawn, or tracing held for good (paused, counter stopped). */
 bool ps_session_settled(ps_session *s);
