@@ -67,21 +67,23 @@ ps_status ps_memory_check(uint64_t bytes, const char *who, const char *what, ps_
 void ps_memory_set_drawing_policy(void);
 
 /* photosplat-snap's allocator (glibc on Linux; elsewhere, and under ASan,
- * ps_memory_set_drawing_policy): the heap grown at once by `bytes` (at most a quarter of the
- * memory budget), advised for 2 MiB pages, and every block under
- * PS_MEMORY_HEAP_MAP_THRESHOLD (glibc's largest) served from it, so that the
- * first write to each 2 MiB is one page fault instead of 512: llvmpipe's
- * textures, shadow maps and bins, the splat arrays, the specular layer's
- * lookups. A 4 KiB page's fault costs about 10 us on these machines, and
- * the default box's first picture at 256^2 wrote some 40 MiB never touched
- * before: 10 700 faults, 0.22-0.25 s; from such a heap 390, 0.12-0.18 s.
- * What is never written stays virtual; freed memory goes back to the kernel
- * only past `bytes` + PS_MEMORY_TRIM_THRESHOLD at the heap's top, so that the
- * advised part stays the heap's. The area box's sixteen virtual lights'
- * shadow cubes are some 320 MiB: with 256 MiB reserved they faulted past it
- * and took 0.83 s (0.26 s within it). snap only: a run of seconds may keep
- * what it touched; the window keeps ps_memory_set_drawing_policy, whose
- * memory stays flat over hours (docs/soak.md). */
+ * ps_memory_set_drawing_policy): the heap grown at once by `bytes` (at most
+ * a quarter of the memory budget), advised for 2 MiB pages, and every block
+ * under PS_MEMORY_HEAP_MAP_THRESHOLD (glibc's largest) served from it, so
+ * that the first write to each 2 MiB is one page fault instead of 512:
+ * llvmpipe's textures, shadow maps and bins, the splat arrays, the specular
+ * layer's lookups. A 4 KiB page's fault costs about 10 us on these machines,
+ * and the default box's first picture at 256^2 wrote some 40 MiB never
+ * touched before: 10 700 faults, 0.22-0.25 s; from such a heap 390,
+ * 0.12-0.18 s. What is never written stays virtual; freed memory goes back
+ * to the kernel only past `bytes` + PS_MEMORY_TRIM_THRESHOLD at the heap's
+ * top, so that the advised part stays the heap's. With 256 MiB the area
+ * box's sixteen virtual lights' shadow cubes (16 x 5 faces of 4 MiB,
+ * counted, not measured) faulted past it and took 0.83 s, 0.26 s within
+ * 1 GiB. snap only (and not its 8-bit --time runs without checkpoints,
+ * snap_main.c): a run of seconds may keep what it touched; the window keeps
+ * ps_memory_set_drawing_policy, with which the soak finds its memory flat
+ * (docs/soak.md). */
 #define PS_MEMORY_HEAP_MAP_THRESHOLD (32 * 1024 * 1024)
 #define PS_MEMORY_SNAP_HEAP ((size_t)1024 * 1024 * 1024)
 void ps_memory_reserve_large_heap(size_t bytes);
