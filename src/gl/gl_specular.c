@@ -514,24 +514,35 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
     return st;
 }
 
+/* No cube to show: the layer off, illuminance shown, or no mirror or glass
+ * (*cubes: the session's cubes). */
+static bool no_cubes(ps_session *s, int *cubes)
+{
+    *cubes = ps_specular_cube_count(ps_session_specular(s));
+    return !(ps_session_get_settings(s)->layers & PS_LAYER_SPECULAR) || ps_session_illuminance(s) || *cubes == 0;
+}
+
+/* g's cubes were rendered for s's cubes, layers and edits as they are now. */
+static bool cubes_current(const ps_gl_specular *g, ps_session *s, int cubes)
+{
+    return g->cube_count == cubes && g->layers == ps_session_get_settings(s)->layers && g->edits == ps_session_edits(s);
+}
+
 bool ps_gl_specular_all_shown(const ps_gl_specular *g, ps_session *s)
 {
-    unsigned layers = ps_session_get_settings(s)->layers;
-    int cubes = ps_specular_cube_count(ps_session_specular(s));
-    if (!(layers & PS_LAYER_SPECULAR) || ps_session_illuminance(s) || cubes == 0)
+    int cubes;
+    if (no_cubes(s, &cubes))
         return true;
     unsigned all = (1u << cubes) - 1u;
-    return g->cube_count == cubes && g->layers == layers && g->edits == ps_session_edits(s) && (g->shown & all) == all;
+    return cubes_current(g, s, cubes) && (g->shown & all) == all;
 }
 
 bool ps_gl_specular_done(const ps_gl_specular *g, ps_session *s)
 {
-    unsigned layers = ps_session_get_settings(s)->layers;
-    int cubes = ps_specular_cube_count(ps_session_specular(s));
-    if (g->frozen || !(layers & PS_LAYER_SPECULAR) || ps_session_illuminance(s) || cubes == 0)
+    int cubes;
+    if (g->frozen || no_cubes(s, &cubes))
         return true;
-    if (g->cube_count != cubes || g->layers != layers || g->edits != ps_session_edits(s) || g->cubes_changed ||
-        ps_gl_glossy_pending(g->glossy))
+    if (!cubes_current(g, s, cubes) || g->cubes_changed || ps_gl_glossy_pending(g->glossy))
         return false;
     for (int c = 0; c < cubes; c++)
         if (g->back_faces[c] != 0) /* a map still being rendered */
