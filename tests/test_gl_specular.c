@@ -3,7 +3,8 @@
  * mirror showing the floor's direct light at the mirrored point, a mirror
  * and a glass sphere in a furnace (cube maps of radiance 1), and the default
  * scene's spheres against photosplat-ref's `specular` component; and the
- * faces' deadline (photosplat-snap's checkpoints) holding faces back. */
+ * faces' deadline (photosplat-snap's checkpoints) holding faces back, and
+ * faces foreseen from their fill. */
 #include "test.h"
 
 #include <GL/osmesa.h>
@@ -490,6 +491,21 @@ static void refined_shadows_keep_the_round(void **state)
     rig_free(&r);
 }
 
+/* A face foreseen from its fill (ps_gl_specular_face_foreseen): longer as
+ * (fill now / fill then)^PS_GL_SPECULAR_FILL_GROWTH, never shorter, and as
+ * it took when its fill is not known. */
+static void faces_foreseen_from_their_fill(void **state)
+{
+    (void)state;
+    assert_near(ps_gl_specular_face_foreseen(0.03, 3.2e5, 5.1e6), 0.03 * pow(5.1e6 / 3.2e5, PS_GL_SPECULAR_FILL_GROWTH),
+                1e-12);
+    assert_true(ps_gl_specular_face_foreseen(0.03, 3.2e5, 5.1e6) > 0.15); /* the default box's 0.18 s face */
+    assert_near(ps_gl_specular_face_foreseen(0.1, 1e6, 5e5), 0.1, 0.0);
+    assert_near(ps_gl_specular_face_foreseen(0.1, 0.0, 5e5), 0.1, 0.0);
+    assert_near(ps_gl_specular_face_foreseen(0.1, 1e6, 1e6), 0.1, 0.0);
+    assert_near(ps_gl_specular_face_foreseen(0.0, 1e6, 4e6), 0.0, 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -498,6 +514,7 @@ int main(void)
         cmocka_unit_test(furnace_glass_sphere),
         cmocka_unit_test(default_scene_against_reference),
         cmocka_unit_test(deadline_holds_faces),
+        cmocka_unit_test(faces_foreseen_from_their_fill),
         cmocka_unit_test(a_settled_round_ends_whole),
         cmocka_unit_test(refined_lights_keep_the_cubes),
         cmocka_unit_test(refined_lights_mid_first_round),

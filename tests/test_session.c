@@ -1,9 +1,12 @@
 /* test_session.c: the preview's progressive policy (preview/session.h),
  * with no GL at all: which photons each refresh splats, with which gains,
  * when a view starts over, when the error counter stops shooting, what an
- * edit restarts, and what a left-out layer skips. */
+ * edit restarts, what a left-out layer skips, and the pixels the cube
+ * faces' splats cover. */
 #include "test.h"
 
+#include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -1044,6 +1047,68 @@ static void coarse_shadows_first(void **state)
     ps_scene_destroy(scene);
 }
 
+/* ps_session_env_fill against an oracle written another way: each photon
+ * of the env splats' prefix (all of them here) on the cube face whose
+ * forward axis its direction is most along (the largest dot with the six
+ * axes, not the largest coordinate), a disc of the splats' radius seen at
+ * its distance along that axis. Then in closed form: the same photons seen
+ * from twice as far along one axis cover a quarter of the pixels. */
+static void env_fill_counts_each_face(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, false);
+    ps_session *s = open_session(scene, &set);
+    ps_error err;
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    const size_t most[PS_MAP_COUNT] = {SIZE_MAX, SIZE_MAX};
+    const int side = 128;
+    const ps_vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const ps_vec3 centre = ps_v3(0.1, 0.9, -0.2);
+    double want[6] = {0}, got[6];
+    const ps_photon_map *maps = ps_session_maps(s);
+    ps_camera_frame view = camera(scene);
+    ps_splat_batch b;
+    memset(&b, 0, sizeof b);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        double r;
+        assert_int_equal(ps_session_env_splats(s, (ps_map_kind)k, &view, SIZE_MAX, &b, &r, &err), PS_OK);
+        assert_true(maps[k].count > 1000);
+        for (size_t i = 0; i < maps[k].count; i++) {
+            ps_vec3 d = ps_v3_sub(ps_photon_position(&maps[k].photons[i]), centre);
+            int best = 0;
+            for (int f = 1; f < 6; f++)
+                if (ps_v3_dot(d, axes[f]) > ps_v3_dot(d, axes[best]))
+                    best = f;
+            double px = r * side / (2.0 * ps_v3_dot(d, axes[best]));
+            want[best] += fmin(PS_PI * px * px, (double)side * side);
+        }
+    }
+    ps_splat_batch_free(&b);
+    ps_session_env_fill(s, centre, side, most, got);
+    double total = 0.0;
+    for (int f = 0; f < 6; f++) {
+        assert_true(fabs(got[f] - want[f]) <= 1e-9 * want[f] + 1e-9);
+        total += got[f];
+    }
+    assert_true(total > 0.0);
+    /* The floor (y = 0) seen from straight above it, far enough that every
+     * photon is on the down face: from 40 m, a quarter of the pixels of
+     * 20 m, and none elsewhere (the box is 2 m across). */
+    double near[6], far[6];
+    ps_session_env_fill(s, ps_v3(0, 20, 0), side, most, near);
+    ps_session_env_fill(s, ps_v3(0, 40, 0), side, most, far);
+    assert_true(near[3] > 0.0);
+    for (int f = 0; f < 6; f++)
+        if (f != 3)
+            assert_true(near[f] == 0.0 && far[f] == 0.0);
+    /* Each photon's distance along -y is 20 + y or 40 + y (y within the 2 m
+     * box): the ratio is 4 to within (42 / 38)^2 / 4 either way. */
+    assert_true(near[3] / far[3] > 4.0 * pow(38.0 / 42.0, 2.0) && near[3] / far[3] < 4.0 * pow(42.0 / 38.0, 2.0));
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1060,6 +1125,7 @@ int main(void)
         cmocka_unit_test(radius_follows_the_schedule),
         cmocka_unit_test(catch_up_after_the_first_still_refresh),
         cmocka_unit_test(catching_up_only_when_nothing_is_traced),
+        cmocka_unit_test(env_fill_counts_each_face),
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(coarse_shadows_first),
         cmocka_unit_test(moving_camera_level_of_detail),

@@ -49,6 +49,10 @@
  * most of what a face costs. */
 #define PS_GL_SPECULAR_ENV_CAUSTIC 65536
 #define PS_GL_SPECULAR_ENV_GLOBAL 16384
+/* A face's time grows as its fill to this power (ps_gl_specular_face_foreseen):
+ * fitted to the default box's faces, 0.03 s at 3.2*10^5 pixels foreseeing
+ * 0.17 s at 5.1*10^6 (0.18 measured). */
+#define PS_GL_SPECULAR_FILL_GROWTH 0.6
 /* Once every photon has arrived, the last round is drawn over this many
  * refreshes, budget or not. */
 #define PS_GL_SPECULAR_SETTLE_REFRESHES 4
@@ -88,13 +92,28 @@ void ps_gl_specular_set_deadline(ps_gl_specular *g, double at);
  * allowed until the deadline) may start at `now` under deadline `at` (0:
  * none). */
 bool ps_gl_specular_face_fits(double now, double at, double estimate);
+/* A face that took `seconds` when its splats covered fill_then pixels
+ * (ps_session_env_fill), foreseen when they cover fill_now: longer by
+ * (fill_now / fill_then)^PS_GL_SPECULAR_FILL_GROWTH when they cover more,
+ * never shorter (a face's fixed part: its mesh, its shadow passes). The
+ * default box's faces, drawn at 256^2 with the bench's caps: 0.02-0.05 s at
+ * 0.2-1.3*10^6 pixels, 0.11-0.12 s at 2.8-5.0*10^6, 0.18 s at 5.1*10^6 and
+ * 0.31 s at 1.8*10^7 (llvmpipe's fill grows slower than the pixels counted:
+ * overlapping splats, hidden ones). A face never drawn was foreseen from
+ * the others alone: that 0.18 s face at 0.03 s, and a refresh planned to
+ * end before the 0.5 s checkpoint's frame drew it and showed that
+ * checkpoint at 0.62-0.64 s. A face never timed is foreseen from the timed
+ * face nearest it in fill, scaled by the same power either way. */
+double ps_gl_specular_face_foreseen(double seconds, double fill_then, double fill_now);
 
 /* The seconds the next refresh's faces (a few a refresh, not a new view's)
  * take whatever the deadline: the first round's (ps_gl_specular_set_first_round)
  * while it lasts and is not held (ps_gl_specular_hold_first_round), each face
- * at its own last time, or the dearest seen; HUGE_VAL before any was drawn
- * (not known: a caller that must end by a time holds them). */
-double ps_gl_specular_unheld_seconds(const ps_gl_specular *g, ps_session *s);
+ * at its own last time scaled up by its fill since
+ * (ps_gl_specular_face_foreseen), a face never timed from the timed one
+ * nearest it in fill, scaled by their fills either way; HUGE_VAL before any
+ * was drawn (not known: a caller that must end by a time holds them). */
+double ps_gl_specular_unheld_seconds(ps_gl_specular *g, ps_session *s);
 
 /* The seconds every face of every cube takes (a snapshot's last picture,
  * `faces` 0), each at its own last time, else as the last refresh's faces

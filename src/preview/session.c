@@ -1237,39 +1237,53 @@ void ps_session_set_specular_centre(ps_session *s, int cube, ps_vec3 centre)
 }
 uint64_t ps_session_maps_epoch(const ps_session *s) { return s->maps_epoch; }
 
+/* Under the feed's lock: the prefix of map k a cube face splats (at most
+ * max_photons stored, ending at a feed mark: *end stored, *emitted emitted;
+ * 0 when none or the layer is off) and their radius (ps_session_env_splats). */
+static void env_prefix(ps_session *s, ps_map_kind k, size_t max_photons, size_t *end, uint64_t *emitted,
+                       double *radius)
+{
+    *end = 0, *emitted = 0;
+    *radius = s->splat_radius[k];
+    if (!(s->set.layers & ps_map_layer(k)) || s->illuminance)
+        return;
+    size_t nm;
+    const ps_feed_mark *mk = ps_feed_marks(s->feed, k, &nm);
+    for (size_t i = 0; i < nm; i++) {
+        if (*end > 0 && mk[i].stored > max_photons)
+            break;
+        *end = mk[i].stored;
+        *emitted = mk[i].emitted;
+    }
+    if (*end == 0 || *emitted == 0)
+        return;
+    /* The level of detail's cover for the photons left out, grown by
+     * sqrt(arrived / used) (at most PS_RADIUS_GROWTH_MAX), but never past
+     * the larger of the two maps' own radii: a grown global splat would
+     * fill much of a cube face, and the fill is what a face costs. */
+    double arrived = (double)mk[nm - 1].emitted;
+    double own = radius_at(s, k, *emitted);
+    double grown = own * fmin(PS_RADIUS_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)*emitted)));
+    double largest = fmax(s->splat_radius[PS_MAP_CAUSTIC], s->splat_radius[PS_MAP_GLOBAL]);
+    *radius = fmax(own, fmin(grown, largest));
+}
+
 ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_frame *view, size_t max_photons,
                                 ps_splat_batch *b, double *radius, ps_error *err)
 {
     ps_splat_batch_clear(b);
     ps_splat_batch_reset_carry(b);
-    *radius = s->splat_radius[k];
-    if (!(s->set.layers & ps_map_layer(k)) || s->illuminance)
-        return PS_OK;
     ps_feed_lock(s->feed);
-    size_t nm;
-    const ps_feed_mark *mk = ps_feed_marks(s->feed, k, &nm);
-    size_t end = 0;
-    uint64_t emitted = 0;
-    for (size_t i = 0; i < nm; i++) {
-        if (end > 0 && mk[i].stored > max_photons)
-            break;
-        end = mk[i].stored;
-        emitted = mk[i].emitted;
-    }
+    size_t end;
+    uint64_t emitted;
+    env_prefix(s, k, max_photons, &end, &emitted, radius);
     ps_status st = PS_OK;
     if (end > 0 && emitted > 0) {
         const ps_photon_map *m = &ps_feed_maps(s->feed)[k];
         ps_splat_params p;
         memset(&p, 0, sizeof p);
         p.mode = PS_SPLAT_TRIANGLES;
-        /* The level of detail's cover for the photons left out, grown by
-         * sqrt(arrived / used) (at most PS_RADIUS_GROWTH_MAX), but never past
-         * the larger of the two maps' own radii: a grown global splat would
-         * fill much of a cube face, and the fill is what a face costs. */
-        double arrived = (double)mk[nm - 1].emitted;
-        double grown = radius_at(s, k, emitted) * fmin(PS_RADIUS_GROWTH_MAX, sqrt(fmax(1.0, arrived / (double)emitted)));
-        double largest = fmax(s->splat_radius[PS_MAP_CAUSTIC], s->splat_radius[PS_MAP_GLOBAL]);
-        p.radius = fmax(radius_at(s, k, emitted), fmin(grown, largest));
+        p.radius = *radius;
         p.kernel_mean = s->kernel.mean;
         p.kernel_extent = s->kernel.extent;
         p.scale = (double)s->set.caps[k] / (double)emitted; /* radiance: exposure 1 */
@@ -1280,11 +1294,37 @@ ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_fr
         p.objects = s->set.stencil_clip ? m->objects : NULL;
         p.cam = *view;
         p.threads = s->set.threads;
-        *radius = p.radius;
         st = ps_splat_build(m->photons, m->materials, end, &p, b, err);
     }
     ps_feed_unlock(s->feed);
     return st;
+}
+
+void ps_session_env_fill(ps_session *s, ps_vec3 centre, int face_side, const size_t max_photons[PS_MAP_COUNT],
+                         double fill[6])
+{
+    for (int f = 0; f < 6; f++)
+        fill[f] = 0.0;
+    double side = (double)face_side, most = side * side;
+    ps_feed_lock(s->feed);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        size_t end;
+        uint64_t emitted;
+        double radius;
+        env_prefix(s, (ps_map_kind)k, max_photons[k], &end, &emitted, &radius);
+        const ps_photon *ph = ps_feed_maps(s->feed)[k].photons;
+        for (size_t i = 0; i < end && emitted > 0; i++) {
+            /* The face is the direction's largest axis (cube map order
+             * +x, -x, +y, -y, +z, -z); the disc's distance along it sets its
+             * size there (the face's focal length is half its side). */
+            ps_vec3 d = ps_v3_sub(ps_photon_position(&ph[i]), centre);
+            double ax = fabs(d.x), ay = fabs(d.y), az = fabs(d.z);
+            int f = ax >= ay && ax >= az ? (d.x >= 0.0 ? 0 : 1) : ay >= az ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
+            double z = fmax(fmax(ax, ay), az), px = z > 0.0 ? radius * 0.5 * side / z : HUGE_VAL;
+            fill[f] += fmin(PS_PI * px * px, most);
+        }
+    }
+    ps_feed_unlock(s->feed);
 }
 double ps_session_radius(const ps_session *s, ps_map_kind k) { return s->splat_radius[k]; }
 

@@ -456,6 +456,14 @@ void ps_session_set_specular_centre(ps_session *s, int cube, ps_vec3 centre);
  * lock. */
 ps_status ps_session_env_splats(ps_session *s, ps_map_kind k, const ps_camera_frame *view, size_t max_photons,
                                 ps_splat_batch *b, double *radius, ps_error *err);
+/* The pixels those splats (max_photons[k] of map k) would cover on each face
+ * of a cube map at `centre` with faces face_side pixels square, none hidden:
+ * each splat's disc as seen along the face's axis, at most a face, summed
+ * per face in cube map order (+x, -x, +y, -y, +z, -z). What a face's time
+ * grows with (gl_specular.h): the default box's face over the caustic under
+ * its mirror sphere covers 5*10^6 such pixels, the others 0.2-1.1*10^6. */
+void ps_session_env_fill(ps_session *s, ps_vec3 centre, int face_side, const size_t max_photons[PS_MAP_COUNT],
+                         double fill[6]);
 /* A count that changes whenever the maps hold other photons, or the same in
  * another order, than a prefix of what they held (a new feed, a repair, the
  * repair's end putting a map back in index order): what was made from the
