@@ -1092,9 +1092,9 @@ static void env_fill_counts_each_face(void **state)
         total += got[f];
     }
     assert_true(total > 0.0);
-    /* The floor (y = 0) seen from straight above it, far enough that every
-     * photon is on the down face: from 40 m, a quarter of the pixels of
-     * 20 m, and none elsewhere (the box is 2 m across). */
+    /* The box (0 <= y <= 2, |x|, |z| <= 1) seen from far above it, so that
+     * every photon is on the down face: from 40 m, about a quarter of the
+     * pixels of 20 m, and none elsewhere. */
     double near[6], far[6];
     ps_session_env_fill(s, ps_v3(0, 20, 0), side, most, near);
     ps_session_env_fill(s, ps_v3(0, 40, 0), side, most, far);
@@ -1102,9 +1102,10 @@ static void env_fill_counts_each_face(void **state)
     for (int f = 0; f < 6; f++)
         if (f != 3)
             assert_true(near[f] == 0.0 && far[f] == 0.0);
-    /* Each photon's distance along -y is 20 + y or 40 + y (y within the 2 m
-     * box): the ratio is 4 to within (42 / 38)^2 / 4 either way. */
-    assert_true(near[3] / far[3] > 4.0 * pow(38.0 / 42.0, 2.0) && near[3] / far[3] < 4.0 * pow(42.0 / 38.0, 2.0));
+    /* A photon at height y is 20 - y and 40 - y away along -y: its pixels
+     * from 20 m are ((40 - y) / (20 - y))^2 times those from 40 m, between
+     * 4 (y = 0) and (38 / 18)^2 (y = 2). */
+    assert_true(near[3] / far[3] >= 4.0 * (1.0 - 1e-12) && near[3] / far[3] <= pow(38.0 / 18.0, 2.0));
     ps_session_destroy(s);
     ps_scene_destroy(scene);
 }
