@@ -51,7 +51,7 @@
 #define PS_GL_SPECULAR_ENV_GLOBAL 16384
 /* A face's time grows as its fill to this power (ps_gl_specular_face_foreseen):
  * fitted to the default box's faces, 0.03 s at 3.2*10^5 pixels foreseeing
- * 0.17 s at 5.1*10^6 (0.18 measured). */
+ * 0.16 s at 5.1*10^6 (0.18 measured). */
 #define PS_GL_SPECULAR_FILL_GROWTH 0.6
 /* Once every photon has arrived, the last round is drawn over this many
  * refreshes, budget or not. */
