@@ -129,18 +129,17 @@ static void update_fill(ps_gl_specular *g, ps_session *s)
  * face seen, faces of 1.0-1.3*10^6 pixels were foreseen at 0.08-0.09 s
  * where they took 0.03-0.05 s, behind the 0.26-0.28 s of one over the
  * caustic.) */
-static double face_foreseen(ps_gl_specular *g, ps_session *s, int i)
+static double face_foreseen(const ps_gl_specular *g, int i)
 {
-    update_fill(g, s);
-    double now = g->fill_now[i];
+    double now = g->fill_now[i]; /* update_fill first */
     if (g->face_time[i] > 0.0)
         return ps_gl_specular_face_foreseen(g->face_time[i], g->face_fill[i], now);
     double t = g->face_seconds, then = g->face_seconds_fill, gap = HUGE_VAL;
-    for (int j = 0; j < 6 * g->cube_count && now > 0.0; j++)
-        if (g->face_time[j] > 0.0 && g->face_fill[j] > 0.0 && fabs(log(g->face_fill[j] / now)) < gap) {
-            gap = fabs(log(g->face_fill[j] / now));
-            t = g->face_time[j], then = g->face_fill[j];
-        }
+    for (int j = 0; j < 6 * g->cube_count && now > 0.0; j++) {
+        double d = g->face_time[j] > 0.0 && g->face_fill[j] > 0.0 ? fabs(log(g->face_fill[j] / now)) : HUGE_VAL;
+        if (d < gap)
+            gap = d, t = g->face_time[j], then = g->face_fill[j];
+    }
     if (!(t > 0.0))
         return g->face_max;
     return then > 0.0 && now > 0.0 ? t * pow(now / then, PS_GL_SPECULAR_FILL_GROWTH) : t;
@@ -152,7 +151,8 @@ static double face_estimate(ps_gl_specular *g, ps_session *s)
 {
     if (g->face_time[g->cursor] <= 0.0 && g->face_max <= 0.0)
         return g->idle ? g->idle_guess : 0.0;
-    return face_foreseen(g, s, g->cursor);
+    update_fill(g, s);
+    return face_foreseen(g, g->cursor);
 }
 
 void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes) { g->first_refreshes = refreshes > 0 ? refreshes : 0; }
@@ -385,8 +385,9 @@ double ps_gl_specular_unheld_seconds(ps_gl_specular *g, ps_session *s)
         return HUGE_VAL;
     int n = (total + g->first_refreshes - 1) / g->first_refreshes;
     double t = 0.0;
+    update_fill(g, s);
     for (int i = 0; i < n; i++)
-        t += face_foreseen(g, s, (g->cursor + i) % total);
+        t += face_foreseen(g, (g->cursor + i) % total);
     return t;
 }
 
