@@ -323,11 +323,34 @@ static void unheld_faces_stay_out_of_the_checkpoints_frame(void **state)
     assert_true(p.shows && p.hold_faces);
     assert_near(p.start, cp + PS_PACE_MARGIN * 0.05 - 0.05, 1e-12);
     assert_near(p.faces_deadline, last_end - 0.05 + 0.005, 1e-12);
-    /* A second before: the refresh goes at once, faces and all. */
+    /* A second before: the refresh goes at once, faces and all. Its faces,
+     * those it counts on included, end where the frame can still start
+     * (ps_gl_specular starts none past it, whatever they were foreseen). */
     cp = 1.5;
     p = ps_pace_next(&m, 0.4, 0.0, 0.4, &cp, 1);
     assert_false(p.shows || p.hold_faces);
     assert_near(p.start, 0.4, 1e-12);
+    assert_near(p.faces_deadline, cp * (1.0 + PS_PACE_FACES_LATE) - 0.05 - 0.05 + 0.005, 1e-12);
+    /* Simulated: unheld faces 3x as dear as foreseen (0.4 s a refresh as
+     * four of 0.3 s), each started only before the deadline: the
+     * checkpoint's frame ends at most one face past PS_PACE_FACES_LATE
+     * (drawn as planned, 0.8 s past). */
+    for (double start = 0.05; start < 1.45; start += 0.01) {
+        double now = start, end = 0.0;
+        for (int i = 0; i < 100 && end < cp; i++) {
+            p = ps_pace_next(&m, now, 0.0, now, &cp, 1);
+            double t = p.start + m.lead;
+            for (int face = 0; face < 4; face++) {
+                if (p.hold_faces && t + 0.1 <= p.faces_deadline)
+                    t += 0.1; /* held: timed, each as it took */
+                else if (!p.hold_faces && t < p.faces_deadline)
+                    t += 0.3;
+            }
+            end = t + 0.05 - m.lead;
+            now = end;
+        }
+        assert_true(end >= cp && end <= cp * (1.0 + PS_PACE_FACES_LATE) + 0.3 + 1e-9);
+    }
     /* Simulated: every checkpoint's frame within PS_PACE_FACES_LATE. */
     for (double start = 0.05; start < 0.45; start += 0.01) {
         double now = start, end = 0.0;

@@ -124,11 +124,13 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
          * refresh before its 1 s checkpoint, its tracer held meanwhile by
          * the photons not drawn; holding the first round in every refresh
          * instead let its faces fill whole seconds between checkpoints, a
-         * batch of photons shown for each second of faces.) */
+         * batch of photons shown for each second of faces.) The deadline
+         * is where all its faces end, the unheld ones counted on included:
+         * those too start only before it (ps_gl_specular_set_deadline), so
+         * that a round foreseen short delays the frame by one face at most. */
         p.start = s0;
         p.hold_faces = s0 + d0 > last_start;
-        double d = p.hold_faces ? d0_held : d0;
-        p.faces_deadline = last_start - d + fmin(m->lead, d);
+        p.faces_deadline = last_start - d0_held + fmin(m->lead, d0_held);
     }
     return p;
 }

@@ -86,7 +86,9 @@ void ps_gl_specular_hold_first_round(ps_gl_specular *g, bool held);
  * predicts: a face that would pass it waits for a later refresh
  * (photosplat-snap: the refreshes before a checkpoint leave it on time,
  * pace.h). Not for `faces` 0 (all at once). Each face is then finished and
- * timed on its own. */
+ * timed on its own. The first round's faces, unless held
+ * (ps_gl_specular_hold_first_round), are not foreseen against it but still
+ * start only before it. */
 void ps_gl_specular_set_deadline(ps_gl_specular *g, double at);
 /* Whether a face predicted to take `estimate` seconds (0: not timed yet,
  * allowed until the deadline) may start at `now` under deadline `at` (0:
@@ -107,7 +109,8 @@ bool ps_gl_specular_face_fits(double now, double at, double estimate);
 double ps_gl_specular_face_foreseen(double seconds, double fill_then, double fill_now);
 
 /* The seconds the next refresh's faces (a few a refresh, not a new view's)
- * take whatever the deadline: the first round's (ps_gl_specular_set_first_round)
+ * take that the deadline does not foresee (each still starts only before
+ * it): the first round's (ps_gl_specular_set_first_round)
  * while it lasts and is not held (ps_gl_specular_hold_first_round), each face
  * at its own last time scaled up by its fill since
  * (ps_gl_specular_face_foreseen), a face never timed from the timed one
