@@ -540,6 +540,39 @@ static void unheld_first_round_stops_at_the_deadline(void **state)
     rig_free(&r);
 }
 
+/* ps_gl_specular_idle: a program's wait given to the cube faces
+ * (photosplat-snap's, both colour depths): each face only while it is
+ * foreseen to end by the wait's end, a face never timed at the guess given;
+ * the first round's faces so, until its cube is shown. */
+static void idle_draws_the_round_in_a_wait(void **state)
+{
+    (void)state;
+    ps_scene *scene = load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
+                                "material white diffuse albedo 0.5 0.5 0.5\n"
+                                "material mirror mirror reflectance 1 1 1\n"
+                                "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0 material white\n"
+                                "sphere center 0 0.5 -0.5 radius 0.3 material mirror\n"
+                                "light point position 0 1.5 -0.5 power 50 50 50\n");
+    rig r;
+    rig_make_as(&r, scene, 48, 48, true);
+    ps_session *s = r.session;
+    ps_session_frame f;
+    ps_error err;
+    assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+    assert_true(f.new_view);
+    /* A wait already over, or too short for the guess: none. */
+    assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() - 1.0, 0.0, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
+    assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() + 1.0, 10.0, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
+    assert_false(ps_gl_specular_all_shown(r.spec, s));
+    /* A long one: the whole first round, the mirror shown, and no more. */
+    assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() + 1000.0, 1e-3, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 6);
+    assert_true(ps_gl_specular_all_shown(r.spec, s));
+    rig_free(&r);
+}
+
 /* A face foreseen from its fill (ps_gl_specular_face_foreseen): longer as
  * (fill now / fill then)^PS_GL_SPECULAR_FILL_GROWTH, never shorter, and as
  * it took when its fill is not known. */
@@ -568,6 +601,7 @@ int main(void)
         cmocka_unit_test(refined_lights_keep_the_cubes),
         cmocka_unit_test(refined_lights_mid_first_round),
         cmocka_unit_test(unheld_first_round_stops_at_the_deadline),
+        cmocka_unit_test(idle_draws_the_round_in_a_wait),
         cmocka_unit_test(refined_shadows_keep_the_round),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -14,11 +14,13 @@
  * PS_PACE_MARGIN of its time after it (incremental: drawing
  * PS_PACE_SHOWN_BUDGET of its budget); a refresh that would end after that
  * start holds its first round of cube faces if that is enough, and waits
- * for it otherwise (snap is headless: an idle moment only leaves the cores
- * to the tracer); cube faces run only while the checkpoint's frame still
- * ends within PS_PACE_FACES_LATE of it (or the margin, if later): in that
+ * for it otherwise (snap is headless: a wait leaves the cores to the tracer,
+ * and to cube faces while they fit in it, ps_gl_specular_idle); cube faces
+ * run only while the checkpoint's frame still ends within
+ * PS_PACE_FACES_LATE of it (or the margin, if later): in that
  * frame, those of the first round too, which the refreshes further from a
- * checkpoint draw whatever their time (ps_gl_specular_set_first_round).
+ * checkpoint draw as the pace counts on them, each started before the
+ * deadline whatever its time (ps_gl_specular_set_first_round).
  * A whole refresh showing a checkpoint lasts at most PS_PACE_FRAME_SHARE of
  * the checkpoint's time (ps_pace_plan.photons: a prefix of the photons, an
  * unbiased picture of fewer), so that its prediction's error stays within
