@@ -495,7 +495,7 @@ static void refined_shadows_keep_the_round(void **state)
  * counted on them) still start only before the deadline, as the clock says
  * when each starts: foreseen from the faces drawn before, the design room's
  * came 2-5x dearer, and a refresh planned to end before the 0.5 s
- * checkpoint's frame drew twelve of them and showed it at 0.72-0.83 s.
+ * checkpoint's frame drew twelve of them and showed it at 0.72-0.94 s.
  * Held, they keep to it as foreseen (deadline_holds_faces); with no deadline,
  * or one far off, a quarter of the round a refresh as before. */
 static void unheld_first_round_stops_at_the_deadline(void **state)

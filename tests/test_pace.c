@@ -334,7 +334,7 @@ static void unheld_faces_stay_out_of_the_checkpoints_frame(void **state)
     /* Simulated: unheld faces 3x as dear as foreseen (0.4 s a refresh as
      * four of 0.3 s), each started only before the deadline: the
      * checkpoint's frame ends at most one face past PS_PACE_FACES_LATE
-     * (drawn as planned, 0.8 s past). */
+     * (drawn whole, up to 0.8 s later than planned). */
     for (double start = 0.05; start < 1.45; start += 0.01) {
         double now = start, end = 0.0;
         for (int i = 0; i < 100 && end < cp; i++) {
