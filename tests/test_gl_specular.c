@@ -438,6 +438,24 @@ static void refined_lights_mid_first_round(void **state)
     refined_lights(true);
 }
 
+/* A mirror sphere over a floor under a point light, as a refining rig
+ * (progressive lights, photons still to come, the first round of faces
+ * over PS_GL_SPECULAR_FIRST_REFRESHES refreshes): one cube of six faces. */
+static void one_mirror_refining(rig *r)
+{
+    rig_make_as(r,
+                load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
+                          "material white diffuse albedo 0.5 0.5 0.5\n"
+                          "material mirror mirror reflectance 1 1 1\n"
+                          "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0 material white\n"
+                          "sphere center 0 0.5 -0.5 radius 0.3 material mirror\n"
+                          "light point position 0 1.5 -0.5 power 50 50 50\n"),
+                48, 48, true);
+}
+
+/* Its first round's faces a refresh. */
+static const unsigned quick = (6 + PS_GL_SPECULAR_FIRST_REFRESHES - 1) / PS_GL_SPECULAR_FIRST_REFRESHES;
+
 /* A progressive start's coarse shadow maps refined mid-way through the
  * first round (the same lights: ps_session_frame.shadows_refined) keep the
  * round: its faces drawn before count, and the cube is shown once all six
@@ -448,15 +466,8 @@ static void refined_lights_mid_first_round(void **state)
 static void refined_shadows_keep_the_round(void **state)
 {
     (void)state;
-    ps_scene *scene = load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
-                                "material white diffuse albedo 0.5 0.5 0.5\n"
-                                "material mirror mirror reflectance 1 1 1\n"
-                                "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0 material white\n"
-                                "sphere center 0 0.5 -0.5 radius 0.3 material mirror\n"
-                                "light point position 0 1.5 -0.5 power 50 50 50\n");
-    const unsigned quick = (6 + PS_GL_SPECULAR_FIRST_REFRESHES - 1) / PS_GL_SPECULAR_FIRST_REFRESHES;
     rig r;
-    rig_make_as(&r, scene, 48, 48, true);
+    one_mirror_refining(&r);
     ps_session *s = r.session;
     ps_session_frame f;
     ps_error err;
@@ -491,6 +502,16 @@ static void refined_shadows_keep_the_round(void **state)
     rig_free(&r);
 }
 
+/* A refresh of the rig and its specular layer's faces (a few a refresh):
+ * the faces rendered so far. */
+static unsigned refresh_faces(rig *r, ps_session_frame *f)
+{
+    ps_error err;
+    assert_int_equal(ps_session_refresh(r->session, &r->cam, f, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(r->spec, r->gl, r->session, f, 1, &err), PS_OK);
+    return ps_gl_specular_faces_rendered(r->spec);
+}
+
 /* The first round's faces that no deadline holds (not held: the pace
  * counted on them) still start only before the deadline, as the clock says
  * when each starts: foreseen from the faces drawn before, the design room's
@@ -501,42 +522,25 @@ static void refined_shadows_keep_the_round(void **state)
 static void unheld_first_round_stops_at_the_deadline(void **state)
 {
     (void)state;
-    ps_scene *scene = load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
-                                "material white diffuse albedo 0.5 0.5 0.5\n"
-                                "material mirror mirror reflectance 1 1 1\n"
-                                "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0 material white\n"
-                                "sphere center 0 0.5 -0.5 radius 0.3 material mirror\n"
-                                "light point position 0 1.5 -0.5 power 50 50 50\n");
-    const unsigned quick = (6 + PS_GL_SPECULAR_FIRST_REFRESHES - 1) / PS_GL_SPECULAR_FIRST_REFRESHES;
     rig r;
-    rig_make_as(&r, scene, 48, 48, true);
-    ps_session *s = r.session;
+    one_mirror_refining(&r);
     ps_session_frame f;
-    ps_error err;
     ps_gl_specular_hold_first_round(r.spec, false);
     /* Past: none starts, in the new view's refresh or after it. */
     for (int i = 0; i < 3; i++) {
         ps_gl_specular_set_deadline(r.spec, ps_now_seconds() - 1.0);
-        assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
-        assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
-        assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
+        assert_int_equal(refresh_faces(&r, &f), 0);
     }
     assert_false(f.new_view);
     /* Far off, or none: the round's quarter. */
     ps_gl_specular_set_deadline(r.spec, ps_now_seconds() + 1000.0);
-    assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), quick);
+    assert_int_equal(refresh_faces(&r, &f), quick);
     ps_gl_specular_set_deadline(r.spec, 0.0);
-    assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 2 * quick);
+    assert_int_equal(refresh_faces(&r, &f), 2 * quick);
     /* Past again, mid-round: none. */
     ps_gl_specular_set_deadline(r.spec, ps_now_seconds() - 1.0);
-    assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 1, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 2 * quick);
-    assert_false(ps_gl_specular_all_shown(r.spec, s));
+    assert_int_equal(refresh_faces(&r, &f), 2 * quick);
+    assert_false(ps_gl_specular_all_shown(r.spec, r.session));
     rig_free(&r);
 }
 
@@ -547,14 +551,8 @@ static void unheld_first_round_stops_at_the_deadline(void **state)
 static void idle_draws_the_round_in_a_wait(void **state)
 {
     (void)state;
-    ps_scene *scene = load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
-                                "material white diffuse albedo 0.5 0.5 0.5\n"
-                                "material mirror mirror reflectance 1 1 1\n"
-                                "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0 material white\n"
-                                "sphere center 0 0.5 -0.5 radius 0.3 material mirror\n"
-                                "light point position 0 1.5 -0.5 power 50 50 50\n");
     rig r;
-    rig_make_as(&r, scene, 48, 48, true);
+    one_mirror_refining(&r);
     ps_session *s = r.session;
     ps_session_frame f;
     ps_error err;
