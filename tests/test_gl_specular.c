@@ -515,7 +515,7 @@ static unsigned refresh_faces(rig *r, ps_session_frame *f)
 /* The first round's faces that no deadline holds (not held: the pace
  * counted on them) still start only before the deadline, as the clock says
  * when each starts: foreseen from the faces drawn before, the design room's
- * came 2-5x dearer, and a refresh planned to end before the 0.5 s
+ * came up to 7x dearer, and a refresh planned to end before the 0.5 s
  * checkpoint's frame drew twelve of them and showed it at 0.72-0.94 s.
  * Held, they keep to it as foreseen (deadline_holds_faces); with no deadline,
  * or one far off, a quarter of the round a refresh as before. */
