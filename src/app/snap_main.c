@@ -819,15 +819,16 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
          * first round's, which no deadline holds back, made the frame of a
          * 2 s checkpoint 0.5 s late), then is planned again with what they
          * left to it. Float too, though its tracer runs meanwhile, until
-         * every mirror's and glass's first map is shown: the bench limited
-         * to 1 s, three runs each, had the specular layer wholly black at
-         * 0.5 s in 11-13 of 48 configurations against 23-28 with float's
-         * waits idle, the full picture's relMSE 0.88x at 0.5 s and 0.91x
-         * at 1 s, for 0.87x the caustic photons at 0.5 s (the picture less
-         * its specular layer 1.05x there, 0.99x at 1 s). Past the first
-         * maps, faces in every wait cost 3-5 % of the photons at 1-2 s and
-         * bought nothing measured (two runs each, budgets to 2 s): later
-         * rounds keep the budget's share of tau, as the window's. */
+         * every mirror's and glass's first map is shown. Given every wait,
+         * the bench limited to 1 s (three runs each) had the specular layer
+         * wholly black at 0.5 s in 11-13 of 48 configurations against 23-28
+         * with float's waits idle, the full picture's relMSE 0.88x at 0.5 s
+         * and 0.91x at 1 s, for 0.87x the caustic photons at 0.5 s (the
+         * picture less its specular layer 1.05x there, 0.99x at 1 s). Given
+         * the waits only until the first maps are shown (two runs each,
+         * budgets to 2 s): black in 7 and 12 against 15 and 10 with every
+         * wait, 1.03-1.05x the photons at 1-2 s; so later rounds keep the
+         * budget's share of tau, as the window's. */
         bool faces_wait = !s->layers || !ps_gl_specular_all_shown(s->spec, s->session);
         if (faces_wait && s->frames > 0 && plan.start > ps_now_seconds() - clock) {
             /* A face never timed: as long as the last frame (the first,
