@@ -28,6 +28,7 @@ expect_usage_error "bad kernel" "$snap" "$scene" -o "$cli_tmp/x.png" --kernel tr
 expect_usage_error "bad layer" "$snap" "$scene" -o "$cli_tmp/x.png" --layers direct,glow
 expect_usage_error "empty layer" "$snap" "$scene" -o "$cli_tmp/x.png" --layers direct,
 expect_usage_error "bad depth" "$snap" "$scene" -o "$cli_tmp/x.png" --color-depth 16
+expect_usage_error "bad bake" "$snap" "$scene" -o "$cli_tmp/x.png" --bake maybe
 expect_usage_error "bad precision" "$snap" "$scene" -o "$cli_tmp/x.png" --precision dither
 expect_usage_error "zero tau" "$snap" "$scene" -o "$cli_tmp/x.png" --tau 0
 expect_usage_error "bad size" "$snap" "$scene" -o "$cli_tmp/x.png" --size 0x4

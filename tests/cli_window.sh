@@ -102,6 +102,29 @@ rmse=$("$bin/photosplat-compare" "$cli_tmp/maps-w.png" "$cli_tmp/maps-s.png" | s
 echo "window against photosplat-snap, global layer as maps: rmse $rmse"
 awk_true "$rmse < 2.0 / 255" && ok || bad "maps: the window and photosplat-snap differ: rmse $rmse"
 
+# Finished maps baked into textures on their quads (--bake, the window's
+# default): after an orbit away and back, the picture drawn from the textures
+# is the splats' (--bake off) within 2 codes rms and 0.5 % on the mean (at
+# these 2*10^4 photons a caustic splat's cone stands alone, and the texture
+# samples its peak at a quarter radius: 1.4 codes here, 0.5 at 3*10^5 photons
+# and 512^2), and the stats say what was baked; a bad value is refused.
+printf '0 wait done\n0.1 orbit 20 5\n0.2 orbit -20 -5\n0.3 wait done\n0.4 screenshot %s\n0.5 quit\n' "$cli_tmp/bake-on.png" \
+    >"$cli_tmp/bake-on.txt"
+sed "s/bake-on.png/bake-off.png/" "$cli_tmp/bake-on.txt" >"$cli_tmp/bake-off.txt"
+expect_success "window baked" xrun "$win" "$scene" "${same[@]}" --overlay off --script "$cli_tmp/bake-on.txt" \
+    --stats "$cli_tmp/bake-on.json"
+expect_success "window not baked" xrun "$win" "$scene" "${same[@]}" --overlay off --bake off \
+    --script "$cli_tmp/bake-off.txt" --stats "$cli_tmp/bake-off.json"
+grep -q '"baked_texels": 0,' "$cli_tmp/bake-on.json" && bad "bake: nothing baked" || ok
+grep -q '"baked_texels": 0,' "$cli_tmp/bake-off.json" && ok || bad "bake off: something baked"
+cmp_line=$("$bin/photosplat-compare" "$cli_tmp/bake-on.png" "$cli_tmp/bake-off.png")
+echo "window after an orbit, maps baked against splatted: $cmp_line"
+rmse=$(echo "$cmp_line" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
+mean_a=$(echo "$cmp_line" | sed -n 's/.*mean_a=\([^ ]*\).*/\1/p') mean_b=$(echo "$cmp_line" | sed -n 's/.*mean_b=\([^ ]*\).*/\1/p')
+awk_true "$rmse < 2.0 / 255 && ($mean_a - $mean_b)^2 < (0.005 * $mean_b)^2" && ok ||
+    bad "bake: the baked picture differs from the splats': $cmp_line"
+expect_usage_error "bad bake" "$win" "$scene" --bake maybe
+
 # Illuminance in false colour (key F; a script's set false-color): a picture of
 # its own (the lux in it are test_gl_illuminance's), and off again the normal
 # picture comes back, the photons kept.

@@ -907,6 +907,47 @@ static void catching_up_only_when_nothing_is_traced(void **state)
     ps_scene_destroy(scene);
 }
 
+/* After a moving camera's picture the next refresh is due sooner
+ * (PS_SESSION_STILL_SHARE of tau), else a tau after the last; and a moving
+ * picture is never the settled view, even one that drew every photon (maps
+ * of one batch, their level of detail all of them). */
+static void still_view_due_sooner_after_a_move(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = PS_FEED_BATCH / 4;
+    set.caps[PS_MAP_GLOBAL] = PS_FEED_BATCH / 4;
+    ps_camera_frame cam;
+    ps_session_frame f;
+    ps_session *s = start_and_refresh(scene, &set, &cam, &f);
+    ps_session_drawn(s, 0.01);
+    wait_ended(s);
+    for (int i = 0; i < 10 && !ps_session_settled(s); i++) {
+        refresh(s, &cam, &f);
+        ps_session_drawn(s, 0.01);
+    }
+    assert_true(ps_session_settled(s));
+    assert_near(ps_session_next_refresh(s, 10.0), 10.0 + set.tau, 1e-12);
+    cam.eye.x += 0.05;
+    refresh(s, &cam, &f);
+    ps_session_drawn(s, 0.01);
+    assert_true(f.moving);
+    ps_session_counts c;
+    ps_session_get_counts(s, &c);
+    assert_true(f.emitted[PS_MAP_CAUSTIC] == c.map[PS_MAP_CAUSTIC].emitted); /* all of them drawn */
+    assert_false(ps_session_settled(s));
+    assert_near(ps_session_next_refresh(s, 10.0), 10.0 + PS_SESSION_STILL_SHARE * set.tau, 1e-12);
+    refresh(s, &cam, &f); /* still: the full view */
+    ps_session_drawn(s, 0.01);
+    assert_false(f.moving);
+    assert_true(f.new_view);
+    assert_true(ps_session_settled(s));
+    assert_near(ps_session_next_refresh(s, 10.0), 10.0 + set.tau, 1e-12);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 /* Progressive area lights: the first refresh with one virtual light an area
  * light, then 2 x 2, then all 16, each change said (lights_changed); an
  * edit starts over at one; without the setting, 16 from the start. */
@@ -1126,6 +1167,7 @@ int main(void)
         cmocka_unit_test(radius_follows_the_schedule),
         cmocka_unit_test(catch_up_after_the_first_still_refresh),
         cmocka_unit_test(catching_up_only_when_nothing_is_traced),
+        cmocka_unit_test(still_view_due_sooner_after_a_move),
         cmocka_unit_test(env_fill_counts_each_face),
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(coarse_shadows_first),

@@ -161,6 +161,7 @@ void ps_preview_options_init(ps_preview_options *o, bool float_depth)
     o->layers = PS_LAYER_ALL;
     o->radius_schedule = PS_RADIUS_FIXED;
     o->radius_alpha = PS_RADIUS_ALPHA_DEFAULT;
+    o->bake = float_depth;
 }
 
 ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_preview_options *o, const ps_scene *s)
@@ -185,6 +186,7 @@ ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_pre
     set.radius_schedule = o->radius_schedule;
     set.radius_alpha = o->radius_alpha;
     set.global_layer = o->global_layer;
+    set.bake = o->bake;
     set.exposure = c->exposure;
     set.tau = o->tau;
     set.shadow_size = o->shadows ? PS_SHADOW_SIZE_DEFAULT : 0;
@@ -248,6 +250,8 @@ bool ps_preview_option(ps_cli *cli, const char *prog, ps_preview_options *o, ps_
         *st = choose_schedule(cli, ps_radius_schedule_names, &o->radius_schedule, err);
     else if (ps_cli_is(cli, "--global-layer"))
         *st = choose_global(cli, ps_global_layer_names, &o->global_layer, err);
+    else if (ps_cli_is(cli, "--bake"))
+        *st = choose_bool(cli, on_off, &o->bake, err);
     else if (ps_cli_is(cli, "--radius-alpha"))
         *st = ps_cli_double(cli, 0.01, 1.0, &o->radius_alpha, err);
     else if (ps_cli_is(cli, "--layers")) {

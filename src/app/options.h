@@ -51,6 +51,8 @@ typedef struct ps_preview_options {
     ps_radius_schedule radius_schedule; /* fixed */
     double radius_alpha;      /* progressive schedule's alpha (2/3) */
     ps_global_layer global_layer; /* splats (the thesis) or illumination maps */
+    bool bake;                /* finished maps on diffuse quads laid into textures (preview/bake.h):
+                               * on in the window, off in snap */
 } ps_preview_options;
 
 /* float_depth: whether the colour depth defaults to float (the window) or

@@ -68,6 +68,9 @@ static const char usage[] =
     "  --radius-alpha A         the progressive schedule's alpha in (0, 1] (default 2/3)\n"
     "  --global-layer splats|maps  the global map as splats, or as illumination maps\n"
     "                           on the surfaces (glossy lobes still splatted) (default splats)\n"
+    "  --bake on|off            float layers: once a map is traced to its end and its\n"
+    "                           photons all lie on diffuse quads, lay its splats into\n"
+    "                           textures on them, drawn for each later view (default off)\n"
     "  --hdr-layers PREFIX      also each layer alone, linear: PREFIX-direct.pfm,\n"
     "                           PREFIX-caustic.pfm, PREFIX-global.pfm, PREFIX-specular.pfm\n"
     "  --checkpoints T1,T2,...  progressive mode: at each of these seconds, write the\n"
@@ -1129,7 +1132,7 @@ static ps_status run_script(snap_run *s, double t_start, double *first_frame, ps
             break;
         if (o->time > 0.0 && now - t_start >= o->time)
             break;
-        double due = now + o->p.tau;
+        double due = ps_session_next_refresh(s->session, now);
         if (!waiting && next < count) {
             double at = t0 + delay + ps_script_at(o->script, next)->time;
             due = fmin(due, fmax(at, now));

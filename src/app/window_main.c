@@ -104,6 +104,9 @@ static const char usage[] =
     "  --radius-alpha A         the progressive schedule's alpha (default 2/3)\n"
     "  --global-layer splats|maps  the global map as splats or as illumination maps\n"
     "                           on the surfaces (default splats; key M)\n"
+    "  --bake on|off            once a map is traced to its end and its photons all\n"
+    "                           lie on diffuse quads, lay its splats into textures on\n"
+    "                           them and draw those for each new view (default on)\n"
     "  --overlay on|off         the text overlay (default on)\n"
     "  --autosave on|off        write every edit within a second to\n"
     "                           NAME.autosave.scn (default on; off with --script,\n"
@@ -1140,7 +1143,7 @@ static ps_status session(app *a, ps_error *err)
              * 0.95 s: scripts/bench-window.sh orbit). */
             next = a->frame.edit_lod || ps_session_catching_up(a->session)
                        ? 0.0
-                       : now + ps_session_get_settings(a->session)->tau;
+                       : ps_session_next_refresh(a->session, now);
         }
     }
     if (st == PS_OK && a->session)
@@ -1184,6 +1187,13 @@ static ps_status write_stats(app *a, ps_error *err)
     ps_stats_add(&rs, "moving_frames", (double)a->moving_frames);
     ps_stats_add(&rs, "moving_frame_seconds_mean", a->moving_frames ? a->moving_seconds / (double)a->moving_frames : 0.0);
     ps_stats_add(&rs, "full_after_stop_seconds", a->full_after_stop);
+    size_t baked_texels = 0;
+    for (int k = 0; k < PS_MAP_COUNT && a->session; k++) {
+        size_t texels;
+        ps_session_baked(a->session, (ps_map_kind)k, &texels);
+        baked_texels += texels;
+    }
+    ps_stats_add(&rs, "baked_texels", (double)baked_texels);
     ps_stats_add(&rs, "composite_seconds_mean", a->show_count ? a->show_sum / (double)a->show_count : 0.0);
     ps_stats_add(&rs, "counter_stopped", a->session && ps_session_counter_stopped(a->session, NULL) ? 1.0 : 0.0);
     ps_stats_add(&rs, "caustic_cap", set ? (double)set->caps[PS_MAP_CAUSTIC] : 0.0);

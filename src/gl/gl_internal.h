@@ -120,5 +120,21 @@ void ps_gl_layers_set_extra(ps_gl_layers *l, GLuint texture, double gain);
 
 /* Splats (gl_splat.c). */
 void ps_gl_upload_kernel(ps_gl_renderer *r, const ps_kernel_texture *k);
+/* A map's baked textures (preview/bake.h, gl_bake.c): one RGBA32F texture
+ * and FBO a target of the session's plan, made when the plan's first splats
+ * come, dropped when the session says the plan is new. */
+typedef struct ps_gl_bake {
+    size_t count;
+    ps_bake_target *targets;
+    GLuint *tex, *fbo;
+    bool complete; /* every FBO could be made (else nothing is baked or drawn) */
+} ps_gl_bake;
+void ps_gl_bake_reset(ps_gl_bake *g);
+/* The plan's splats of this refresh added to its textures (made first). */
+void ps_gl_bake_lay(ps_gl_bake *g, ps_gl_renderer *r, const ps_bake *plan);
+/* Each target on the side the eye sees, textured, added to the bound
+ * framebuffer under the view's matrices where its object shows. */
+void ps_gl_bake_draw(const ps_gl_bake *g, const ps_gl_renderer *r, ps_vec3 eye);
+
 
 #endif

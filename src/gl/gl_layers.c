@@ -43,6 +43,7 @@ struct ps_gl_layers {
     bool albedo; /* LAYER_ALBEDO_TEX holds this view's T */
     GLuint extra_tex; /* the specular layer (gl_specular.c), times extra_gain */
     double extra_gain;
+    ps_gl_bake bake[PS_MAP_COUNT]; /* each map's baked textures (preview/bake.h) */
 };
 
 GLuint ps_gl_layers_depth_stencil(const ps_gl_layers *l) { return l->depth_stencil; }
@@ -110,6 +111,8 @@ void ps_gl_layers_destroy(ps_gl_layers *l)
 {
     if (!l)
         return;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        ps_gl_bake_reset(&l->bake[k]);
     glDeleteFramebuffers(LAYER_TEX_COUNT, l->fbo);
     glDeleteFramebuffers(PS_MAP_COUNT, l->shrunk_fbo);
     glDeleteTextures(LAYER_TEX_COUNT, l->tex);
@@ -264,6 +267,17 @@ void ps_gl_layers_add(ps_gl_layers *l, ps_gl_renderer *r, int map, const ps_spla
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
 }
 
+/* Map k's layer drawn from its baked textures (the layer cleared first). */
+static void draw_baked(ps_gl_layers *l, ps_gl_renderer *r, int k, ps_vec3 eye)
+{
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_CAUSTIC_TEX + k]);
+    glViewport(0, 0, l->map_w[k], l->map_h[k]);
+    ps_gl_bake_draw(&l->bake[k], r, eye);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
 /* The bound texture sampled texel for texel (the view fills the layers),
  * or bilinearly (a level of detail scaled up). */
 static void set_filter(bool scaled)
@@ -340,9 +354,16 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
         glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     }
     for (int k = 0; k < PS_MAP_COUNT; k++) {
-        if (f->map[k].clear)
+        const ps_session_layer *m = &f->map[k];
+        if (m->bake_reset)
+            ps_gl_bake_reset(&l->bake[k]);
+        if (m->bake)
+            ps_gl_bake_lay(&l->bake[k], r, m->bake);
+        if (m->clear)
             ps_gl_layers_clear_map(l, k);
-        ps_gl_layers_add(l, r, k, f->map[k].batch, f->splat, f->map[k].radius, f->point_size);
+        if (m->baked)
+            draw_baked(l, r, k, cam->eye);
+        ps_gl_layers_add(l, r, k, m->batch, f->splat, m->radius, f->point_size);
     }
     if (f->imap_colors ? f->imap_redraw || !l->imap_drawn : l->imap_drawn)
         draw_imap(l, r, f);

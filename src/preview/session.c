@@ -86,7 +86,22 @@ struct ps_session {
     bool skip_prime;       /* ... and every map kept photons: no first round to prime */
     uint64_t feed_gen;     /* the feed's generation the drawn prefixes belong to */
     uint64_t maps_epoch;   /* ps_session_maps_epoch */
+    /* settings.bake (bake.h): each map's plan, and how far it is laid. */
+    ps_bake *bake[PS_MAP_COUNT];
+    struct session_bake {
+        int state;             /* BAKE_* */
+        size_t laid;           /* photons in the textures (a prefix ending at a feed mark) ... */
+        uint64_t laid_emitted; /* ... this many emitted */
+        /* What the textures were laid from: another of any drops them. */
+        uint64_t epoch;        /* maps_epoch */
+        const ps_material *mats;
+        double radius, kernel_mean;
+    } baked[PS_MAP_COUNT];
 };
+
+/* A map's bake: not planned yet; refused (not all on diffuse quads, or too
+ * many texels); being laid; laid, the layer drawn from it. */
+enum { BAKE_NONE, BAKE_REFUSED, BAKE_LAYING, BAKE_DONE };
 
 int ps_session_tracing_threads(int64_t requested, bool draws_while_tracing)
 {
@@ -364,8 +379,10 @@ void ps_session_destroy(ps_session *s)
     ps_preview_mesh_free(&s->moving_mesh);
     ps_preview_lights_free(&s->lights);
     ps_kernel_texture_free(&s->kernel);
-    for (int k = 0; k < PS_MAP_COUNT; k++)
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_splat_batch_free(&s->batch[k]);
+        ps_bake_destroy(s->bake[k]);
+    }
     free(s->white);
     ps_illummap_destroy(s->imap);
     free(s->lobe_mats);
@@ -586,6 +603,98 @@ static ps_status imap_refresh(ps_session *s, const ps_photon_map *m, const ps_ca
     return st;
 }
 
+/* Whether map k may be baked at all (settings.bake): incremental triangle
+ * splats, not the illumination maps' global layer. */
+static bool bake_wanted(const ps_session *s, int k)
+{
+    return s->set.bake && incremental(s) && s->set.splat == PS_SPLAT_TRIANGLES && !(k == PS_MAP_GLOBAL && s->imap);
+}
+
+/* Map k's bake dropped when what it was laid from changed (the maps, the
+ * materials the splats take, the radius for its photons, the kernel), or
+ * baking no longer applies: the textures to be dropped too. */
+static void bake_check(ps_session *s, int k, const ps_material *mats, double radius, ps_session_frame *out)
+{
+    struct session_bake *b = &s->baked[k];
+    if (b->state == BAKE_NONE)
+        return;
+    if (!bake_wanted(s, k) || b->epoch != s->maps_epoch || b->mats != mats || b->radius != radius ||
+        b->kernel_mean != s->kernel.mean) {
+        out->map[k].bake_reset = b->state != BAKE_REFUSED;
+        memset(b, 0, sizeof *b);
+    }
+}
+
+/* Under the lock, once the feed is over and map k's layer shows all of it
+ * for a still camera: planned the first time (the textures made anew), then
+ * a budget's photons a refresh laid into the textures. */
+static ps_status bake_step(ps_session *s, int k, const ps_photon_map *m, const ps_material *mats,
+                           ps_session_frame *out, ps_error *err)
+{
+    struct session_bake *b = &s->baked[k];
+    if (b->state == BAKE_NONE) {
+        if (!s->bake[k]) {
+            ps_status st = ps_bake_create(&s->bake[k], err);
+            if (st != PS_OK)
+                return st;
+        }
+        double radius = radius_at(s, k, s->drawn_emitted[k]);
+        bool covered;
+        ps_status st = ps_bake_plan(s->bake[k], s->scene, mats, m->photons, m->materials, m->objects, m->count, radius,
+                                    &covered, err);
+        if (st != PS_OK)
+            return st;
+        b->state = covered ? BAKE_LAYING : BAKE_REFUSED;
+        b->laid = 0;
+        b->laid_emitted = 0;
+        b->epoch = s->maps_epoch;
+        b->mats = mats;
+        b->radius = radius;
+        b->kernel_mean = s->kernel.mean;
+        out->map[k].bake_reset = true;
+    }
+    if (b->state != BAKE_LAYING)
+        return PS_OK;
+    /* The catch-up's larger share: nothing else waits for these refreshes
+     * (ps_session_catching_up), and each pays the view's fixed costs. */
+    uint64_t emitted;
+    size_t end = prefix_within(s, k, b->laid, b->laid_emitted, PS_SESSION_CATCH_UP_GAIN * s->budget * s->budget_share,
+                               &emitted);
+    ps_splat_params p;
+    memset(&p, 0, sizeof p);
+    p.mode = PS_SPLAT_TRIANGLES;
+    p.radius = b->radius;
+    p.kernel_mean = s->kernel.mean;
+    p.kernel_extent = s->kernel.extent;
+    p.scale = 1.0; /* stored powers, as the incremental layers sum them */
+    p.materials = mats;
+    ps_status st = ps_bake_build(s->bake[k], m->photons, m->materials, m->objects, b->laid, end, &p, err);
+    if (st != PS_OK)
+        return st;
+    out->splats += ps_bake_splats(s->bake[k]);
+    out->map[k].bake = s->bake[k];
+    b->laid = end;
+    b->laid_emitted = emitted;
+    if (end >= m->count)
+        b->state = BAKE_DONE;
+    return PS_OK;
+}
+
+/* Whether map k still waits to be baked (ps_session_settled), under the lock. */
+static bool bake_pending(const ps_session *s, int k, const ps_photon_map *m)
+{
+    return bake_wanted(s, k) && (s->set.layers & ps_map_layer((ps_map_kind)k)) && m->count > 0 &&
+           (s->baked[k].state == BAKE_NONE || s->baked[k].state == BAKE_LAYING);
+}
+
+bool ps_session_baked(const ps_session *s, ps_map_kind k, size_t *texels)
+{
+    bool done = s->baked[k].state == BAKE_DONE;
+    if (texels)
+        *texels = done ? ps_bake_texels(s->bake[k]) : 0;
+    return done;
+}
+
 ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_session_frame *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -687,6 +796,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     if (out->new_view)
         s->lobe_drawn = 0;
     double growth[PS_MAP_COUNT]; /* the level of detail's radius growth */
+    bool baked_draw[PS_MAP_COUNT] = {false, false}; /* the layer drawn from its baked textures */
     for (int k = 0; k < PS_MAP_COUNT; k++)
         growth[k] = 1.0;
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
@@ -705,6 +815,23 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         ps_splat_batch_reset_carry(b);
         b->wanted = b->lost = 0.0;
         const ps_photon_map *m = &maps[k];
+        const ps_material *kmats = k == PS_MAP_GLOBAL ? global_mats : materials;
+        {
+            size_t nm;
+            const ps_feed_mark *mk = ps_feed_marks(s->feed, (ps_map_kind)k, &nm);
+            bake_check(s, k, kmats, radius_at(s, k, nm ? mk[nm - 1].emitted : 0), out);
+        }
+        if (s->baked[k].state == BAKE_DONE && (s->set.layers & ps_map_layer((ps_map_kind)k))) {
+            /* The layer is the baked textures, whatever the view: drawn into
+             * it again for a new one (a moving camera's too: no level of
+             * detail needed), else kept. */
+            s->drawn[k] = s->baked[k].laid;
+            s->drawn_emitted[k] = s->baked[k].laid_emitted;
+            out->emitted[k] = s->baked[k].laid_emitted;
+            s->splat_radius[k] = s->baked[k].radius;
+            baked_draw[k] = out->new_view;
+            continue;
+        }
         size_t from = inc ? s->drawn[k] : 0;
         uint64_t emitted;
         size_t end = prefix(s, k, from, inc ? s->drawn_emitted[k] : 0, &emitted);
@@ -734,7 +861,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         p.point_size = s->set.point_size;
         p.precision = s->set.precision;
         p.levels = float_splats(s) ? 0 : 255;
-        p.materials = k == PS_MAP_GLOBAL ? global_mats : materials;
+        p.materials = kmats;
         p.objects = s->set.stencil_clip ? m->objects + from : NULL;
         p.cam = *cam;
         st = ps_splat_build(m->photons + from, m->materials + from, end - from, &p, b, err);
@@ -742,6 +869,12 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         lost += b->lost;
         out->splats += b->splats;
     }
+    /* Baking (settings.bake): once nothing more will arrive and a still
+     * view shows every photon of the map, its textures are laid. */
+    bool feed_over = ps_feed_ended(s->feed) && !ps_feed_merge_pending(s->feed) && ps_feed_generation(s->feed) == s->feed_gen;
+    for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
+        if (feed_over && !s->moving && bake_pending(s, k, &maps[k]) && s->drawn[k] >= maps[k].count)
+            st = bake_step(s, k, &maps[k], k == PS_MAP_GLOBAL ? global_mats : materials, out, err);
     bool whole = true;
     for (int k = 0; k < PS_MAP_COUNT; k++)
         whole = whole && s->drawn[k] >= maps[k].count;
@@ -787,7 +920,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         ps_session_layer *l = &out->map[k];
         bool shown = (s->set.layers & ps_map_layer((ps_map_kind)k)) && out->emitted[k] > 0;
-        l->clear = !inc;
+        l->clear = !inc || baked_draw[k];
+        l->baked = baked_draw[k];
         l->batch = &s->batch[k];
         l->radius = s->splat_radius[k];
         l->gain = !shown ? 0.0 : inc ? exposure(s) * (double)s->set.caps[k] / (double)out->emitted[k] : 1.0;
@@ -905,9 +1039,14 @@ bool ps_session_refine_lights(ps_session *s)
 
 bool ps_session_catching_up(ps_session *s)
 {
-    if (!s->catch_up || !incremental(s))
+    /* A bake being laid: planned once the feed was over, so nothing is
+     * traced meanwhile either. */
+    bool laying = false;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        laying = laying || s->baked[k].state == BAKE_LAYING;
+    if (!(s->catch_up || laying) || !incremental(s))
         return false;
-    if (s->user_paused || s->counter_stopped)
+    if (!laying && (s->user_paused || s->counter_stopped))
         return true;
     ps_feed_lock(s->feed);
     bool ended = ps_feed_ended(s->feed);
@@ -915,9 +1054,16 @@ bool ps_session_catching_up(ps_session *s)
     return ended;
 }
 
+double ps_session_next_refresh(const ps_session *s, double at)
+{
+    return at + (s->moving ? PS_SESSION_STILL_SHARE : 1.0) * s->set.tau;
+}
+
 bool ps_session_settled(ps_session *s)
 {
-    if (s->edited || s->view_dirty || !s->have_cam || s->lights_pending)
+    /* A moving camera's picture (or an edit's first) is a level of detail,
+     * whatever it drew: the full view is still to come. */
+    if (s->edited || s->view_dirty || !s->have_cam || s->lights_pending || s->moving)
         return false;
     if (s->user_paused || s->counter_stopped)
         return true;
@@ -925,7 +1071,7 @@ bool ps_session_settled(ps_session *s)
     bool over = ps_feed_ended(s->feed) && !ps_feed_merge_pending(s->feed) &&
                 ps_feed_generation(s->feed) == s->feed_gen;
     for (int k = 0; k < PS_MAP_COUNT; k++)
-        over = over && s->drawn[k] >= ps_feed_maps(s->feed)[k].count;
+        over = over && s->drawn[k] >= ps_feed_maps(s->feed)[k].count && !bake_pending(s, k, &ps_feed_maps(s->feed)[k]);
     ps_feed_unlock(s->feed);
     return over;
 }

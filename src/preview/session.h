@@ -37,6 +37,7 @@
 #include "photon/estimate.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
+#include "preview/bake.h"
 #include "preview/illummap.h"
 #include "preview/layers.h"
 #include "preview/lights.h"
@@ -189,6 +190,11 @@ typedef struct ps_session_settings {
     uint64_t edit_splats_whole;    /* an edit's first refresh draws every photon when the maps
                                     * hold at most this many at 256^2, in proportion to the
                                     * view's pixels (PS_SESSION_EDIT_SPLATS_WHOLE) */
+    bool bake;                     /* incremental, triangle splats: a map traced to its end
+                                    * whose photons all lie on diffuse quads is laid into
+                                    * textures on them (bake.h), a budget a refresh once the
+                                    * view shows all of it, and each later view draws the
+                                    * textures instead of its splats (the window; default off) */
 } ps_session_settings;
 
 /* A progressive start's first shadow maps: this many times fewer texels a
@@ -266,6 +272,11 @@ typedef struct ps_session_layer {
     int shrink;                  /* drawn at 1/shrink of the view's pixels a side, scaled up in
                                   * the composite (PS_SESSION_MOVING_GLOBAL_SHRINK; 1: all of
                                   * them); read at a new view, kept until the next */
+    /* settings.bake (bake.h): */
+    bool bake_reset;             /* drop the map's baked textures (its photons or their look changed) */
+    const ps_bake *bake;         /* this refresh's splats to lay into the textures of its plan
+                                  * (made when the first come); NULL: none */
+    bool baked;                  /* the layer is the textures: draw them into it (after clear) */
 } ps_session_layer;
 
 typedef struct ps_session_frame {
@@ -339,12 +350,30 @@ void ps_session_drawn(ps_session *s, double draw_seconds);
 
 /* Whether the refreshes are drawing a view again after the camera stopped
  * (PS_SESSION_CATCH_UP_GAIN) with nothing traced meanwhile (the maps at
- * their end, or tracing held): the next refresh need not wait for tau, as
- * no tracer shares the cores and the user waits for the full picture. */
+ * their end, or tracing held), or laying a bake (settings.bake, the maps at
+ * their end): the next refresh need not wait for tau, as no tracer shares
+ * the cores and the user waits for the full picture, or for the camera to
+ * move freely. */
 bool ps_session_catching_up(ps_session *s);
 
+/* After a moving camera's picture, the next refresh is due this share of tau
+ * later (else a tau): a camera step before then draws its own picture at
+ * once (the window and snap's scripts refresh on a camera move), so that
+ * refresh finds the camera stopped and draws the full view. Longer than an
+ * orbit's steps 0.05 s apart (at a quarter of tau, still views came between
+ * them and the orbit drew 37-52 moving frames of its 60 steps); with baked
+ * maps (settings.bake) the full view over 10^6 photons at 512^2 is one
+ * refresh, and waiting a whole tau for it was most of its return after an
+ * orbit (0.14 s). */
+#define PS_SESSION_STILL_SHARE 0.6
+/* When the next refresh is due after the one at `at` (the caller's clock, the
+ * instant it counts tau from): at + tau, or at + PS_SESSION_STILL_SHARE tau
+ * after a moving camera's picture. */
+double ps_session_next_refresh(const ps_session *s, double at);
+
 /* Whether everything is shown: no edit or new view pending, and every map at
- * its end and drawn, or tracing held for good (paused, counter stopped). */
+ * its end and drawn (and baked, where settings.bake lays it), or tracing
+ * held for good (paused, counter stopped). */
 bool ps_session_settled(ps_session *s);
 
 /* ---- settings ----------------------------------------------------------------- */
@@ -469,6 +498,9 @@ void ps_session_env_fill(ps_session *s, ps_vec3 centre, int face_side, const siz
  * repair's end putting a map back in index order): what was made from the
  * maps (the specular layer's cube maps) is to be made again. */
 uint64_t ps_session_maps_epoch(const ps_session *s);
+/* Whether map k's layer is drawn from its baked textures (bake.h) from now
+ * on; *texels: theirs (0 when not). */
+bool ps_session_baked(const ps_session *s, ps_map_kind k, size_t *texels);
 /* Map k's splat radius for the last refresh (under the radius schedule). */
 double ps_session_radius(const ps_session *s, ps_map_kind k);
 

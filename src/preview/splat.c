@@ -527,7 +527,7 @@ static void build_splats_of(build_range *R)
             if (p->mode == PS_SPLAT_SPRITES)
                 c = ps_rgb_scale(c, cos_v);
         }
-        double lift = PS_SPLAT_EYE_OFFSET * dist;
+        double lift = p->surface ? 0.0 : PS_SPLAT_EYE_OFFSET * dist;
         if (p->mode == PS_SPLAT_SPRITES) {
             double tan_v = sqrt(fmax(0.0, 1.0 - cos_v * cos_v)) / cos_v;
             lift = fmax(lift, r * fmin(tan_v, PS_SPLAT_SPRITE_MAX_TAN));

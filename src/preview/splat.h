@@ -108,6 +108,10 @@ typedef struct ps_splat_params {
      * whatever lies behind its edge. */
     const uint32_t *objects;
     ps_camera_frame cam;
+    /* Lay the splats on their surfaces, not lifted toward the eye: drawn
+     * into a surface's own texture (preview/bake.h), where cam only chooses
+     * the side and the lift would shift them along it. */
+    bool surface;
     int threads;        /* building threads; 0: one a core (the same bytes either way) */
 } ps_splat_params;
 

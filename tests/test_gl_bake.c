@@ -1,0 +1,303 @@
+/* test_gl_bake.c: finished maps baked into textures on their quads
+ * (preview/bake.h, settings.bake) and drawn from them for a new view,
+ * against the same view's splats:
+ *  - the Cornell box with its glass and mirror spheres: each map's layer
+ *    drawn from its textures within 0.5 % of the splats' mean and at a
+ *    relative squared error of at most 0.001 (measured: 0.04 % and 0.19 %,
+ *    2.6e-4 and 2.0e-4; the caustic's sharp edges sampled at a quarter
+ *    radius; a texture shifted by half a texel, drawn on the wrong side or
+ *    without its last batch of photons fails);
+ *  - a map with photons on a diffuse sphere is not baked, and the session
+ *    still settles;
+ *  - an edit drops the textures (the frame says so) and the maps are baked
+ *    again once traced. */
+#include "test.h"
+
+#include <GL/osmesa.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_render.h"
+#include "image/image.h"
+#include "preview/session.h"
+#include "scene/scene.h"
+
+#define SIDE 128
+
+static const char *const BOX = "camera eye 0 1 3.4 target 0 1 0 up 0 1 0 fov 40\n"
+                               "material white diffuse albedo 0.75 0.75 0.75\n"
+                               "material red diffuse albedo 0.75 0.25 0.25\n"
+                               "material green diffuse albedo 0.25 0.75 0.25\n"
+                               "material glass dielectric ior 1.5\n"
+                               "material mirror mirror reflectance 1 1 1\n"
+                               "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
+                               "quad corner -1 2 -1 edge1 2 0 0 edge2 0 0 2 material white\n"
+                               "quad corner -1 0 -1 edge1 2 0 0 edge2 0 2 0 material white\n"
+                               "quad corner -1 0 -1 edge1 0 2 0 edge2 0 0 2 material red\n"
+                               "quad corner 1 0 -1 edge1 0 0 2 edge2 0 2 0 material green\n"
+                               "sphere center 0.35 0.4 0.2 radius 0.4 material glass\n"
+                               "sphere center -0.45 0.35 -0.4 radius 0.35 material mirror\n"
+                               "light point position 0 1.9 0 power 100 100 100\n"
+                               "photons caustic 60000 global 20000\n"
+                               "radius caustic 0.03 global 0.12\n";
+
+/* The same with the mirror sphere diffuse: global photons land on it. */
+static const char *const MATTE_SPHERE = "camera eye 0 1 3.4 target 0 1 0 up 0 1 0 fov 40\n"
+                                        "material white diffuse albedo 0.75 0.75 0.75\n"
+                                        "material glass dielectric ior 1.5\n"
+                                        "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
+                                        "quad corner -1 0 -1 edge1 2 0 0 edge2 0 2 0 material white\n"
+                                        "sphere center 0.35 0.4 0.2 radius 0.4 material glass\n"
+                                        "sphere center -0.45 0.35 -0.4 radius 0.35 material white\n"
+                                        "light point position 0 1.9 0 power 100 100 100\n"
+                                        "photons caustic 20000 global 20000\n"
+                                        "radius caustic 0.03 global 0.12\n";
+
+typedef struct rig {
+    ps_scene *scene;
+    ps_session *s;
+    OSMesaContext ctx;
+    uint8_t *buffer;
+    ps_camera_frame cam;
+    ps_gl_renderer *gl;
+    ps_gl_layers *layers;
+} rig;
+
+static void rig_open(rig *g, const char *text)
+{
+    ps_error err;
+    if (ps_scene_load_text(text, "bake.scn", "", NULL, &g->scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_session_settings set = ps_session_default_settings(g->scene);
+    set.threads = 2;
+    set.seed = 1;
+    set.float_buffer = true;
+    set.incremental = true;
+    set.bake = true;
+    set.layers = PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
+    if (ps_session_create(g->scene, &set, &g->s, &err) != PS_OK)
+        fail_msg("session: %s", err.msg);
+    assert_int_equal(ps_session_trace_all(g->s, &err), PS_OK);
+    g->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    assert_non_null(g->ctx);
+    g->buffer = malloc(4 * SIDE * SIDE);
+    assert_non_null(g->buffer);
+    assert_true(OSMesaMakeCurrent(g->ctx, g->buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
+    g->cam = ps_camera_frame_make(ps_scene_camera(g->scene), SIDE, SIDE);
+    ps_gl_scene gs = ps_gl_scene_of(g->s);
+    ps_gl_options go = {true, true, 0, false};
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g->s), &go, &g->gl, &err), PS_OK);
+    assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &g->layers, &err), PS_OK);
+}
+
+static void rig_close(rig *g)
+{
+    ps_gl_layers_destroy(g->layers);
+    ps_gl_renderer_destroy(g->gl);
+    OSMesaDestroyContext(g->ctx);
+    free(g->buffer);
+    ps_session_destroy(g->s);
+    ps_scene_destroy(g->scene);
+}
+
+/* One refresh at cam, drawn, said to take draw_seconds (the next budget). */
+static void refresh_taking(rig *g, const ps_camera_frame *cam, ps_session_frame *f, double draw_seconds)
+{
+    ps_error err;
+    assert_int_equal(ps_session_refresh(g->s, cam, f, &err), PS_OK);
+    ps_gl_layers_draw(g->layers, g->gl, cam, f);
+    ps_session_drawn(g->s, draw_seconds);
+}
+
+static void refresh(rig *g, const ps_camera_frame *cam, ps_session_frame *f) { refresh_taking(g, cam, f, 0.01); }
+
+/* Refreshes at the rig's camera until everything is shown (and baked):
+ * the refreshes that lay a bake need not wait for tau. */
+static void settle(rig *g, ps_session_frame *f)
+{
+    int n = 0;
+    do {
+        refresh(g, &g->cam, f);
+        bool laid = false, more = false; /* laid this refresh; more to lay */
+        for (int k = 0; k < PS_MAP_COUNT; k++) {
+            laid = laid || f->map[k].bake;
+            more = more || (f->map[k].bake && !ps_session_baked(g->s, (ps_map_kind)k, NULL));
+        }
+        if (laid)
+            assert_true(ps_session_catching_up(g->s) == more);
+        assert_true(++n < 10000);
+    } while (!ps_session_settled(g->s));
+    assert_false(ps_session_catching_up(g->s));
+}
+
+/* Map k's layer alone, composited. */
+static ps_image layer(rig *g, const ps_session_frame *f, int k)
+{
+    double gains[PS_MAP_COUNT] = {0.0, 0.0};
+    gains[k] = f->map[k].gain;
+    ps_image img;
+    ps_error err;
+    assert_int_equal(ps_gl_layers_composite(g->layers, 0.0, gains, &img, &err), PS_OK);
+    return img;
+}
+
+static double image_mean(const ps_image *img)
+{
+    double sum = 0.0;
+    size_t n = 3 * (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n; i++)
+        sum += img->rgb[i];
+    return sum / (double)n;
+}
+
+/* The camera away and back: the second refresh back is the full view
+ * again, drawn anew. */
+static void away_and_back(rig *g, ps_session_frame *f)
+{
+    ps_camera_frame away = g->cam;
+    away.eye.x += 0.05;
+    refresh(g, &away, f);
+    assert_true(f->moving);
+    refresh(g, &g->cam, f);
+    assert_true(f->moving);
+    refresh(g, &g->cam, f);
+    assert_false(f->moving);
+    assert_true(f->new_view);
+}
+
+static void baked_layers_match_the_splats(void **state)
+{
+    (void)state;
+    rig g;
+    rig_open(&g, BOX);
+    ps_session_frame f;
+    settle(&g, &f);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        size_t texels;
+        assert_true(ps_session_baked(g.s, (ps_map_kind)k, &texels));
+        assert_true(texels > 0);
+    }
+    /* The view settled before the bake: its layers are the splats. */
+    ps_image splats[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        splats[k] = layer(&g, &f, k);
+    away_and_back(&g, &f);
+    assert_int_equal(f.splats, 0);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        assert_true(f.map[k].baked && f.map[k].clear);
+        ps_image baked = layer(&g, &f, k);
+        size_t n = 3 * (size_t)SIDE * SIDE;
+        double se = 0.0, ss = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            se += (baked.rgb[i] - splats[k].rgb[i]) * (baked.rgb[i] - splats[k].rgb[i]);
+            ss += splats[k].rgb[i] * splats[k].rgb[i];
+        }
+        double mb = image_mean(&baked), ms = image_mean(&splats[k]);
+        printf("%s layer: baked mean %.5f, splats %.5f; relative squared error %.2g\n", k ? "global" : "caustic", mb,
+               ms, se / ss);
+        assert_true(ms > 0.0);
+        assert_near(mb, ms, 0.005 * ms);
+        assert_true(se / ss <= 0.001);
+        ps_image_destroy(&baked);
+        ps_image_destroy(&splats[k]);
+    }
+    /* Moving, the layers are the textures too: no level of detail. */
+    ps_camera_frame away = g.cam;
+    away.eye.y += 0.1;
+    refresh(&g, &away, &f);
+    assert_true(f.moving && f.map[PS_MAP_CAUSTIC].baked && f.map[PS_MAP_GLOBAL].baked);
+    assert_int_equal(f.splats, 0);
+    rig_close(&g);
+}
+
+static void photons_off_the_quads_are_splatted(void **state)
+{
+    (void)state;
+    rig g;
+    rig_open(&g, MATTE_SPHERE);
+    ps_session_frame f;
+    settle(&g, &f);
+    /* A map is baked exactly when all its photons lie on quads (the
+     * global map's land on the matte sphere too). */
+    const ps_photon_map *maps = ps_session_maps(g.s);
+    size_t nobj;
+    const ps_object *obj = ps_scene_objects(g.scene, &nobj);
+    bool on_quads[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        on_quads[k] = maps[k].count > 0;
+        for (size_t i = 0; i < maps[k].count; i++)
+            on_quads[k] = on_quads[k] && obj[maps[k].objects[i]].type == PS_OBJ_QUAD;
+        assert_int_equal(ps_session_baked(g.s, (ps_map_kind)k, NULL), on_quads[k]);
+    }
+    assert_false(on_quads[PS_MAP_GLOBAL]);
+    away_and_back(&g, &f);
+    assert_int_equal(f.map[PS_MAP_CAUSTIC].baked, on_quads[PS_MAP_CAUSTIC]);
+    assert_false(f.map[PS_MAP_GLOBAL].baked);
+    assert_true(f.splats > 0);
+    rig_close(&g);
+}
+
+/* The textures are the same bytes however many refreshes laid them: each
+ * target's splats go in index order whatever the budget. */
+static void baked_bytes_do_not_depend_on_the_budget(void **state)
+{
+    (void)state;
+    ps_image img[2][PS_MAP_COUNT];
+    int refreshes[2] = {0, 0};
+    for (int run = 0; run < 2; run++) {
+        rig g;
+        rig_open(&g, BOX);
+        ps_session_frame f;
+        do { /* a slow drawing makes a small budget: more refreshes */
+            refresh_taking(&g, &g.cam, &f, run == 0 ? 0.01 : 10.0);
+            refreshes[run]++;
+        } while (!ps_session_settled(g.s));
+        away_and_back(&g, &f);
+        for (int k = 0; k < PS_MAP_COUNT; k++) {
+            assert_true(f.map[k].baked);
+            img[run][k] = layer(&g, &f, k);
+        }
+        rig_close(&g);
+    }
+    printf("laid and drawn in %d and %d refreshes\n", refreshes[0], refreshes[1]);
+    assert_true(refreshes[1] > refreshes[0]);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        size_t n = 3 * (size_t)SIDE * SIDE;
+        assert_memory_equal(img[0][k].rgb, img[1][k].rgb, n * sizeof *img[0][k].rgb);
+        ps_image_destroy(&img[0][k]);
+        ps_image_destroy(&img[1][k]);
+    }
+}
+
+static void an_edit_drops_the_textures(void **state)
+{
+    (void)state;
+    rig g;
+    rig_open(&g, BOX);
+    ps_session_frame f;
+    settle(&g, &f);
+    ps_error err;
+    assert_int_equal(ps_session_move_light(g.s, 0, ps_v3(0.2, 1.9, 0.0), &err), PS_OK);
+    ps_session_changes ch;
+    assert_int_equal(ps_session_update(g.s, &ch, &err), PS_OK);
+    assert_int_equal(ps_session_trace_all(g.s, &err), PS_OK);
+    refresh(&g, &g.cam, &f);
+    assert_true(f.map[PS_MAP_CAUSTIC].bake_reset && f.map[PS_MAP_GLOBAL].bake_reset);
+    assert_false(f.map[PS_MAP_CAUSTIC].baked);
+    assert_false(ps_session_baked(g.s, PS_MAP_CAUSTIC, NULL));
+    settle(&g, &f);
+    assert_true(ps_session_baked(g.s, PS_MAP_CAUSTIC, NULL) && ps_session_baked(g.s, PS_MAP_GLOBAL, NULL));
+    rig_close(&g);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(baked_layers_match_the_splats),
+        cmocka_unit_test(photons_off_the_quads_are_splatted),
+        cmocka_unit_test(baked_bytes_do_not_depend_on_the_budget),
+        cmocka_unit_test(an_edit_drops_the_textures),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
