@@ -1040,10 +1040,11 @@ bool ps_session_refine_lights(ps_session *s)
 bool ps_session_catching_up(ps_session *s)
 {
     /* A bake being laid: planned once the feed was over, so nothing is
-     * traced meanwhile either. */
+     * traced meanwhile either. Only while its layer shows: a hidden one's
+     * bake waits (refreshes back to back would lay nothing). */
     bool laying = false;
     for (int k = 0; k < PS_MAP_COUNT; k++)
-        laying = laying || s->baked[k].state == BAKE_LAYING;
+        laying = laying || (s->baked[k].state == BAKE_LAYING && (s->set.layers & ps_map_layer((ps_map_kind)k)));
     if (!(s->catch_up || laying) || !incremental(s))
         return false;
     if (!laying && (s->user_paused || s->counter_stopped))
