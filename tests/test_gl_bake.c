@@ -23,6 +23,7 @@
 #include "image/image.h"
 #include "preview/session.h"
 #include "scene/scene.h"
+#include "gl_rig.h"
 
 #define SIDE 128
 
@@ -55,11 +56,12 @@ static const char *const MATTE_SPHERE = "camera eye 0 1 3.4 target 0 1 0 up 0 1 
                                         "photons caustic 20000 global 20000\n"
                                         "radius caustic 0.03 global 0.12\n";
 
+/* The session (bake on, the two maps' layers only), its renderer and
+ * layers. */
 typedef struct rig {
+    gl_rig base;
     ps_scene *scene;
     ps_session *s;
-    OSMesaContext ctx;
-    uint8_t *buffer;
     ps_camera_frame cam;
     ps_gl_renderer *gl;
     ps_gl_layers *layers;
@@ -67,27 +69,16 @@ typedef struct rig {
 
 static void rig_open(rig *g, const char *text)
 {
-    ps_error err;
-    if (ps_scene_load_text(text, "bake.scn", "", NULL, &g->scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_session_settings set = ps_session_default_settings(g->scene);
-    set.threads = 2;
-    set.seed = 1;
-    set.float_buffer = true;
-    set.incremental = true;
+    ps_session_settings set = gl_rig_load(&g->base, text, "bake.scn");
     set.bake = true;
     set.layers = PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
-    if (ps_session_create(g->scene, &set, &g->s, &err) != PS_OK)
-        fail_msg("session: %s", err.msg);
-    assert_int_equal(ps_session_trace_all(g->s, &err), PS_OK);
-    g->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    assert_non_null(g->ctx);
-    g->buffer = malloc(4 * SIDE * SIDE);
-    assert_non_null(g->buffer);
-    assert_true(OSMesaMakeCurrent(g->ctx, g->buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
-    g->cam = ps_camera_frame_make(ps_scene_camera(g->scene), SIDE, SIDE);
+    gl_rig_start(&g->base, &set, SIDE);
+    g->scene = g->base.scene;
+    g->s = g->base.s;
+    g->cam = g->base.cam;
     ps_gl_scene gs = ps_gl_scene_of(g->s);
     ps_gl_options go = {true, true, 0, false};
+    ps_error err;
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g->s), &go, &g->gl, &err), PS_OK);
     assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &g->layers, &err), PS_OK);
 }
@@ -96,10 +87,7 @@ static void rig_close(rig *g)
 {
     ps_gl_layers_destroy(g->layers);
     ps_gl_renderer_destroy(g->gl);
-    OSMesaDestroyContext(g->ctx);
-    free(g->buffer);
-    ps_session_destroy(g->s);
-    ps_scene_destroy(g->scene);
+    gl_rig_close(&g->base);
 }
 
 /* One refresh at cam, drawn, said to take draw_seconds (the next budget). */
@@ -143,15 +131,6 @@ static ps_image layer(rig *g, const ps_session_frame *f, int k)
     return img;
 }
 
-static double image_mean(const ps_image *img)
-{
-    double sum = 0.0;
-    size_t n = 3 * (size_t)img->width * (size_t)img->height;
-    for (size_t i = 0; i < n; i++)
-        sum += img->rgb[i];
-    return sum / (double)n;
-}
-
 /* The camera away and back: the second refresh back is the full view
  * again, drawn anew. */
 static void away_and_back(rig *g, ps_session_frame *f)
@@ -167,6 +146,41 @@ static void away_and_back(rig *g, ps_session_frame *f)
     assert_true(f->new_view);
 }
 
+/* A settled view's layers (every photon splatted), then the same view drawn
+ * from the baked textures (away and back): each map's splats and baked
+ * means, and the relative squared error of the baked layer. */
+typedef struct against {
+    double splats[PS_MAP_COUNT], baked[PS_MAP_COUNT], rse[PS_MAP_COUNT];
+} against;
+
+static against baked_against_splats(rig *g, ps_session_frame *f)
+{
+    ps_image splats[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        splats[k] = layer(g, f, k);
+    away_and_back(g, f);
+    against a;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        assert_true(f->map[k].baked && f->map[k].clear);
+        ps_image baked = layer(g, f, k);
+        size_t n = 3 * (size_t)SIDE * SIDE;
+        double se = 0.0, ss = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            se += (baked.rgb[i] - splats[k].rgb[i]) * (baked.rgb[i] - splats[k].rgb[i]);
+            ss += splats[k].rgb[i] * splats[k].rgb[i];
+        }
+        a.baked[k] = gl_rig_image_mean(&baked);
+        a.splats[k] = gl_rig_image_mean(&splats[k]);
+        a.rse[k] = ss > 0.0 ? se / ss : 0.0;
+        printf("%s layer: baked mean %.5f, splats %.5f; relative squared error %.2g\n", k ? "global" : "caustic",
+               a.baked[k], a.splats[k], a.rse[k]);
+        assert_true(a.splats[k] > 0.0);
+        ps_image_destroy(&baked);
+        ps_image_destroy(&splats[k]);
+    }
+    return a;
+}
+
 static void baked_layers_match_the_splats(void **state)
 {
     (void)state;
@@ -180,28 +194,11 @@ static void baked_layers_match_the_splats(void **state)
         assert_true(texels > 0);
     }
     /* The view settled before the bake: its layers are the splats. */
-    ps_image splats[PS_MAP_COUNT];
-    for (int k = 0; k < PS_MAP_COUNT; k++)
-        splats[k] = layer(&g, &f, k);
-    away_and_back(&g, &f);
+    against a = baked_against_splats(&g, &f);
     assert_int_equal(f.splats, 0);
     for (int k = 0; k < PS_MAP_COUNT; k++) {
-        assert_true(f.map[k].baked && f.map[k].clear);
-        ps_image baked = layer(&g, &f, k);
-        size_t n = 3 * (size_t)SIDE * SIDE;
-        double se = 0.0, ss = 0.0;
-        for (size_t i = 0; i < n; i++) {
-            se += (baked.rgb[i] - splats[k].rgb[i]) * (baked.rgb[i] - splats[k].rgb[i]);
-            ss += splats[k].rgb[i] * splats[k].rgb[i];
-        }
-        double mb = image_mean(&baked), ms = image_mean(&splats[k]);
-        printf("%s layer: baked mean %.5f, splats %.5f; relative squared error %.2g\n", k ? "global" : "caustic", mb,
-               ms, se / ss);
-        assert_true(ms > 0.0);
-        assert_near(mb, ms, 0.005 * ms);
-        assert_true(se / ss <= 0.001);
-        ps_image_destroy(&baked);
-        ps_image_destroy(&splats[k]);
+        assert_near(a.baked[k], a.splats[k], 0.005 * a.splats[k]);
+        assert_true(a.rse[k] <= 0.001);
     }
     /* Moving, the layers are the textures too: no level of detail. */
     ps_camera_frame away = g.cam;
@@ -318,15 +315,9 @@ static void an_edit_drops_the_textures(void **state)
     assert_true(ps_session_baked(g.s, PS_MAP_CAUSTIC, NULL) && ps_session_baked(g.s, PS_MAP_GLOBAL, NULL));
     /* Laid again from the new photons alone: the same view drawn from them
      * is the splats' (textures kept and added to would show both lights). */
-    ps_image splats = layer(&g, &f, PS_MAP_CAUSTIC);
-    away_and_back(&g, &f);
-    assert_true(f.map[PS_MAP_CAUSTIC].baked);
-    ps_image baked = layer(&g, &f, PS_MAP_CAUSTIC);
-    double mb = image_mean(&baked), ms = image_mean(&splats);
-    printf("after the edit, caustic layer: baked mean %.5f, splats %.5f\n", mb, ms);
-    assert_near(mb, ms, 0.005 * ms);
-    ps_image_destroy(&baked);
-    ps_image_destroy(&splats);
+    against a = baked_against_splats(&g, &f);
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        assert_near(a.baked[k], a.splats[k], 0.005 * a.splats[k]);
     rig_close(&g);
 }
 

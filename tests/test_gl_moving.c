@@ -26,6 +26,7 @@
 #include "image/image.h"
 #include "preview/session.h"
 #include "scene/scene.h"
+#include "gl_rig.h"
 
 #define SIDE 96
 #define EXPOSURE 0.4
@@ -51,44 +52,17 @@ static const char *const FLOOR = "camera eye 0 2 1.2 target 0 0 0 fov 60\n"
                                  "light point position 0 0.4 0 power 10 10 10\n"
                                  "photons caustic 0 global 2000\n";
 
-typedef struct rig {
-    ps_scene *scene;
-    ps_session *s;
-    OSMesaContext ctx;
-    uint8_t *buffer;
-    ps_camera_frame cam;
-} rig;
+typedef gl_rig rig;
 
 static void rig_open(rig *g, const char *text, unsigned layers)
 {
-    ps_error err;
-    if (ps_scene_load_text(text, "moving.scn", "", NULL, &g->scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_session_settings set = ps_session_default_settings(g->scene);
-    set.threads = 2;
-    set.seed = 1;
-    set.float_buffer = true;
-    set.incremental = true;
+    ps_session_settings set = gl_rig_load(g, text, "moving.scn");
     set.exposure = EXPOSURE;
     set.layers = layers;
-    if (ps_session_create(g->scene, &set, &g->s, &err) != PS_OK)
-        fail_msg("session: %s", err.msg);
-    assert_int_equal(ps_session_trace_all(g->s, &err), PS_OK);
-    g->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    assert_non_null(g->ctx);
-    g->buffer = malloc(4 * SIDE * SIDE);
-    assert_non_null(g->buffer);
-    assert_true(OSMesaMakeCurrent(g->ctx, g->buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
-    g->cam = ps_camera_frame_make(ps_scene_camera(g->scene), SIDE, SIDE);
+    gl_rig_start(g, &set, SIDE);
 }
 
-static void rig_close(rig *g)
-{
-    OSMesaDestroyContext(g->ctx);
-    free(g->buffer);
-    ps_session_destroy(g->s);
-    ps_scene_destroy(g->scene);
-}
+static void rig_close(rig *g) { gl_rig_close(g); }
 
 static ps_gl_renderer *renderer(const ps_gl_scene *gs, ps_session *s)
 {
@@ -127,15 +101,6 @@ static ps_image composite(ps_gl_layers *l, const ps_session_frame *f)
     return img;
 }
 
-static double image_mean(const ps_image *img)
-{
-    double sum = 0.0;
-    size_t n = 3 * (size_t)img->width * (size_t)img->height;
-    for (size_t i = 0; i < n; i++)
-        sum += img->rgb[i];
-    return sum / (double)n;
-}
-
 static void global_layer_shrunk(void **state)
 {
     (void)state;
@@ -169,7 +134,7 @@ static void global_layer_shrunk(void **state)
         se += (shrunk.rgb[i] - full.rgb[i]) * (shrunk.rgb[i] - full.rgb[i]);
         ss += full.rgb[i] * full.rgb[i];
     }
-    double ms = image_mean(&shrunk), mf = image_mean(&full);
+    double ms = gl_rig_image_mean(&shrunk), mf = gl_rig_image_mean(&full);
     printf("global layer while moving: shrunk mean %.5f, at the view's pixels %.5f; pixels %.3f .. %.3f of those, "
            "relative squared error %.2g\n",
            ms, mf, lo, hi, se / ss);
@@ -214,7 +179,7 @@ static void direct_on_the_moving_mesh(void **state)
     for (size_t i = 0; i < n; i++)
         if (b.rgb[i] > 0.01 * peak)
             worst = fmax(worst, fabs(a.rgb[i] - b.rgb[i]) / b.rgb[i]);
-    double ma = image_mean(&a), mb = image_mean(&b);
+    double ma = gl_rig_image_mean(&a), mb = gl_rig_image_mean(&b);
     printf("direct layer while moving: moving mesh mean %.5f, fine mesh %.5f, worst pixel %.2f %%\n", ma, mb,
            100.0 * worst);
     assert_true(worst <= 0.03);
