@@ -112,6 +112,10 @@ static void settle(rig *g, ps_session_frame *f)
         for (int k = 0; k < PS_MAP_COUNT; k++) {
             laid = laid || f->map[k].bake;
             more = more || (f->map[k].bake && !ps_session_baked(g->s, (ps_map_kind)k, NULL));
+            /* The share laid: in [0, 1) while laying, 1 once baked. */
+            double share = ps_session_bake_progress(g->s, (ps_map_kind)k);
+            if (f->map[k].bake)
+                assert_true(ps_session_baked(g->s, (ps_map_kind)k, NULL) ? share == 1.0 : share > 0.0 && share < 1.0);
         }
         if (laid)
             assert_true(ps_session_catching_up(g->s) == more);
@@ -227,6 +231,7 @@ static void photons_off_the_quads_are_splatted(void **state)
         for (size_t i = 0; i < maps[k].count; i++)
             on_quads[k] = on_quads[k] && obj[maps[k].objects[i]].type == PS_OBJ_QUAD;
         assert_int_equal(ps_session_baked(g.s, (ps_map_kind)k, NULL), on_quads[k]);
+        assert_true(ps_session_bake_progress(g.s, (ps_map_kind)k) == (on_quads[k] ? 1.0 : -1.0));
     }
     assert_false(on_quads[PS_MAP_GLOBAL]);
     away_and_back(&g, &f);

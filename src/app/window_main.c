@@ -351,6 +351,21 @@ static void draw_overlay(app *a)
                      ps_global_layer_name(set->global_layer),
                      float_layers ? "float" : ps_precision_name(set->precision),
                      set->exposure);
+    /* The bake (--bake): how far each map is laid, once it has begun. */
+    bool baking = false;
+    for (int k = 0; k < PS_MAP_COUNT && n > 0 && (size_t)n < sizeof text; k++) {
+        double laid = ps_session_bake_progress(a->session, (ps_map_kind)k);
+        if (laid < 0.0)
+            continue;
+        if (laid >= 1.0)
+            n += snprintf(text + n, sizeof text - (size_t)n, "%s%s baked", baking ? ", " : "", ps_map_name((ps_map_kind)k));
+        else
+            n += snprintf(text + n, sizeof text - (size_t)n, "%sbaking %s %.0f %%", baking ? ", " : "",
+                          ps_map_name((ps_map_kind)k), 100.0 * laid);
+        baking = true;
+    }
+    if (baking && n > 0 && (size_t)n < sizeof text)
+        n += snprintf(text + n, sizeof text - (size_t)n, "\n");
     if (!float_layers && n > 0 && (size_t)n < sizeof text)
         n += snprintf(text + n, sizeof text - (size_t)n, "error counter: %.1f %% of the last refresh rounded away%s\n",
                       100.0 * a->frame.round_off, counter_stopped ? " (stopped shooting)" : "");

@@ -90,6 +90,7 @@ struct ps_session {
     ps_bake *bake[PS_MAP_COUNT];
     struct session_bake {
         int state;             /* BAKE_* */
+        size_t total;          /* photons of the map when planned */
         size_t laid;           /* photons in the textures (a prefix ending at a feed mark) ... */
         uint64_t laid_emitted; /* ... this many emitted */
         /* What the textures were laid from: another of any drops them. */
@@ -645,6 +646,7 @@ static ps_status bake_step(ps_session *s, int k, const ps_photon_map *m, const p
         if (st != PS_OK)
             return st;
         b->state = covered ? BAKE_LAYING : BAKE_REFUSED;
+        b->total = m->count;
         b->laid = 0;
         b->laid_emitted = 0;
         b->epoch = s->maps_epoch;
@@ -685,6 +687,14 @@ static bool bake_pending(const ps_session *s, int k, const ps_photon_map *m)
 {
     return bake_wanted(s, k) && (s->set.layers & ps_map_layer((ps_map_kind)k)) && m->count > 0 &&
            (s->baked[k].state == BAKE_NONE || s->baked[k].state == BAKE_LAYING);
+}
+
+double ps_session_bake_progress(const ps_session *s, ps_map_kind k)
+{
+    const struct session_bake *b = &s->baked[k];
+    if (b->state == BAKE_DONE)
+        return 1.0;
+    return b->state == BAKE_LAYING && b->total > 0 ? (double)b->laid / (double)b->total : -1.0;
 }
 
 bool ps_session_baked(const ps_session *s, ps_map_kind k, size_t *texels)

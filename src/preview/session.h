@@ -501,6 +501,10 @@ uint64_t ps_session_maps_epoch(const ps_session *s);
 /* Whether map k's layer is drawn from its baked textures (bake.h) from now
  * on; *texels: theirs (0 when not). */
 bool ps_session_baked(const ps_session *s, ps_map_kind k, size_t *texels);
+/* How far map k's bake is laid: the share of its photons in the textures
+ * (1 once drawn from them), or -1 when it is not being baked (not planned
+ * yet, refused, or settings.bake off). */
+double ps_session_bake_progress(const ps_session *s, ps_map_kind k);
 /* Map k's splat radius for the last refresh (under the radius schedule). */
 double ps_session_radius(const ps_session *s, ps_map_kind k);
 
