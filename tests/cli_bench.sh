@@ -148,10 +148,13 @@ awk_true "${took:-0} >= $least && ${took:-99} <= 9.2" && ok || bad "snap --time 
 # The caps within the first round (16 384 photons of the larger map, traced
 # before the first frame): 20 000 needed a second round, which under the
 # sanitizers, with a core left to drawing, came after the 0.5 s frame.
+# Under the sanitizers the first frame is slower: a clean-clone CI on a
+# loaded machine put the 0.5 s checkpoint at 1.19 s (0.57-0.73 s run alone).
 expect_success "capped float checkpoints on time" "$snap" data/scenes/cornell-caustic-area.scn --size 64x64 \
     --time 2.5 --checkpoints 0.5,2 --checkpoint-prefix "$cli_tmp/cc" --caustic-photons 16000 \
     --global-photons 4000 --color-depth float
-awk -F, 'NR > 1 && ($3 < $2 || $3 > 1.5 * $2 + 0.25 || $4 != 16000) { print "checkpoint " $2 " s at " $3 " s, " $4 " photons"; bad = 1 }
+if [[ $bin == *asan* ]]; then late=0.75; else late=0.25; fi
+awk -F, -v late=$late 'NR > 1 && ($3 < $2 || $3 > 1.5 * $2 + late || $4 != 16000) { print "checkpoint " $2 " s at " $3 " s, " $4 " photons"; bad = 1 }
          END { exit bad }' "$cli_tmp/cc.csv" && ok || bad "capped float checkpoints: $(cat "$cli_tmp/cc.csv")"
 
 # ---- compare --clamp --------------------------------------------------------------

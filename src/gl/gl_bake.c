@@ -20,7 +20,10 @@ void ps_gl_bake_reset(ps_gl_bake *g)
 }
 
 /* The plan's textures, cleared; false (and none) where memory or the GL
- * implementation refuses. */
+ * implementation refuses. The session cannot hear of it: the map's layer
+ * then shows nothing of its textures. Only memory should fail here: baking
+ * needs float layers, whose RGBA32F framebuffers ps_gl_layers_create has
+ * already made (it refuses a GL without them). */
 static bool make_textures(ps_gl_bake *g, const ps_bake *plan)
 {
     size_t n = ps_bake_target_count(plan);

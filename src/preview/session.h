@@ -360,8 +360,9 @@ bool ps_session_catching_up(ps_session *s);
  * later (else a tau): a camera step before then draws its own picture at
  * once (the window and snap's scripts refresh on a camera move), so that
  * refresh finds the camera stopped and draws the full view. Longer than an
- * orbit's steps 0.05 s apart (at a quarter of tau, still views came between
- * them and the orbit drew 37-52 moving frames of its 60 steps); with baked
+ * orbit's steps 0.05 s apart (a quarter of tau after the picture ended let
+ * still views come between them: the orbit drew 37-52 moving frames of its
+ * 60 steps, against 60 at this share); with baked
  * maps (settings.bake) the full view over 10^6 photons at 512^2 is one
  * refresh, and waiting a whole tau for it was most of its return after an
  * orbit (0.14 s). */
