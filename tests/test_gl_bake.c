@@ -8,7 +8,8 @@
  *    radius; a texture shifted by half a texel, drawn on the wrong side or
  *    without its last batch of photons fails);
  *  - a map with photons on a diffuse sphere is not baked, and the session
- *    still settles;
+ *    still settles; nor one whose floor would need more than
+ *    PS_BAKE_MAX_SIDE texels a side;
  *  - a hidden layer's bake waits (the refreshes not back to back meanwhile);
  *  - an edit drops the textures (the frame says so) and the maps are baked
  *    again once traced. */
@@ -241,6 +242,31 @@ static void photons_off_the_quads_are_splatted(void **state)
     rig_close(&g);
 }
 
+/* A radius so fine that the floor would need more than PS_BAKE_MAX_SIDE
+ * texels a side (though its texels would fit PS_BAKE_MAX_TEXELS): that map is
+ * splatted (coarser texels would blur it), the other baked. */
+static void too_fine_a_radius_is_not_baked(void **state)
+{
+    (void)state;
+    static const char *const FLOOR = "camera eye 0 1 3.4 target 0 0.3 0 up 0 1 0 fov 40\n"
+                                     "material white diffuse albedo 0.75 0.75 0.75\n"
+                                     "material glass dielectric ior 1.5\n"
+                                     "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
+                                     "sphere center 0 0.5 0 radius 0.4 material glass\n"
+                                     "light point position 0 1.9 0 power 100 100 100\n"
+                                     "photons caustic 20000 global 5000\n"
+                                     "radius caustic 0.0035 global 0.12\n";
+    double side = 2.0 * PS_BAKE_TEXELS_PER_RADIUS / 0.0035;
+    assert_true(side > PS_BAKE_MAX_SIDE && side * side < (double)PS_BAKE_MAX_TEXELS);
+    rig g;
+    rig_open(&g, FLOOR);
+    ps_session_frame f;
+    settle(&g, &f);
+    assert_false(ps_session_baked(g.s, PS_MAP_CAUSTIC, NULL));
+    assert_true(ps_session_baked(g.s, PS_MAP_GLOBAL, NULL));
+    rig_close(&g);
+}
+
 /* The textures are the same bytes however many refreshes laid them: each
  * target's splats go in index order whatever the budget. */
 static void baked_bytes_do_not_depend_on_the_budget(void **state)
@@ -331,6 +357,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(baked_layers_match_the_splats),
         cmocka_unit_test(photons_off_the_quads_are_splatted),
+        cmocka_unit_test(too_fine_a_radius_is_not_baked),
         cmocka_unit_test(baked_bytes_do_not_depend_on_the_budget),
         cmocka_unit_test(a_hidden_layer_waits),
         cmocka_unit_test(an_edit_drops_the_textures),

@@ -79,11 +79,12 @@ static void quad_frame(const ps_scene *scene, const ps_object *o, ps_vec3 *corne
 }
 
 /* Texels along an edge of this length: r / PS_BAKE_TEXELS_PER_RADIUS each,
- * within the sides' bounds. */
+ * at least PS_BAKE_MIN_SIDE; 0 past PS_BAKE_MAX_SIDE (coarser texels would
+ * blur the splats: the map is not baked). */
 static int texels_along(double length, double radius)
 {
     double n = ceil(length * PS_BAKE_TEXELS_PER_RADIUS / radius);
-    return n < PS_BAKE_MIN_SIDE ? PS_BAKE_MIN_SIDE : n > PS_BAKE_MAX_SIDE ? PS_BAKE_MAX_SIDE : (int)n;
+    return n < PS_BAKE_MIN_SIDE ? PS_BAKE_MIN_SIDE : n > PS_BAKE_MAX_SIDE ? 0 : (int)n;
 }
 
 static int side_of(const ps_bake_target *t, const ps_photon *ph)
@@ -126,6 +127,10 @@ ps_status ps_bake_plan(ps_bake *b, const ps_scene *scene, const ps_material *mat
         t.side = side;
         t.width = texels_along(ps_v3_len(t.edge1), radius);
         t.height = texels_along(ps_v3_len(t.edge2), radius);
+        if (t.width == 0 || t.height == 0) {
+            free_targets(b);
+            return PS_OK;
+        }
         if (b->count == b->cap) {
             size_t cap = b->cap ? 2 * b->cap : 8;
             ps_bake_target *nt = realloc(b->targets, cap * sizeof *nt);

@@ -37,8 +37,8 @@
 /* Texels a splat radius: the kernel (a cone: one kink at its centre) sampled
  * 8 texels across, bilinearly; a splat then covers about 80 texels. */
 #define PS_BAKE_TEXELS_PER_RADIUS 4.0
-/* A texture's side at most (a quad much wider than its splats), and at
- * least. */
+/* A texture's side at most (a quad wider than this many quarter radii is
+ * not baked: coarser texels would blur its splats), and at least. */
 #define PS_BAKE_MAX_SIDE 2048
 #define PS_BAKE_MIN_SIDE 8
 /* A map's textures hold at most this many texels in all (RGBA32F: 128 MiB);
@@ -63,8 +63,8 @@ void ps_bake_destroy(ps_bake *b); /* accepts NULL */
  * ps_photon_map) at splat radius `radius`, the scene's quads where they are
  * now. *covered: whether every photon lies on a quad whose material (in
  * `materials`, indexed by the photons' ids) is diffuse, and the texels fit
- * PS_BAKE_MAX_TEXELS; the targets are then the quads' sides that hold
- * photons. PS_ERR_NOMEM leaves no targets. */
+ * PS_BAKE_MAX_TEXELS and each side PS_BAKE_MAX_SIDE; the targets are then
+ * the quads' sides that hold photons. PS_ERR_NOMEM leaves no targets. */
 ps_status ps_bake_plan(ps_bake *b, const ps_scene *scene, const ps_material *materials, const ps_photon *photons,
                        const uint16_t *ids, const uint32_t *objects, size_t count, double radius, bool *covered,
                        ps_error *err);
