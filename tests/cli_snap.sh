@@ -104,7 +104,10 @@ grep -q '"first_frame_seconds":' "$cli_tmp/p.json" && ok || bad "no first_frame_
 expect_success "float first picture at once" "$snap" "$scene" --size 32x32 --color-depth float --time 1.6 --tau 1.5 \
     --checkpoints 1.6 --checkpoint-prefix "$cli_tmp/fa" --stats "$cli_tmp/fa.json"
 first=$(sed -n 's/.*"first_frame_seconds": \([0-9.e+-]*\).*/\1/p' "$cli_tmp/fa.json")
-awk_true "$first < 1.0" && ok || bad "float checkpoints: the first picture came at $first s, after tau"
+# Under the sanitizers a loaded make test put it at 1.26 s (0.75-0.89 s run
+# alone): still before tau, which a wait for it would not be.
+if [[ $bin == *asan* ]]; then first_by=1.4; else first_by=1.0; fi
+awk_true "$first < $first_by" && ok || bad "float checkpoints: the first picture came at $first s, after tau"
 # Progressive in float draws only new photons into layers kept between
 # refreshes (as the window): at the caps the same picture as drawing them all
 # at once, but for the order of float additions.
