@@ -12,11 +12,14 @@ struct ps_bake {
     size_t count, cap;
     ps_splat_batch *batches; /* one a target (as many as cap) */
     int32_t *target_of;      /* 2 an object (its sides): the target, or -1 */
+    ps_vec3 *normal_of;      /* an object: its quad's edge1 x edge2, once a photon met it */
     size_t objects;
-    /* The build's scratch: the photons regrouped by target. */
+    /* The build's scratch: each photon's target, and the photons regrouped
+     * by target. */
+    int32_t *slot;
     ps_photon *photons;
     uint16_t *ids;
-    size_t cap_photons, cap_ids;
+    size_t cap_slot, cap_photons, cap_ids;
     size_t *first;           /* count + 1: where each target's photons start */
     size_t cap_first;
     size_t splats;
@@ -47,6 +50,8 @@ void ps_bake_destroy(ps_bake *b)
         return;
     free_targets(b);
     free(b->target_of);
+    free(b->normal_of);
+    free(b->slot);
     free(b->photons);
     free(b->ids);
     free(b->first);
@@ -87,9 +92,13 @@ static int texels_along(double length, double radius)
     return n < PS_BAKE_MIN_SIDE ? PS_BAKE_MIN_SIDE : n > PS_BAKE_MAX_SIDE ? 0 : (int)n;
 }
 
-static int side_of(const ps_bake_target *t, const ps_photon *ph)
+/* Photon ph's target: its object's side that its normal is on (-1: none). */
+static int32_t target_of_photon(const ps_bake *b, uint32_t object, const ps_photon *ph)
 {
-    return ps_v3_dot(ps_photon_normal(ph), ps_v3_cross(t->edge1, t->edge2)) >= 0.0 ? 0 : 1;
+    if (object >= b->objects || (b->target_of[2 * object] < 0 && b->target_of[2 * object + 1] < 0))
+        return -1;
+    int side = ps_v3_dot(ps_photon_normal(ph), b->normal_of[object]) >= 0.0 ? 0 : 1;
+    return b->target_of[2 * object + (uint32_t)side];
 }
 
 ps_status ps_bake_plan(ps_bake *b, const ps_scene *scene, const ps_material *materials, const ps_photon *photons,
@@ -102,9 +111,12 @@ ps_status ps_bake_plan(ps_bake *b, const ps_scene *scene, const ps_material *mat
     const ps_object *obj = ps_scene_objects(scene, &nobj);
     if (nobj > b->objects) {
         int32_t *p = realloc(b->target_of, 2 * nobj * sizeof *p);
-        if (!p)
+        if (p)
+            b->target_of = p;
+        ps_vec3 *q = p ? realloc(b->normal_of, nobj * sizeof *q) : NULL;
+        if (!q)
             return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the baked maps");
-        b->target_of = p;
+        b->normal_of = q;
         b->objects = nobj;
     }
     for (size_t i = 0; i < 2 * nobj; i++)
@@ -118,13 +130,19 @@ ps_status ps_bake_plan(ps_bake *b, const ps_scene *scene, const ps_material *mat
             free_targets(b);
             return PS_OK;
         }
-        ps_bake_target t = {0};
-        t.object = o;
-        quad_frame(scene, &obj[o], &t.corner, &t.edge1, &t.edge2);
-        int side = side_of(&t, &photons[i]);
+        bool met = b->target_of[2 * o] >= 0 || b->target_of[2 * o + 1] >= 0;
+        if (!met) {
+            ps_vec3 c, e1, e2;
+            quad_frame(scene, &obj[o], &c, &e1, &e2);
+            b->normal_of[o] = ps_v3_cross(e1, e2);
+        }
+        int side = ps_v3_dot(ps_photon_normal(&photons[i]), b->normal_of[o]) >= 0.0 ? 0 : 1;
         if (b->target_of[2 * o + (uint32_t)side] >= 0)
             continue;
+        ps_bake_target t = {0};
+        t.object = o;
         t.side = side;
+        quad_frame(scene, &obj[o], &t.corner, &t.edge1, &t.edge2);
         t.width = texels_along(ps_v3_len(t.edge1), radius);
         t.height = texels_along(ps_v3_len(t.edge2), radius);
         if (t.width == 0 || t.height == 0) {
@@ -184,28 +202,22 @@ ps_status ps_bake_build(ps_bake *b, const ps_photon *photons, const uint16_t *id
 {
     b->splats = 0;
     size_t n = to > from ? to - from : 0;
-    if (!PS_RESERVE(b->first, b->cap_first, b->count + 1) || !PS_RESERVE(b->photons, b->cap_photons, n) ||
-        !PS_RESERVE(b->ids, b->cap_ids, n))
+    if (!PS_RESERVE(b->first, b->cap_first, b->count + 1) || !PS_RESERVE(b->slot, b->cap_slot, n) ||
+        !PS_RESERVE(b->photons, b->cap_photons, n) || !PS_RESERVE(b->ids, b->cap_ids, n))
         return ps_error_set(err, PS_ERR_NOMEM, "baked maps: out of memory for %zu photons", n);
     /* Regrouped by target, in index order within each (a counting sort). */
     memset(b->first, 0, (b->count + 1) * sizeof *b->first);
     for (size_t i = from; i < to; i++) {
-        uint32_t o = objects[i];
-        int32_t t = o < b->objects ? b->target_of[2 * o] : -1;
-        if (t >= 0 && side_of(&b->targets[t], &photons[i]) != 0)
-            t = b->target_of[2 * o + 1];
+        int32_t t = target_of_photon(b, objects[i], &photons[i]);
         if (t < 0)
             return ps_error_set(err, PS_ERR_RANGE, "baked maps: photon %zu is on no planned quad", i);
+        b->slot[i - from] = t;
         b->first[t + 1]++;
     }
     for (size_t t = 0; t < b->count; t++)
         b->first[t + 1] += b->first[t];
     for (size_t i = from; i < to; i++) {
-        uint32_t o = objects[i];
-        int32_t t = b->target_of[2 * o];
-        if (t >= 0 && side_of(&b->targets[t], &photons[i]) != 0)
-            t = b->target_of[2 * o + 1];
-        size_t at = b->first[t]++;
+        size_t at = b->first[b->slot[i - from]]++;
         b->photons[at] = photons[i];
         b->ids[at] = ids[i];
     }

@@ -614,11 +614,15 @@ static bool bake_wanted(const ps_session *s, int k)
 /* Map k's bake dropped when what it was laid from changed (the maps, the
  * materials the splats take, the radius for its photons, the kernel), or
  * baking no longer applies: the textures to be dropped too. */
-static void bake_check(ps_session *s, int k, const ps_material *mats, double radius, ps_session_frame *out)
+static void bake_check(ps_session *s, int k, const ps_material *mats, ps_session_frame *out)
 {
     struct session_bake *b = &s->baked[k];
     if (b->state == BAKE_NONE)
         return;
+    /* The radius for the photons it was laid from: the map's last mark's. */
+    size_t nm;
+    const ps_feed_mark *mk = ps_feed_marks(s->feed, (ps_map_kind)k, &nm);
+    double radius = radius_at(s, k, nm ? mk[nm - 1].emitted : 0);
     if (!bake_wanted(s, k) || b->epoch != s->maps_epoch || b->mats != mats || b->radius != radius ||
         b->kernel_mean != s->kernel.mean) {
         out->map[k].bake_reset = b->state != BAKE_REFUSED;
@@ -826,11 +830,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         b->wanted = b->lost = 0.0;
         const ps_photon_map *m = &maps[k];
         const ps_material *kmats = k == PS_MAP_GLOBAL ? global_mats : materials;
-        {
-            size_t nm;
-            const ps_feed_mark *mk = ps_feed_marks(s->feed, (ps_map_kind)k, &nm);
-            bake_check(s, k, kmats, radius_at(s, k, nm ? mk[nm - 1].emitted : 0), out);
-        }
+        bake_check(s, k, kmats, out);
         if (s->baked[k].state == BAKE_DONE && (s->set.layers & ps_map_layer((ps_map_kind)k))) {
             /* The layer is the baked textures, whatever the view: drawn into
              * it again for a new one (a moving camera's too: no level of
