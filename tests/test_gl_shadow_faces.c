@@ -48,6 +48,7 @@ static void inputs_make_sized(const ps_scene *s, int shadow_size, inputs *in)
     memset(in, 0, sizeof *in);
     ps_mesh_options mo = ps_mesh_default_options(s);
     assert_int_equal(ps_preview_mesh_build(s, &mo, &in->mesh, &err), PS_OK);
+    assert_int_equal(ps_mesh_make_tiles(&in->mesh, PS_MESH_TILE_TRIANGLES, &in->mesh.tiles, &err), PS_OK); /* as the session's */
     mo.max_edge = HUGE_VAL;
     assert_int_equal(ps_preview_mesh_build(s, &mo, &in->coarse, &err), PS_OK);
     assert_int_equal(ps_preview_lights_build(s, NULL, &in->coarse, shadow_size, PS_PREVIEW_AREA_SIDE, &in->lights, &err),
@@ -241,20 +242,28 @@ static void culled_faces_draw_the_same(void **state)
         inputs in;
         inputs_make(s, &in);
         ps_gl_scene gs = gl_scene(s, &in);
-        ps_image pic[2];
-        uint64_t vertices[2];
-        for (int whole = 0; whole < 2; whole++) {
-            ps_gl_options go = {true, true, 0, whole != 0};
+        ps_image pic[3];
+        uint64_t vertices[3];
+        /* Culled by tiles, every object whole, culled by whole ranges (the
+         * mesh's tiles dropped: what a mesh without them draws). */
+        for (int v = 0; v < 3; v++) {
+            ps_gl_options go = {true, true, 0, v == 1};
+            if (v == 2)
+                ps_mesh_tiling_free(&in.mesh.tiles);
             ps_gl_renderer *r;
             assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &r, &err), PS_OK);
-            pic[whole] = draw(r, s);
-            vertices[whole] = ps_gl_get_stats(r).light_vertices;
+            pic[v] = draw(r, s);
+            vertices[v] = ps_gl_get_stats(r).light_vertices;
             ps_gl_renderer_destroy(r);
         }
-        printf("scene %d: the lit passes drew %llu vertices culled, %llu whole (%.2f)\n", t,
-               (unsigned long long)vertices[0], (unsigned long long)vertices[1],
-               (double)vertices[0] / (double)vertices[1]);
+        printf("scene %d: the lit passes drew %llu vertices culled by tiles, %llu by whole ranges, %llu whole (%.2f, "
+               "%.2f)\n",
+               t, (unsigned long long)vertices[0], (unsigned long long)vertices[2], (unsigned long long)vertices[1],
+               (double)vertices[0] / (double)vertices[1], (double)vertices[2] / (double)vertices[1]);
         assert_true(same_pixels(&pic[0], &pic[1]));
+        assert_true(same_pixels(&pic[2], &pic[1]));
+        assert_true(vertices[0] < vertices[2]); /* a wall in two or three pyramids is drawn in parts */
+        assert_true(vertices[2] < vertices[1]);
         assert_true(vertices[0] < vertices[1]);
         if (t == 1) /* six faces of the point light, the spot's one or two */
             assert_true(vertices[0] < vertices[1] / 2);
@@ -268,8 +277,8 @@ static void culled_faces_draw_the_same(void **state)
             assert_true(sphere_vertices > 0);
             assert_true(vertices[0] + sphere_vertices <= vertices[1]);
         }
-        ps_image_destroy(&pic[0]);
-        ps_image_destroy(&pic[1]);
+        for (int v = 0; v < 3; v++)
+            ps_image_destroy(&pic[v]);
         inputs_free(&in);
         gl_rig_close(&g);
     }

@@ -295,6 +295,49 @@ static void default_scene_against_reference(void **state)
     rig_free(&r);
 }
 
+/* The per-vertex lookups' passes (the window's until the per-pixel paths
+ * are whole) draw only the triangles each term lights
+ * (ps_specular_weighted_triangles): the same pixels, float for float, as
+ * passes over every triangle, in the default scene, where a term past the
+ * first lights under a third of the spheres' vertices. */
+static void lit_triangles_draw_the_same(void **state)
+{
+    (void)state;
+    ps_scene *scene;
+    ps_error err;
+    assert_int_equal(ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err), PS_OK);
+    rig r;
+    rig_make(&r, scene, DEFAULT_SIZE, DEFAULT_SIZE);
+    ps_session_set_layers(r.session, PS_LAYER_DIRECT | PS_LAYER_SPECULAR);
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 0, &err), PS_OK);
+    /* The per-pixel points dropped: the lookups' terms are drawn. */
+    ps_specular_invalidate(ps_session_specular(r.session));
+    ps_gl_options go = {true, true, 0, true};
+    ps_gl_scene gs = ps_gl_scene_of(r.session);
+    ps_gl_renderer *whole;
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(r.session), &go, &whole, &err), PS_OK);
+    ps_image pic[2];
+    ps_gl_renderer *by[2] = {r.gl, whole};
+    for (int v = 0; v < 2; v++) {
+        ps_gl_begin_frame(by[v], &r.cam, 1.0, false);
+        ps_gl_specular_draw(r.spec, by[v], r.session, 1.0);
+        assert_int_equal(ps_gl_read(by[v], &pic[v], &err), PS_OK);
+    }
+    size_t n = 3 * (size_t)r.w * (size_t)r.h, lit = 0;
+    for (size_t i = 0; i < n; i++)
+        lit += pic[1].rgb[i] > 0.0f;
+    print_message("lookup terms: %zu lit channels, the two pictures %s\n", lit,
+                  memcmp(pic[0].rgb, pic[1].rgb, n * sizeof(float)) ? "DIFFER" : "the same");
+    assert_true(lit > 3000);
+    assert_memory_equal(pic[0].rgb, pic[1].rgb, n * sizeof(float));
+    ps_image_destroy(&pic[0]);
+    ps_image_destroy(&pic[1]);
+    ps_gl_renderer_destroy(whole);
+    rig_free(&r);
+}
+
 /* ps_gl_specular_set_deadline: a face that would pass the deadline waits
  * (none drawn in a refresh whose deadline is past), and none set or one far
  * off draws as before; a face not timed yet is allowed until the deadline. */
@@ -593,6 +636,7 @@ int main(void)
         cmocka_unit_test(furnace_mirror_sphere),
         cmocka_unit_test(furnace_glass_sphere),
         cmocka_unit_test(default_scene_against_reference),
+        cmocka_unit_test(lit_triangles_draw_the_same),
         cmocka_unit_test(deadline_holds_faces),
         cmocka_unit_test(faces_foreseen_from_their_fill),
         cmocka_unit_test(a_settled_round_ends_whole),

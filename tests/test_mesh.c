@@ -469,6 +469,75 @@ static void moving_mesh(void **state)
     ps_scene_destroy(s);
 }
 
+/* Tiles (ps_mesh_make_tiles): each range's triangles, every one once and
+ * as its three vertices in order, in tiles that follow one another; each
+ * tile's bounds hold its vertices; a flat range is cut on its two long axes
+ * only, into about triangles / per tiles; a small range is one tile. */
+static int cmp_triple(const void *a, const void *b)
+{
+    const uint32_t *x = a, *y = b;
+    for (int k = 0; k < 3; k++)
+        if (x[k] != y[k])
+            return x[k] < y[k] ? -1 : 1;
+    return 0;
+}
+
+static void tiles(void **state)
+{
+    (void)state;
+    ps_scene *s = load(ROOM);
+    ps_preview_mesh m = build(s, 0.05);
+    const size_t per = 64;
+    ps_mesh_tiling t;
+    ps_error err;
+    assert_int_equal(ps_mesh_make_tiles(&m, per, &t, &err), PS_OK);
+    assert_int_equal(t.range_count, m.range_count);
+    size_t next = 0;
+    for (size_t r = 0; r < m.range_count; r++) {
+        const ps_mesh_range *g = &m.ranges[r];
+        size_t tris = g->count / 3, first = t.range_tiles[r], end = t.range_tiles[r + 1];
+        assert_true(end > first);
+        uint32_t *want = malloc(g->count * sizeof *want), *got = malloc(g->count * sizeof *got);
+        assert_non_null(want);
+        assert_non_null(got);
+        for (size_t j = 0; j < g->count; j++)
+            want[j] = m.shared ? m.shared[g->first + j] : (uint32_t)(g->first + j);
+        size_t n = 0;
+        for (size_t x = first; x < end; x++) {
+            const ps_mesh_tile *tile = &t.tiles[x];
+            assert_int_equal(tile->first, next); /* one after another */
+            assert_true(tile->count > 0 && tile->count % 3 == 0);
+            next += tile->count;
+            for (size_t j = tile->first; j < tile->first + tile->count; j++) {
+                ps_vec3 p = get3(m.positions, t.indices[j]);
+                assert_true(p.x >= tile->bounds.lo.x && p.x <= tile->bounds.hi.x);
+                assert_true(p.y >= tile->bounds.lo.y && p.y <= tile->bounds.hi.y);
+                assert_true(p.z >= tile->bounds.lo.z && p.z <= tile->bounds.hi.z);
+                got[n++] = t.indices[j];
+            }
+        }
+        assert_int_equal(n, g->count);
+        qsort(want, tris, 3 * sizeof *want, cmp_triple);
+        qsort(got, tris, 3 * sizeof *got, cmp_triple);
+        assert_memory_equal(want, got, g->count * sizeof *got);
+        free(want);
+        free(got);
+        if (tris <= per)
+            assert_int_equal(end - first, 1);
+        if (g->object == FLOOR) {
+            /* y = 0 throughout: no cut across it, about tris / per tiles */
+            printf("floor: %zu triangles in %zu tiles of at most %zu asked\n", tris, end - first, per);
+            assert_true(end - first >= tris / per / 2 && end - first <= 2 * tris / per);
+            for (size_t x = first; x < end; x++)
+                assert_true(t.tiles[x].bounds.lo.y == 0.0 && t.tiles[x].bounds.hi.y == 0.0);
+        }
+    }
+    ps_mesh_tiling_free(&t);
+    ps_mesh_tiling_free(&t); /* zeroed: again is harmless */
+    ps_preview_mesh_free(&m);
+    ps_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -477,6 +546,7 @@ int main(void)
         cmocka_unit_test(defaults_and_errors),
         cmocka_unit_test(memory_budget),
         cmocka_unit_test(moving_mesh),
+        cmocka_unit_test(tiles),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -15,6 +15,7 @@
 #include "photon/tracer.h"
 #include "preview/feed.h"
 #include "preview/session.h"
+#include "preview/specular.h"
 #include "scene/scene.h"
 
 #define SCENE "data/scenes/cornell-caustic.scn"
@@ -948,6 +949,82 @@ static void still_view_due_sooner_after_a_move(void **state)
     ps_scene_destroy(scene);
 }
 
+/* While the program waits after a moving picture (ps_session_prepare_still),
+ * the still view's specular lookups for that eye are traced a little a call,
+ * and are the ones the still refresh would have traced: the same bytes as in
+ * a session that waited idle; nothing to do while the camera is still, nor
+ * while photons are traced. */
+static size_t lookup_vertices(ps_session *s)
+{
+    const struct ps_specular *sp = ps_session_specular(s);
+    size_t nr = ps_specular_range_count(sp);
+    assert_true(nr > 0);
+    const ps_specular_range *r = &ps_specular_ranges(sp)[nr - 1];
+    return r->offset + ps_session_mesh(s)->ranges[r->range].count;
+}
+
+static void still_lookups_prepared_while_waiting(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.caps[PS_MAP_CAUSTIC] = PS_FEED_BATCH / 4;
+    set.caps[PS_MAP_GLOBAL] = PS_FEED_BATCH / 4;
+    ps_session *s[2];
+    ps_camera_frame cam[2];
+    ps_session_frame f;
+    for (int v = 0; v < 2; v++) {
+        s[v] = start_and_refresh(scene, &set, &cam[v], &f);
+        ps_session_drawn(s[v], 0.01);
+        wait_ended(s[v]);
+        for (int i = 0; i < 10 && !ps_session_settled(s[v]); i++) {
+            refresh(s[v], &cam[v], &f);
+            ps_session_drawn(s[v], 0.01);
+        }
+        assert_true(ps_session_settled(s[v]));
+        assert_false(ps_session_prepare_still(s[v], 64)); /* still: nothing to do */
+        cam[v].eye.x += 0.05;
+        refresh(s[v], &cam[v], &f);
+        ps_session_drawn(s[v], 0.01);
+        assert_true(f.moving);
+    }
+    int calls = 0;
+    while (ps_session_prepare_still(s[0], 64))
+        calls++;
+    print_message("the still view's lookups traced in %d calls of 64 vertices while waiting\n", calls);
+    assert_true(calls >= 10);
+    assert_false(ps_session_prepare_still(s[0], 64));
+    /* Nothing left for the refresh to trace for this eye. */
+    assert_int_equal(ps_specular_update(ps_session_specular(s[0]), ps_session_world(s[0]), cam[0].eye, 1), 0);
+    assert_true(ps_specular_update(ps_session_specular(s[1]), ps_session_world(s[1]), cam[1].eye, 0) == 0);
+    size_t n = lookup_vertices(s[0]);
+    assert_int_equal(n, lookup_vertices(s[1]));
+    for (int v = 0; v < 2; v++) {
+        refresh(s[v], &cam[v], &f);
+        assert_false(f.moving);
+    }
+    for (int k = 0; k < PS_SPECULAR_TERMS; k++) {
+        assert_memory_equal(ps_specular_weights(ps_session_specular(s[0]), k),
+                            ps_specular_weights(ps_session_specular(s[1]), k), 3 * n * sizeof(float));
+        assert_memory_equal(ps_specular_dirs(ps_session_specular(s[0]), k),
+                            ps_specular_dirs(ps_session_specular(s[1]), k), 3 * n * sizeof(float));
+    }
+    for (int v = 0; v < 2; v++)
+        ps_session_destroy(s[v]);
+
+    /* Still tracing: the tracer keeps the cores. */
+    set.caps[PS_MAP_CAUSTIC] = 8000000;
+    set.caps[PS_MAP_GLOBAL] = 2000000;
+    ps_session *t = start_and_refresh(scene, &set, &cam[0], &f);
+    ps_session_drawn(t, 1e3);
+    cam[0].eye.x += 0.05;
+    refresh(t, &cam[0], &f);
+    assert_true(f.moving);
+    assert_false(ps_session_prepare_still(t, 64));
+    ps_session_destroy(t);
+    ps_scene_destroy(scene);
+}
+
 /* Progressive area lights: the first refresh with one virtual light an area
  * light, then 2 x 2, then all 16, each change said (lights_changed); an
  * edit starts over at one; without the setting, 16 from the start. */
@@ -1168,6 +1245,7 @@ int main(void)
         cmocka_unit_test(catch_up_after_the_first_still_refresh),
         cmocka_unit_test(catching_up_only_when_nothing_is_traced),
         cmocka_unit_test(still_view_due_sooner_after_a_move),
+        cmocka_unit_test(still_lookups_prepared_while_waiting),
         cmocka_unit_test(env_fill_counts_each_face),
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(coarse_shadows_first),

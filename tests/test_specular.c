@@ -5,6 +5,7 @@
  * centre against fresh ones. */
 #include "test.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "photon/world.h"
@@ -272,6 +273,28 @@ static void reaimed_lookups_equal_fresh_ones(void **state)
     default_rig_free(&d);
 }
 
+/* The triangles a term lights (ps_specular_weighted_triangles): any corner
+ * with any channel above 0 keeps the triangle whole (GL interpolates the
+ * weight from it across the triangle), a NaN too (never hidden); all-zero
+ * ones are left out; a partial last triangle is ignored. */
+static void weighted_triangles(void **state)
+{
+    (void)state;
+    float w[3 * 13];
+    memset(w, 0, sizeof w);
+    w[3 * 2 + 2] = 0.5f;   /* triangle 0: its last corner's blue */
+    w[3 * 6 + 0] = 1e-30f; /* triangle 2: its first corner, a tiny red */
+    w[3 * 10 + 1] = NAN;   /* triangle 3: its second corner */
+    w[3 * 12] = 1.0f;      /* the 13th vertex: no triangle */
+    unsigned idx[13];
+    size_t n = ps_specular_weighted_triangles(w, 13, idx);
+    const unsigned want[9] = {0, 1, 2, 6, 7, 8, 9, 10, 11};
+    assert_int_equal(n, 9);
+    assert_memory_equal(idx, want, sizeof want);
+    memset(w, 0, sizeof w);
+    assert_int_equal(ps_specular_weighted_triangles(w, 12, idx), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -280,6 +303,7 @@ int main(void)
         cmocka_unit_test(mirror_lookup_is_distance_corrected),
         cmocka_unit_test(default_scene_lookups),
         cmocka_unit_test(reaimed_lookups_equal_fresh_ones),
+        cmocka_unit_test(weighted_triangles),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1144,6 +1144,9 @@ static ps_status run_script(snap_run *s, double t_start, double *first_frame, ps
         if ((ps_session_settled(s->session) && waiting) || ps_session_edited(s->session) || s->frame.edit_lod ||
             ps_session_catching_up(s->session))
             due = now;
+        /* The still view's first work while the camera may have stopped (session.h). */
+        while (ps_now_seconds() < due && ps_session_prepare_still(s->session, PS_SESSION_PREPARE_VERTICES))
+            ;
         sleep_until(due);
     }
     return last_picture(s, st, err);

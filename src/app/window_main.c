@@ -185,6 +185,9 @@ typedef struct app {
      * and how long after the last one every photon was back in the picture. */
     uint64_t moving_frames;
     double moving_seconds, moving_end, full_after_stop;
+    /* When the camera last moved (an orbit, pan or zoom, a script's or the
+     * user's), and from then to the full picture after the last such move. */
+    double camera_step, full_after_step;
     bool full_pending;
     ps_latency lat; /* an edit's first refreshed frame, phase by phase (app/latency.h) */
     /* Illuminance in false colour (key F): the last refresh's lux, a pixel
@@ -552,6 +555,7 @@ static ps_status refresh(app *a, ps_error *err)
         a->full_pending = true;
     } else if (a->full_pending && ps_session_settled(a->session)) {
         a->full_after_stop = t1 - a->moving_end;
+        a->full_after_step = t1 - a->camera_step;
         a->full_pending = false;
     }
     return PS_OK;
@@ -600,6 +604,7 @@ static void orbit(app *a, double yaw_deg, double pitch_deg)
     v = rotate(v, right, -(want - elevation) * PS_PI / 180.0);
     a->camera.eye = ps_v3_add(a->camera.target, v);
     a->redraw = true;
+    a->camera_step = ps_now_seconds();
 }
 
 static void pan(app *a, double dx, double dy)
@@ -610,6 +615,7 @@ static void pan(app *a, double dx, double dy)
     a->camera.eye = ps_v3_add(a->camera.eye, move);
     a->camera.target = ps_v3_add(a->camera.target, move);
     a->redraw = true;
+    a->camera_step = ps_now_seconds();
 }
 
 static void zoom(app *a, double notches)
@@ -617,6 +623,7 @@ static void zoom(app *a, double notches)
     ps_vec3 v = ps_v3_sub(a->camera.eye, a->camera.target);
     a->camera.eye = ps_v3_add(a->camera.target, ps_v3_scale(v, pow(ZOOM_PER_NOTCH, notches)));
     a->redraw = true;
+    a->camera_step = ps_now_seconds();
 }
 
 /* ---- editing ----------------------------------------------------------------------- */
@@ -1096,8 +1103,11 @@ static ps_status session(app *a, ps_error *err)
             wake = fmin(wake, a->t_first_frame + a->script_delay + ps_script_at(a->script, a->script_next)->time);
         if (a->work.pending)
             wake = fmin(wake, a->work.due);
-        if (now < wake && !a->redraw && !ps_session_edited(a->session))
-            glfwWaitEventsTimeout(wake - now);
+        bool idle = now < wake && !a->redraw && !ps_session_edited(a->session);
+        /* The still view's first work while the camera may have stopped
+         * (session.h), a little at a time, events polled between. */
+        if (idle && !ps_session_prepare_still(a->session, PS_SESSION_PREPARE_VERTICES) && ps_now_seconds() < wake)
+            glfwWaitEventsTimeout(wake - ps_now_seconds());
         else
             glfwPollEvents();
         /* Script actions that are due, in order; times count from the first frame. */
@@ -1202,6 +1212,7 @@ static ps_status write_stats(app *a, ps_error *err)
     ps_stats_add(&rs, "moving_frames", (double)a->moving_frames);
     ps_stats_add(&rs, "moving_frame_seconds_mean", a->moving_frames ? a->moving_seconds / (double)a->moving_frames : 0.0);
     ps_stats_add(&rs, "full_after_stop_seconds", a->full_after_stop);
+    ps_stats_add(&rs, "full_after_step_seconds", a->full_after_step);
     size_t baked_texels = 0;
     for (int k = 0; k < PS_MAP_COUNT && a->session; k++) {
         size_t texels;

@@ -121,8 +121,6 @@ static void draw_ranges(const ps_gl_renderer *r, bool with_materials, bool stenc
             outside = box_clipped(r->range_bounds[i], planes[p]);
         if (outside)
             continue;
-        if (vertices)
-            *vertices += rg->count;
         if (with_materials) {
             const ps_material *mat = &r->in.materials[rg->material];
             GLfloat diffuse[4] = {0, 0, 0, 1}, specular[4] = {0, 0, 0, 1};
@@ -149,6 +147,30 @@ static void draw_ranges(const ps_gl_renderer *r, bool with_materials, bool stenc
         }
         if (stencil)
             glStencilFunc(GL_ALWAYS, (GLint)ps_splat_stencil(rg->object), 0xff);
+        if (cull && m->tiles.tile_count > 0) {
+            /* Only its tiles in the pyramid, neighbours in one call. */
+            const ps_mesh_tiling *t = &m->tiles;
+            size_t run_first = 0, run_count = 0;
+            for (size_t x = t->range_tiles[i]; x <= t->range_tiles[i + 1]; x++) {
+                bool in = x < t->range_tiles[i + 1];
+                for (int p = 0; in && p < plane_count; p++)
+                    in = !box_clipped(t->tiles[x].bounds, planes[p]);
+                if (in && run_count > 0 && t->tiles[x].first == run_first + run_count) {
+                    run_count += t->tiles[x].count;
+                    continue;
+                }
+                if (run_count > 0) {
+                    glDrawElements(GL_TRIANGLES, (GLsizei)run_count, GL_UNSIGNED_INT, t->indices + run_first);
+                    if (vertices)
+                        *vertices += run_count;
+                }
+                run_first = in ? t->tiles[x].first : 0;
+                run_count = in ? t->tiles[x].count : 0;
+            }
+            continue;
+        }
+        if (vertices)
+            *vertices += rg->count;
         /* Shared vertices (mesh.h): each lit once, the same triangles. */
         if (m->shared)
             glDrawElements(GL_TRIANGLES, (GLsizei)rg->count, GL_UNSIGNED_INT, m->shared + rg->first);

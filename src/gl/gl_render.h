@@ -50,10 +50,12 @@ typedef struct ps_gl_options {
     int shadow_size;   /* shadow maps' side in texels where the lights plan none
                           (ps_preview_lights.shadow_size 0); 0: PS_GL_SHADOW_SIZE */
     bool whole_face_passes; /* tests: every object in every shadowed face's lit
-                             * pass, and mirrors and glass in every lit pass
+                             * pass, mirrors and glass in every lit pass, and
+                             * every triangle in each specular lookup's pass
                              * (default false: those outside the face's
-                             * pyramid, and mirrors and glass, which add
-                             * nothing there, are left out: the same pixels) */
+                             * pyramid or its tiles, mirrors and glass, and
+                             * triangles a lookup gives no light, all of which
+                             * add nothing there, are left out: the same pixels) */
 } ps_gl_options;
 
 /* What the renderer draws, prepared GL-free; everything pointed to must

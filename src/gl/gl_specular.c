@@ -60,6 +60,8 @@ struct ps_gl_specular {
     ps_gl_glossy *glossy; /* the glossy objects' blurred levels (gl_specular_blur.h) */
     float *xy; /* the per-pixel points' window coordinates */
     size_t xy_cap;
+    unsigned *tris; /* a term's lit triangles of one range (ps_specular_weighted_triangles) */
+    size_t tris_cap;
     int first_refreshes; /* the first round over this many refreshes; 0: budgeted */
     /* ps_gl_specular_set_deadline: faces past the first round end by
      * `deadline` (0: none), as each face's last time predicts: the faces
@@ -199,6 +201,7 @@ void ps_gl_specular_destroy(ps_gl_specular *g)
     ps_gl_glossy_destroy(g->glossy);
     free(g->scaled);
     free(g->xy);
+    free(g->tris);
     free(g);
 }
 
@@ -687,11 +690,27 @@ static void draw_terms(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, doub
             bool glossy = level && ps_glossy_wants(&ps_session_materials(s)[rg->material]);
             if (glossy_only && !glossy)
                 continue;
+            if (g->tris_cap < rg->count) {
+                unsigned *t = realloc(g->tris, rg->count * sizeof *t);
+                if (t)
+                    g->tris = t, g->tris_cap = rg->count;
+            }
+            /* Only the triangles the term lights; all of them where there
+             * is no room for the list, or for tests (the same picture). */
+            bool listed = g->tris_cap >= rg->count && !r->opt.whole_face_passes;
+            size_t lit = listed ? ps_specular_weighted_triangles(ps_specular_weights(sp, k) + 3 * ranges[i].offset,
+                                                                 rg->count, g->tris)
+                                : rg->count;
+            if (lit == 0)
+                continue;
             glBindTexture(GL_TEXTURE_CUBE_MAP, glossy ? level : g->cube[ranges[i].cube]);
             glVertexPointer(3, GL_FLOAT, 0, mesh->positions + 3 * rg->first);
             glColorPointer(3, GL_FLOAT, 0, w + 3 * ranges[i].offset);
             glTexCoordPointer(3, GL_FLOAT, 0, d + 3 * ranges[i].offset);
-            glDrawArrays(GL_TRIANGLES, 0, (GLsizei)rg->count);
+            if (listed)
+                glDrawElements(GL_TRIANGLES, (GLsizei)lit, GL_UNSIGNED_INT, g->tris);
+            else
+                glDrawArrays(GL_TRIANGLES, 0, (GLsizei)rg->count);
         }
     }
     glDisableClientState(GL_TEXTURE_COORD_ARRAY);

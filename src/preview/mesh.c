@@ -300,5 +300,146 @@ void ps_preview_mesh_free(ps_preview_mesh *m)
     free(m->texcoords);
     free(m->shared);
     free(m->ranges);
+    ps_mesh_tiling_free(&m->tiles);
     memset(m, 0, sizeof *m);
+}
+
+/* ---- tiles --------------------------------------------------------------------------- */
+
+/* Axes shorter than this share of the longest are flat: not cut. */
+#define TILE_FLAT_SHARE 1e-3
+
+static ps_vec3 vertex_at(const ps_preview_mesh *m, size_t j, uint32_t *index)
+{
+    *index = m->shared ? m->shared[j] : (uint32_t)j;
+    const float *q = m->positions + 3 * (size_t)*index;
+    return ps_v3(q[0], q[1], q[2]);
+}
+
+/* Range rg's grid: cells a side (1 on flat axes) for about `cells` cells. */
+static void tile_grid(ps_aabb b, double cells, int n[3])
+{
+    double e[3] = {b.hi.x - b.lo.x, b.hi.y - b.lo.y, b.hi.z - b.lo.z};
+    double longest = fmax(e[0], fmax(e[1], e[2]));
+    double volume = 1.0;
+    int dims = 0;
+    for (int a = 0; a < 3; a++)
+        if (e[a] > TILE_FLAT_SHARE * longest)
+            volume *= e[a], dims++;
+    double side = dims > 0 ? pow(volume / fmax(cells, 1.0), 1.0 / dims) : 1.0;
+    for (int a = 0; a < 3; a++) {
+        double k = e[a] > TILE_FLAT_SHARE * longest && side > 0.0 ? floor(e[a] / side + 0.5) : 1.0;
+        n[a] = (int)fmin(fmax(k, 1.0), 64.0);
+    }
+}
+
+static int grid_cell(double v, double lo, double hi, int n)
+{
+    if (n <= 1 || !(hi > lo))
+        return 0;
+    int c = (int)((v - lo) / (hi - lo) * n);
+    return c < 0 ? 0 : c >= n ? n - 1 : c;
+}
+
+ps_status ps_mesh_make_tiles(const ps_preview_mesh *m, size_t triangles_per_tile, ps_mesh_tiling *out, ps_error *err)
+{
+    memset(out, 0, sizeof *out);
+    size_t per = triangles_per_tile > 0 ? triangles_per_tile : 1;
+    size_t most_cells = 0, total_tiles = 0;
+    int (*grids)[3] = calloc(m->range_count ? m->range_count : 1, sizeof *grids);
+    out->range_tiles = calloc(m->range_count + 1, sizeof *out->range_tiles);
+    out->indices = malloc((m->vertex_count ? m->vertex_count : 1) * sizeof *out->indices);
+    ps_aabb *bounds = malloc((m->range_count ? m->range_count : 1) * sizeof *bounds);
+    if (!grids || !out->range_tiles || !out->indices || !bounds) {
+        free(grids), free(bounds);
+        ps_mesh_tiling_free(out);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory tiling the preview mesh");
+    }
+    out->range_count = m->range_count;
+    for (size_t i = 0; i < m->range_count; i++) {
+        const ps_mesh_range *rg = &m->ranges[i];
+        ps_aabb b = ps_aabb_empty();
+        uint32_t v;
+        for (size_t j = rg->first; j < rg->first + rg->count; j++)
+            b = ps_aabb_point(b, vertex_at(m, j, &v));
+        bounds[i] = b;
+        size_t tris = rg->count / 3;
+        if (tris > per)
+            tile_grid(b, (double)tris / (double)per, grids[i]);
+        else
+            grids[i][0] = grids[i][1] = grids[i][2] = 1;
+        size_t cells = (size_t)grids[i][0] * (size_t)grids[i][1] * (size_t)grids[i][2];
+        most_cells = cells > most_cells ? cells : most_cells;
+        total_tiles += cells < tris ? cells : tris > 0 ? tris : 1;
+    }
+    out->tiles = malloc(total_tiles * sizeof *out->tiles);
+    size_t *start = calloc(most_cells + 1, sizeof *start);
+    uint32_t *cell_of = malloc((m->vertex_count / 3 + 1) * sizeof *cell_of);
+    if (!out->tiles || !start || !cell_of) {
+        free(grids), free(bounds), free(start), free(cell_of);
+        ps_mesh_tiling_free(out);
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory tiling the preview mesh");
+    }
+    size_t written = 0;
+    for (size_t i = 0; i < m->range_count; i++) {
+        const ps_mesh_range *rg = &m->ranges[i];
+        const int *n = grids[i];
+        size_t cells = (size_t)n[0] * (size_t)n[1] * (size_t)n[2], tris = rg->count / 3;
+        ps_aabb b = bounds[i];
+        out->range_tiles[i] = out->tile_count;
+        /* A counting sort by cell: stable, so each cell keeps the
+         * triangles' order (and GL's vertex cache its reuse). */
+        memset(start, 0, (cells + 1) * sizeof *start);
+        for (size_t t = 0; t < tris; t++) {
+            ps_vec3 c = ps_v3(0, 0, 0);
+            uint32_t v;
+            for (int k = 0; k < 3; k++)
+                c = ps_v3_add(c, vertex_at(m, rg->first + 3 * t + (size_t)k, &v));
+            c = ps_v3_scale(c, 1.0 / 3.0);
+            size_t cell = (size_t)grid_cell(c.x, b.lo.x, b.hi.x, n[0]) +
+                          (size_t)n[0] * ((size_t)grid_cell(c.y, b.lo.y, b.hi.y, n[1]) +
+                                          (size_t)n[1] * (size_t)grid_cell(c.z, b.lo.z, b.hi.z, n[2]));
+            cell_of[t] = (uint32_t)cell;
+            start[cell + 1]++;
+        }
+        for (size_t c = 0; c < cells; c++)
+            start[c + 1] += start[c];
+        for (size_t c = 0; c < cells; c++)
+            if (start[c + 1] > start[c]) {
+                ps_mesh_tile *tile = &out->tiles[out->tile_count++];
+                tile->first = written + 3 * start[c];
+                tile->count = 3 * (start[c + 1] - start[c]);
+                tile->bounds = ps_aabb_empty();
+            }
+        /* start[c] now walks cell c's slots. */
+        for (size_t t = 0; t < tris; t++) {
+            size_t slot = start[cell_of[t]]++;
+            for (int k = 0; k < 3; k++) {
+                uint32_t v;
+                vertex_at(m, rg->first + 3 * t + (size_t)k, &v);
+                out->indices[written + 3 * slot + (size_t)k] = v;
+            }
+        }
+        for (size_t x = out->range_tiles[i]; x < out->tile_count; x++) {
+            ps_mesh_tile *tile = &out->tiles[x];
+            for (size_t j = tile->first; j < tile->first + tile->count; j++) {
+                const float *q = m->positions + 3 * (size_t)out->indices[j];
+                tile->bounds = ps_aabb_point(tile->bounds, ps_v3(q[0], q[1], q[2]));
+            }
+        }
+        written += 3 * tris;
+    }
+    out->range_tiles[m->range_count] = out->tile_count;
+    free(grids), free(bounds), free(start), free(cell_of);
+    return PS_OK;
+}
+
+void ps_mesh_tiling_free(ps_mesh_tiling *t)
+{
+    if (!t)
+        return;
+    free(t->tiles);
+    free(t->indices);
+    free(t->range_tiles);
+    memset(t, 0, sizeof *t);
 }

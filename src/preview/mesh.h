@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "core/status.h"
+#include "core/vec.h"
 #include "scene/scene.h"
 
 /* Subdivision stops here whatever max_edge asks: 2 * 256^2 triangles a face. */
@@ -26,6 +27,28 @@
  * texture coordinates too when the scene has textures. */
 #define PS_MESH_PLAN_VERTEX_BYTES (2 * 6 * sizeof(float) + sizeof(uint32_t))
 #define PS_MESH_PLAN_UV_BYTES (2 * 2 * sizeof(float))
+
+/* ---- tiles: a range's triangles regrouped by place ---------------------------- */
+
+/* A shadowed lit pass draws only what lies in one cube face's pyramid of a
+ * light (src/gl), and a whole range was drawn wherever any of it did: a
+ * Cornell wall lies in two or three pyramids, and each drew all of it.
+ * Tiles let the pass skip the parts outside. */
+typedef struct ps_mesh_tile {
+    ps_aabb bounds;      /* of its triangles' vertices */
+    size_t first, count; /* into the tiling's indices, 3 a triangle */
+} ps_mesh_tile;
+
+typedef struct ps_mesh_tiling {
+    ps_mesh_tile *tiles;
+    size_t tile_count;
+    /* Vertex indices into the mesh's arrays (its shared ones where it has
+     * them), for glDrawElements; a range's tiles are contiguous, so
+     * neighbouring tiles drawn together are one run. */
+    uint32_t *indices;
+    size_t *range_tiles; /* range i's tiles: [range_tiles[i], range_tiles[i + 1]) */
+    size_t range_count;
+} ps_mesh_tiling;
 
 /* A run of triangles of one object and one material. */
 typedef struct ps_mesh_range {
@@ -51,6 +74,9 @@ typedef struct ps_preview_mesh {
     uint32_t *shared;
     ps_mesh_range *ranges;
     size_t range_count;
+    /* Its ranges in tiles (ps_mesh_make_tiles), where the session made them
+     * (the fine mesh, for the shadowed lit passes); tile_count 0: none. */
+    ps_mesh_tiling tiles;
 } ps_preview_mesh;
 
 typedef struct ps_mesh_options {
@@ -81,5 +107,18 @@ uint64_t ps_preview_mesh_vertex_count(const ps_scene *s, const ps_mesh_options *
  * (core/memory.h), counted before anything is allocated. */
 ps_status ps_preview_mesh_build(const ps_scene *s, const ps_mesh_options *o, ps_preview_mesh *out, ps_error *err);
 void ps_preview_mesh_free(ps_preview_mesh *m); /* and zero it; accepts a zeroed one */
+
+
+/* About this many triangles a tile: a Cornell wall of the default scene's
+ * fine mesh in some 20 tiles. */
+#define PS_MESH_TILE_TRIANGLES 256
+
+/* Each range's triangles binned by centroid into a grid over the range's
+ * bounds (cells as square as its extents allow, about
+ * triangles_per_tile triangles a cell; its flat axes not cut), in their
+ * order within a cell; every triangle in exactly one tile, empty cells
+ * left out. A range of at most triangles_per_tile triangles is one tile. */
+ps_status ps_mesh_make_tiles(const ps_preview_mesh *m, size_t triangles_per_tile, ps_mesh_tiling *out, ps_error *err);
+void ps_mesh_tiling_free(ps_mesh_tiling *t); /* and zero it; accepts a zeroed one */
 
 #endif

@@ -173,6 +173,11 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
     ps_mesh_options mo = ps_mesh_default_options(s->scene);
     if (st == PS_OK)
         st = ps_preview_mesh_build(s->scene, &mo, &s->mesh, err);
+    /* Its tiles, for the shadowed lit passes (mesh.h): without them (out of
+     * memory) those passes draw whole ranges, the same pixels. */
+    ps_error tile_err;
+    if (st == PS_OK && ps_mesh_make_tiles(&s->mesh, PS_MESH_TILE_TRIANGLES, &s->mesh.tiles, &tile_err) != PS_OK)
+        ps_mesh_tiling_free(&s->mesh.tiles);
     size_t nm;
     if (st == PS_OK)
         st = ps_specular_create(&s->mesh, ps_scene_materials(s->scene, &nm), &s->spec, err);
@@ -1063,6 +1068,22 @@ bool ps_session_catching_up(ps_session *s)
     bool ended = ps_feed_ended(s->feed);
     ps_feed_unlock(s->feed);
     return ended;
+}
+
+bool ps_session_prepare_still(ps_session *s, size_t max_vertices)
+{
+    /* Only for the camera the last (moving) picture drew; an edit's level
+     * of detail is followed by its full view at once, with no wait. */
+    if (!s->moving || !s->have_cam || !incremental(s) || s->edited || s->illuminance ||
+        !(s->set.layers & PS_LAYER_SPECULAR) || ps_specular_range_count(s->spec) == 0)
+        return false;
+    bool traced = !(s->user_paused || s->counter_stopped);
+    if (traced) {
+        ps_feed_lock(s->feed);
+        traced = !ps_feed_ended(s->feed);
+        ps_feed_unlock(s->feed);
+    }
+    return !traced && ps_specular_update(s->spec, s->world, s->cam.eye, max_vertices) > 0;
 }
 
 double ps_session_next_refresh(const ps_session *s, double at)

@@ -419,6 +419,20 @@ void ps_specular_set_threads(ps_specular *sp, int threads)
 const float *ps_specular_dirs(const ps_specular *sp, int k) { return sp->dirs[k]; }
 const float *ps_specular_weights(const ps_specular *sp, int k) { return sp->weights[k]; }
 
+size_t ps_specular_weighted_triangles(const float *weights, size_t vertices, unsigned *out)
+{
+    size_t n = 0;
+    for (size_t t = 0; t + 3 <= vertices; t += 3) {
+        bool lit = false;
+        for (size_t i = 3 * t; i < 3 * (t + 3) && !lit; i++)
+            lit = weights[i] != 0.0f;
+        if (lit)
+            for (size_t v = t; v < t + 3; v++)
+                out[n++] = (unsigned)v;
+    }
+    return n;
+}
+
 /* ---- tracing ------------------------------------------------------------------- */
 
 typedef struct path_ctx {

@@ -110,6 +110,13 @@ void ps_specular_invalidate(ps_specular *sp);
  * centre, and an rgb weight (0 where a vertex has fewer paths). */
 const float *ps_specular_dirs(const ps_specular *sp, int k);
 const float *ps_specular_weights(const ps_specular *sp, int k);
+/* The triangles (vertices 3t, 3t + 1, 3t + 2 of `vertices`) that one term's
+ * rgb weights (3 floats a vertex) give any light: an index list of their
+ * vertices into out (room for `vertices`), its length returned. The rest add
+ * 0 to the layer at every pixel: most of a term past the first (a mirror's
+ * vertices have one path; vertices facing away from the eye none), which
+ * llvmpipe's passes, bound by vertices, would transform for nothing. */
+size_t ps_specular_weighted_triangles(const float *weights, size_t vertices, unsigned *out);
 
 /* ---- per-pixel eye paths ------------------------------------------------------ */
 
