@@ -23,6 +23,7 @@
 
 #include "gl/gl_render.h"
 #include "image/image.h"
+#include "preview/bake.h"
 #include "preview/session.h"
 #include "scene/scene.h"
 #include "gl_rig.h"
@@ -73,7 +74,7 @@ static void rig_open(rig *g, const char *text)
     set.layers = PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
     gl_rig_start(&g->base, &set, SIDE);
     ps_gl_scene gs = ps_gl_scene_of(g->base.s);
-    ps_gl_options go = {true, true, 0, false};
+    ps_gl_options go = {true, true, 0, false, false};
     ps_error err;
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g->base.s), &go, &g->gl, &err), PS_OK);
     assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &g->layers, &err), PS_OK);
@@ -379,6 +380,54 @@ static void an_edit_drops_the_textures(void **state)
     rig_close(&g);
 }
 
+/* The direct light's targets (ps_bake_direct_targets, GL-free): both sides
+ * of each diffuse quad, as the scene has it, texels of a 1024th of the
+ * scene's diagonal; a mirror quad none; too many texels none at all. */
+static void direct_light_targets(void **state)
+{
+    (void)state;
+    char text[4096];
+    snprintf(text, sizeof text, "%squad corner -0.5 1 -0.9 edge1 1 0 0 edge2 0 0.5 0 material mirror\n", BOX);
+    ps_scene *s;
+    ps_error err;
+    assert_int_equal(ps_scene_load_text(text, "inline.scn", "", NULL, &s, &err), PS_OK);
+    size_t nmat, nobj;
+    const ps_material *mats = ps_scene_materials(s, &nmat);
+    const ps_object *obj = ps_scene_objects(s, &nobj);
+    ps_bake_target *t;
+    size_t n;
+    assert_int_equal(ps_bake_direct_targets(s, mats, &t, &n, &err), PS_OK);
+    assert_int_equal(n, 10); /* five walls, two sides each; not the spheres, not the mirror quad */
+    double texel = ps_v3_len(ps_aabb_diag(ps_scene_bounds(s))) / PS_BAKE_DIRECT_TEXELS_PER_DIAG;
+    for (size_t i = 0; i < n; i++) {
+        assert_int_equal(t[i].object, i / 2);
+        assert_int_equal(t[i].side, (int)(i % 2));
+        assert_int_equal(obj[t[i].object].type, PS_OBJ_QUAD);
+        assert_int_equal(t[i].width, (int)ceil(ps_v3_len(t[i].edge1) / texel));
+        assert_int_equal(t[i].height, (int)ceil(ps_v3_len(t[i].edge2) / texel));
+        assert_true(t[i].width > 500 && t[i].width < 1000); /* 2 m walls, a 3.2 m diagonal (the light's too) */
+    }
+    /* The floor as written: corner (-1, 0, -1), edge1 (0, 0, 2), edge2 (2, 0, 0). */
+    assert_true(ps_v3_equal(t[0].corner, ps_v3(-1, 0, -1)) && ps_v3_equal(t[0].edge1, ps_v3(0, 0, 2)) &&
+                ps_v3_equal(t[0].edge2, ps_v3(2, 0, 0)));
+    free(t);
+    ps_scene_destroy(s);
+    /* Twelve 2 x 2 floors 0.1 apart: 2 m over a 3.03 m diagonal is 676 texels,
+     * 0.91 10^6 a floor's two sides, 1.1 10^7 in all: past
+     * PS_BAKE_MAX_TEXELS (8.4 10^6), none baked. */
+    char many[4096];
+    int at = snprintf(many, sizeof many, "camera eye 0 1 3 target 0 0 0\nmaterial white diffuse albedo 0.5 0.5 0.5\n"
+                                         "light point position 0 1.1 0 power 10 10 10\n");
+    for (int q = 0; q < 12; q++)
+        at += snprintf(many + at, sizeof many - (size_t)at,
+                       "quad corner -1 %.1f -1 edge1 0 0 2 edge2 2 0 0 material white\n", 0.1 * q);
+    assert_int_equal(ps_scene_load_text(many, "inline.scn", "", NULL, &s, &err), PS_OK);
+    assert_int_equal(ps_bake_direct_targets(s, ps_scene_materials(s, &nmat), &t, &n, &err), PS_OK);
+    assert_int_equal(n, 0);
+    assert_null(t);
+    ps_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -389,6 +438,7 @@ int main(void)
         cmocka_unit_test(baked_bytes_do_not_depend_on_the_budget),
         cmocka_unit_test(a_hidden_layer_waits),
         cmocka_unit_test(an_edit_drops_the_textures),
+        cmocka_unit_test(direct_light_targets),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

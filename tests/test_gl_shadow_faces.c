@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gl/gl_internal.h" /* ps_gl_begin_frame_shadows: a moving frame */
 #include "gl/gl_render.h"
 #include "preview/lights.h"
 #include "preview/mesh.h"
@@ -140,7 +141,7 @@ static void edit_renders(edit_kind e, unsigned expect_faces, bool picture_change
     ps_error err;
     gl_rig g = gl_rig_open(scene_text);
     ps_scene *s = g.s;
-    ps_gl_options go = {true, true, 0, false};
+    ps_gl_options go = {true, true, 0, false, false};
 
     inputs before;
     inputs_make(s, &before);
@@ -247,7 +248,7 @@ static void culled_faces_draw_the_same(void **state)
         /* Culled by tiles, every object whole, culled by whole ranges (the
          * mesh's tiles dropped: what a mesh without them draws). */
         for (int v = 0; v < 3; v++) {
-            ps_gl_options go = {true, true, 0, v == 1};
+            ps_gl_options go = {true, true, 0, v == 1, false};
             if (v == 2)
                 ps_mesh_tiling_free(&in.mesh.tiles);
             ps_gl_renderer *r;
@@ -294,7 +295,7 @@ static void resized_shadows_render_every_face(void **state)
     (void)state;
     ps_error err;
     gl_rig g = gl_rig_open(scene_text);
-    ps_gl_options go = {true, true, 0, false};
+    ps_gl_options go = {true, true, 0, false, false};
     inputs coarse, full;
     inputs_make_sized(g.s, 32, &coarse);
     inputs_make(g.s, &full);
@@ -324,6 +325,129 @@ static void resized_shadows_render_every_face(void **state)
     gl_rig_close(&g);
 }
 
+/* ps_gl_options.bake_direct: the direct layer of diffuse quads drawn from
+ * textures laid once (gl_direct_bake.c) against the lit passes themselves
+ * (a renderer without them), at the laying view and at another: relative
+ * squared error (pixels over 1 % of the peak) and the mean. Texels of a
+ * 1024th of the scene's diagonal against pixels of about a 96th of the
+ * view: the error is the shadow edges' and the Gouraud ramps' resampling. */
+static double rel_mse(const ps_image *a, const ps_image *b, double *mean_a, double *mean_b)
+{
+    size_t n = 3 * (size_t)a->width * (size_t)a->height, counted = 0;
+    double peak = 0.0, e = 0.0, sa = 0.0, sb = 0.0;
+    for (size_t i = 0; i < n; i++)
+        peak = fmax(peak, b->rgb[i]);
+    for (size_t i = 0; i < n; i++) {
+        sa += a->rgb[i], sb += b->rgb[i];
+        if (b->rgb[i] > 0.01 * peak) {
+            double d = (double)a->rgb[i] - (double)b->rgb[i];
+            e += d * d / ((double)b->rgb[i] * (double)b->rgb[i]);
+            counted++;
+        }
+    }
+    *mean_a = sa / (double)n, *mean_b = sb / (double)n;
+    return counted ? e / (double)counted : 0.0;
+}
+
+static ps_image draw_at(ps_gl_renderer *r, const ps_camera_frame *cam, bool moving)
+{
+    ps_gl_begin_frame_shadows(r, cam, 1.0, true, !moving, moving);
+    ps_image img;
+    ps_error err;
+    assert_int_equal(ps_gl_read(r, &img, &err), PS_OK);
+    return img;
+}
+
+static void baked_against_lit(const char *text, const char *what, ps_vec3 other_eye)
+{
+    ps_error err;
+    gl_rig g = gl_rig_open(text);
+    inputs in;
+    inputs_make(g.s, &in);
+    ps_gl_scene gs = gl_scene(g.s, &in);
+    ps_gl_options lit_o = {true, true, 0, false, false}, baked_o = {true, true, 0, false, true};
+    ps_gl_renderer *lit, *baked;
+    assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &lit_o, &lit, &err), PS_OK);
+    assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &baked_o, &baked, &err), PS_OK);
+    ps_camera cam0 = *ps_scene_camera(g.s), cam1 = cam0;
+    cam1.eye = other_eye;
+    ps_camera_frame frames[2] = {ps_camera_frame_make(&cam0, W, H), ps_camera_frame_make(&cam1, W, H)};
+    /* The first view makes the shadow maps (the lights new): lit passes,
+     * the same pixels; the next lays the textures; a moving one after
+     * another camera draws them, and a still one there too. */
+    ps_image first = draw_at(baked, &frames[0], false), want0 = draw_at(lit, &frames[0], false);
+    assert_false(ps_gl_get_stats(baked).direct_baked_last);
+    assert_true(same_pixels(&first, &want0));
+    for (int v = 0; v < 3; v++) {
+        const ps_camera_frame *f = &frames[v == 0 ? 0 : 1];
+        ps_image got = draw_at(baked, f, v == 1), want = draw_at(lit, f, false);
+        assert_true(ps_gl_get_stats(baked).direct_baked_last);
+        assert_int_equal(ps_gl_get_stats(baked).direct_bakes, 1);
+        double ma, mb, e = rel_mse(&got, &want, &ma, &mb);
+        print_message("%s, view %d%s: the direct layer from its textures, mean %.5f against %.5f (%.3f %%), relMSE "
+                      "%.2e\n",
+                      what, v, v == 1 ? " (moving)" : "", ma, mb, 100.0 * (ma / mb - 1.0), e);
+        assert_true(mb > 0.0);
+        assert_true(fabs(ma / mb - 1.0) < 0.005);
+        assert_true(e < 5e-3);
+        ps_image_destroy(&got);
+        ps_image_destroy(&want);
+    }
+    /* A moved light: the textures are dropped, the lit passes draw (the same
+     * pixels as a fresh renderer's), and the next still view lays them again. */
+    assert_int_equal(ps_scene_set_light_position(g.s, 0, ps_v3_add(ps_scene_lights(g.s, NULL)[0].position,
+                                                                    ps_v3(0.1, -0.05, 0.05)),
+                                                 &err),
+                     PS_OK);
+    inputs after;
+    inputs_make(g.s, &after);
+    gs = gl_scene(g.s, &after);
+    assert_int_equal(ps_gl_renderer_set_scene(baked, &gs, &err), PS_OK);
+    assert_int_equal(ps_gl_renderer_set_scene(lit, &gs, &err), PS_OK);
+    ps_image got = draw_at(baked, &frames[1], false), want = draw_at(lit, &frames[1], false);
+    assert_false(ps_gl_get_stats(baked).direct_baked_last);
+    assert_true(same_pixels(&got, &want));
+    ps_image_destroy(&got);
+    got = draw_at(baked, &frames[1], false);
+    assert_true(ps_gl_get_stats(baked).direct_baked_last);
+    assert_int_equal(ps_gl_get_stats(baked).direct_bakes, 2);
+    double ma, mb;
+    assert_true(rel_mse(&got, &want, &ma, &mb) < 1e-3);
+    ps_image_destroy(&got);
+    ps_image_destroy(&want);
+    ps_image_destroy(&first);
+    ps_image_destroy(&want0);
+    ps_gl_renderer_destroy(lit);
+    ps_gl_renderer_destroy(baked);
+    inputs_free(&in);
+    inputs_free(&after);
+    gl_rig_close(&g);
+}
+
+static void direct_light_baked_on_quads(void **state)
+{
+    (void)state;
+    char box[2048];
+    snprintf(box, sizeof box, TWO_LIGHTS_SCENE "60 50 40\n");
+    /* The floor and its occluder from above, then from a side. */
+    baked_against_lit(scene_text, "floor", ps_v3(1.5, 2.0, 1.5));
+    /* The box with its spot and point light, its spheres' shadows. */
+    baked_against_lit(box, "box", ps_v3(0.6, 1.3, 2.9));
+}
+
+/* A quad lit on its back, seen from there: its back side's texture (its
+ * lay must see the triangles wound as that view does). */
+static void direct_light_baked_on_a_back_side(void **state)
+{
+    (void)state;
+    const char *text = "camera eye 0 -2 0.01 target 0 0 0 up 0 0 -1 fov 70\n"
+                       "material floor diffuse albedo 0.5 0.5 0.5\n"
+                       "quad corner -2 0 2 edge1 4 0 0 edge2 0 0 -4 material floor\n"
+                       "quad corner -0.2 -0.5 -0.2 edge1 0.4 0 0 edge2 0 0 0.4 material floor\n"
+                       "light point position 0.1 -1 0 power 100 100 100\n";
+    baked_against_lit(text, "back side", ps_v3(1.0, -1.8, 0.5));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -333,6 +457,8 @@ int main(void)
         cmocka_unit_test(moved_light_renders_its_cube),
         cmocka_unit_test(culled_faces_draw_the_same),
         cmocka_unit_test(resized_shadows_render_every_face),
+        cmocka_unit_test(direct_light_baked_on_quads),
+        cmocka_unit_test(direct_light_baked_on_a_back_side),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

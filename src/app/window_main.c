@@ -106,7 +106,9 @@ static const char usage[] =
     "                           on the surfaces (default splats; key M)\n"
     "  --bake on|off            once a map is traced to its end and its photons all\n"
     "                           lie on diffuse quads, lay its splats into textures on\n"
-    "                           them and draw those for each new view (default on)\n"
+    "                           them, and the direct light on diffuse quads once the\n"
+    "                           lights hold, and draw those for each new view\n"
+    "                           (default on)\n"
     "  --overlay on|off         the text overlay (default on)\n"
     "  --autosave on|off        write every edit within a second to\n"
     "                           NAME.autosave.scn (default on; off with --script,\n"
@@ -290,7 +292,7 @@ static ps_status open_session(app *a, ps_error *err)
     set.progressive_lights = true; /* the first picture (and the first after an edit) sooner */
     set.repair = !a->o.no_repair;
     ps_status st = ps_session_create(a->scene, &set, &a->session, err);
-    ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE, false};
+    ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE, false, a->o.p.bake};
     if (st == PS_OK) {
         ps_gl_scene gs = ps_gl_scene_of(a->session);
         st = ps_gl_renderer_create(&gs, ps_session_kernel(a->session), &go, &a->gl, err);
@@ -1213,6 +1215,7 @@ static ps_status write_stats(app *a, ps_error *err)
     ps_stats_add(&rs, "moving_frame_seconds_mean", a->moving_frames ? a->moving_seconds / (double)a->moving_frames : 0.0);
     ps_stats_add(&rs, "full_after_stop_seconds", a->full_after_stop);
     ps_stats_add(&rs, "full_after_step_seconds", a->full_after_step);
+    ps_stats_add(&rs, "direct_light_bakes", a->gl ? (double)ps_gl_get_stats(a->gl).direct_bakes : 0.0);
     size_t baked_texels = 0;
     for (int k = 0; k < PS_MAP_COUNT && a->session; k++) {
         size_t texels;

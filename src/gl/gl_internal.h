@@ -8,6 +8,23 @@
 #include "gl/gl_api.h"
 #include "gl/gl_render.h"
 
+/* The direct light of diffuse quads laid into textures (preview/bake.h's
+ * ps_bake_direct_targets, gl_direct_bake.c; ps_gl_options.bake_direct):
+ * valid while r->lit_epoch, the exposure and the shadows it was laid with
+ * hold. */
+typedef struct ps_gl_direct_bake {
+    size_t count;
+    ps_bake_target *targets;
+    GLuint *tex, *fbo;
+    bool *flip;          /* a target's texture rows run against edge2 (its lay kept GL's winding) */
+    bool *object_baked;  /* per scene object: the textures are its direct light */
+    size_t objects;
+    bool laid;
+    uint64_t epoch;
+    double exposure;
+    bool shadows;
+} ps_gl_direct_bake;
+
 struct ps_gl_renderer {
     ps_gl_scene in;
     /* The mesh this frame's lit passes draw: in.mesh, or in.moving for a
@@ -48,6 +65,15 @@ struct ps_gl_renderer {
      * (NULL when out of memory: nothing culled). */
     ps_aabb *range_bounds;
     const float *range_bounds_of;
+    /* What the lit passes draw: counted up whenever what they would draw
+     * changes (new inputs, materials, shadow faces); the direct light's
+     * textures are valid for one count. */
+    uint64_t lit_epoch;
+    ps_gl_direct_bake direct_bake;
+    /* Lit passes of only this object (UINT32_MAX: every one), for laying
+     * its textures; and without the objects drawn from them. */
+    uint32_t only_object;
+    bool skip_baked;
 };
 
 /* Textures (gl_albedo.c). The lit passes and the splats use the materials'
@@ -135,6 +161,15 @@ void ps_gl_bake_lay(ps_gl_bake *g, ps_gl_renderer *r, const ps_bake *plan);
 /* Each target on the side the eye sees, textured, added to the bound
  * framebuffer under the view's matrices where its object shows. */
 void ps_gl_bake_draw(const ps_gl_bake *g, const ps_gl_renderer *r, ps_vec3 eye);
+
+void ps_gl_direct_bake_free(ps_gl_renderer *r);
+/* Before a view's direct layer: whether the textures hold this exposure's
+ * direct light (laid now where `may_lay` and they do not: the lights, the
+ * geometry and the materials as they stand, every shadow map fresh). */
+bool ps_gl_direct_bake_ready(ps_gl_renderer *r, double exposure, bool may_lay);
+/* The textures on their quads, the side the eye sees, added to the bound
+ * framebuffer under the view's matrices against the prepass's depth. */
+void ps_gl_direct_bake_draw(const ps_gl_renderer *r, ps_vec3 eye);
 
 
 #endif

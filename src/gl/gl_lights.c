@@ -247,6 +247,7 @@ static bool all_fresh(const ps_gl_renderer *r)
 
 ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err)
 {
+    r->lit_epoch++;
     free_profiles(r);
     size_t n = lights_of(r)->count;
     r->stats.virtual_lights = (unsigned)n;
@@ -372,6 +373,8 @@ void ps_gl_make_shadow_maps(ps_gl_renderer *r)
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     glBindTexture(GL_TEXTURE_2D, 0);
     r->shadows_valid = true;
+    if (faces > 0)
+        r->lit_epoch++; /* the lit passes' shadows are new */
     glFinish();
     r->stats.shadow_faces_last += faces;
     r->stats.shadow_seconds_last += ps_now_seconds() - t0;
@@ -389,7 +392,13 @@ static void draw_emission(const ps_gl_renderer *r, double exposure)
     glCullFace(GL_BACK);
     for (size_t i = 0; i < m->range_count; i++) {
         const ps_material *mat = &r->in.materials[m->ranges[i].material];
+        uint32_t obj = m->ranges[i].object;
         if (ps_rgb_is_black(mat->emission))
+            continue;
+        /* As the lit passes: one quad's while its textures are laid, none of
+         * theirs while they are drawn (gl_direct_bake.c). */
+        if ((r->only_object != UINT32_MAX && obj != r->only_object) ||
+            (r->skip_baked && obj < r->direct_bake.objects && r->direct_bake.object_baked[obj]))
             continue;
         glColor4f((GLfloat)(mat->emission.r * exposure), (GLfloat)(mat->emission.g * exposure),
                   (GLfloat)(mat->emission.b * exposure), 1.0f);

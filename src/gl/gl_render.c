@@ -116,6 +116,12 @@ static void draw_ranges(const ps_gl_renderer *r, bool with_materials, bool stenc
         const ps_mesh_range *rg = &m->ranges[i];
         if ((r->skip_specular || skip_black) && ps_material_is_specular(&r->in.materials[rg->material]))
             continue;
+        /* Laying one quad's textures; or its direct light drawn from them. */
+        if (with_materials && r->only_object != UINT32_MAX && rg->object != r->only_object)
+            continue;
+        if (with_materials && r->skip_baked && rg->object < r->direct_bake.objects &&
+            r->direct_bake.object_baked[rg->object])
+            continue;
         bool outside = false;
         for (int p = 0; cull && p < plane_count && !outside; p++)
             outside = box_clipped(r->range_bounds[i], planes[p]);
@@ -227,8 +233,16 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
     r->lit = moving && r->in.moving ? r->in.moving : r->in.mesh;
     r->stats.light_passes = 0;
     r->stats.light_vertices = 0;
+    uint64_t epoch = r->lit_epoch;
     if (direct && shadows && !r->shadows_valid)
         ps_gl_make_shadow_maps(r);
+    /* The direct light of diffuse quads from their textures (bake_direct),
+     * laid by a still view with shadows whose lights stand as the last
+     * frame's (not the first after an edit: a light dragged would lay them
+     * each frame), drawn by every view while they hold. */
+    bool baked = direct && r->opt.bake_direct &&
+                 ps_gl_direct_bake_ready(r, exposure, shadows && !moving && epoch == r->lit_epoch);
+    r->stats.direct_baked_last = baked;
     r->width = cam->width;
     r->height = cam->height;
     glViewport(0, 0, cam->width, cam->height);
@@ -281,7 +295,13 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
         glDepthFunc(GL_LEQUAL);
         glEnable(GL_BLEND);
         glBlendFunc(GL_ONE, GL_ONE);
+        if (baked)
+            ps_gl_direct_bake_draw(r, cam->eye);
+        /* With shadows where the textures have them: a moving frame's
+         * other objects keep its level of detail (none). */
+        r->skip_baked = baked;
         ps_gl_draw_direct(r, exposure, shadows);
+        r->skip_baked = false;
         glDisable(GL_BLEND);
     }
     ps_gl_draw_emitters(r, exposure, direct);
@@ -352,6 +372,7 @@ ps_gl_scene ps_gl_scene_of(const ps_session *s)
 static void set_inputs(ps_gl_renderer *r, const ps_gl_scene *in)
 {
     r->in = *in;
+    r->lit_epoch++;
     r->lit = in->mesh;
     make_range_bounds(r);
     r->scene_diag = ps_v3_len(ps_aabb_diag(in->bounds));
@@ -372,6 +393,7 @@ void ps_gl_renderer_set_materials(ps_gl_renderer *r, const ps_material *material
 {
     r->in.materials = materials;
     r->in.hide_emitters = hide_emitters;
+    r->lit_epoch++;
 }
 
 ps_status ps_gl_renderer_create(const ps_gl_scene *in, const ps_kernel_texture *kernel, const ps_gl_options *o,
@@ -382,6 +404,7 @@ ps_status ps_gl_renderer_create(const ps_gl_scene *in, const ps_kernel_texture *
     if (!r)
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the GL renderer");
     r->opt = *o;
+    r->only_object = UINT32_MAX;
     r->shadow_size = o->shadow_size > 0 ? o->shadow_size : PS_GL_SHADOW_SIZE;
     ps_status st = ps_gl_renderer_set_scene(r, in, err);
     if (st != PS_OK) {
@@ -403,6 +426,7 @@ void ps_gl_renderer_destroy(ps_gl_renderer *r)
         return;
     ps_gl_lights_free(r);
     ps_gl_albedo_free(r);
+    ps_gl_direct_bake_free(r);
     free(r->range_bounds);
     if (r->fbo)
         glDeleteFramebuffers(1, &r->fbo);

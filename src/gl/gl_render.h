@@ -56,6 +56,10 @@ typedef struct ps_gl_options {
                              * pyramid or its tiles, mirrors and glass, and
                              * triangles a lookup gives no light, all of which
                              * add nothing there, are left out: the same pixels) */
+    bool bake_direct;       /* the direct light of diffuse quads from textures laid once
+                             * (preview/bake.h): a still view with shadows lays them, and
+                             * every view (moving ones too) draws them until the lights,
+                             * the geometry or the materials change (default false) */
 } ps_gl_options;
 
 /* What the renderer draws, prepared GL-free; everything pointed to must
@@ -186,6 +190,8 @@ typedef struct ps_gl_stats {
     uint64_t light_vertices; /* vertices the lit passes of the last frame drew */
     unsigned shadow_faces_last;
     double shadow_seconds_last;
+    unsigned direct_bakes;   /* times the direct light's textures were laid (bake_direct) */
+    bool direct_baked_last;  /* the last view's direct layer drew them */
 } ps_gl_stats;
 void ps_gl_clear_shadow_timing(ps_gl_renderer *r);
 ps_gl_stats ps_gl_get_stats(const ps_gl_renderer *r);

@@ -243,3 +243,49 @@ ps_status ps_bake_build(ps_bake *b, const ps_photon *photons, const uint16_t *id
     }
     return PS_OK;
 }
+
+/* ---- the direct light on diffuse quads -------------------------------------------- */
+
+ps_status ps_bake_direct_targets(const ps_scene *scene, const ps_material *materials, ps_bake_target **out,
+                                 size_t *count, ps_error *err)
+{
+    *out = NULL;
+    *count = 0;
+    size_t nobj, n = 0;
+    const ps_object *obj = ps_scene_objects(scene, &nobj);
+    for (size_t o = 0; o < nobj; o++)
+        n += obj[o].type == PS_OBJ_QUAD && materials[obj[o].material].type == PS_MAT_DIFFUSE ? 2 : 0;
+    if (n == 0)
+        return PS_OK;
+    ps_bake_target *t = malloc(n * sizeof *t);
+    if (!t)
+        return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the baked direct light");
+    double diag = ps_v3_len(ps_aabb_diag(ps_scene_bounds(scene)));
+    double texel = diag > 0.0 && isfinite(diag) ? diag / PS_BAKE_DIRECT_TEXELS_PER_DIAG : 1.0;
+    size_t k = 0, texels = 0;
+    for (size_t o = 0; o < nobj; o++) {
+        if (obj[o].type != PS_OBJ_QUAD || materials[obj[o].material].type != PS_MAT_DIFFUSE)
+            continue;
+        for (int side = 0; side < 2; side++) {
+            ps_bake_target *q = &t[k++];
+            q->object = (uint32_t)o;
+            q->side = side;
+            quad_frame(scene, &obj[o], &q->corner, &q->edge1, &q->edge2);
+            double along[2] = {ceil(ps_v3_len(q->edge1) / texel), ceil(ps_v3_len(q->edge2) / texel)};
+            int sides[2];
+            for (int a = 0; a < 2; a++)
+                sides[a] = along[a] < PS_BAKE_MIN_SIDE   ? PS_BAKE_MIN_SIDE
+                           : along[a] > PS_BAKE_MAX_SIDE ? PS_BAKE_MAX_SIDE
+                                                         : (int)along[a];
+            q->width = sides[0], q->height = sides[1];
+            texels += (size_t)q->width * (size_t)q->height;
+        }
+    }
+    if (texels > PS_BAKE_MAX_TEXELS) {
+        free(t);
+        return PS_OK;
+    }
+    *out = t;
+    *count = n;
+    return PS_OK;
+}

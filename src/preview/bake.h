@@ -84,4 +84,23 @@ const ps_splat_batch *ps_bake_batch(const ps_bake *b, size_t t);
 /* Splats in the last build, all targets. */
 size_t ps_bake_splats(const ps_bake *b);
 
+/* ---- the direct light on diffuse quads (src/gl: ps_gl_options.bake_direct) ---- */
+
+/* The direct layer (the lit passes: each light's Gouraud-interpolated
+ * diffuse term times its shadow test) on a Lambertian quad is the same
+ * whatever the eye, too: src/gl lays it once into a texture a quad side and
+ * draws the textures for every view until the lights, the geometry or the
+ * materials change. Its texels: the scene's bounding-box diagonal over
+ * this many (the default box's walls 592 a side, 9.4 mm, where a pixel of
+ * its 512^2 view covers about 11 mm). */
+#define PS_BAKE_DIRECT_TEXELS_PER_DIAG 1024.0
+
+/* Both sides of every quad whose material (materials, indexed by the
+ * scene's ids) is diffuse, where the quad is now, texels along each edge as
+ * above (at least PS_BAKE_MIN_SIDE, at most PS_BAKE_MAX_SIDE: a larger quad
+ * gets coarser texels), into *out (free()), *count of them; none (*count 0)
+ * when they would hold more than PS_BAKE_MAX_TEXELS texels in all. */
+ps_status ps_bake_direct_targets(const ps_scene *scene, const ps_material *materials, ps_bake_target **out,
+                                 size_t *count, ps_error *err);
+
 #endif
