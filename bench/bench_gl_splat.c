@@ -224,7 +224,8 @@ static int first_picture_run(bench_gl *g, double t[STAGE_COUNT], double warm[3],
     if (ps_preview_lights_build(g->scene, NULL, &g->coarse, PS_GL_SHADOW_SIZE, PS_PREVIEW_AREA_SIDE, &g->lights, err) != PS_OK)
         goto done;
     size_t nmat;
-    ps_gl_scene gs = {&g->mesh, &g->coarse, ps_scene_materials(g->scene, &nmat), &g->lights, ps_scene_bounds(g->scene), false, g->scene};
+    ps_gl_scene gs = {&g->mesh, &g->coarse, ps_scene_materials(g->scene, &nmat), &g->lights, ps_scene_bounds(g->scene), false, g->scene,
+                      NULL};
     if (ps_gl_renderer_create(&gs, &g->kernel, &gopt, &g->gl, err) != PS_OK)
         goto done;
     glFinish();

@@ -102,8 +102,8 @@ rmse=$("$bin/photosplat-compare" "$cli_tmp/maps-w.png" "$cli_tmp/maps-s.png" | s
 echo "window against photosplat-snap, global layer as maps: rmse $rmse"
 awk_true "$rmse < 2.0 / 255" && ok || bad "maps: the window and photosplat-snap differ: rmse $rmse"
 
-# Finished maps baked into textures on their quads (--bake, the window's
-# default): after an orbit away and back, the picture drawn from the textures
+# Finished maps, and the direct light, baked into textures on their quads
+# (--bake, the window's default): after an orbit away and back, the picture drawn from the textures
 # is the splats' (--bake off) within 2 codes rms and 0.5 % on the mean (at
 # these 2*10^4 photons a caustic splat's cone stands alone, and the texture
 # samples its peak at a quarter radius: 1.4 codes here, 0.5 at 3*10^5 photons
@@ -117,6 +117,10 @@ expect_success "window not baked" xrun "$win" "$scene" "${same[@]}" --overlay of
     --script "$cli_tmp/bake-off.txt" --stats "$cli_tmp/bake-off.json"
 grep -q '"baked_texels": 0,' "$cli_tmp/bake-on.json" && bad "bake: nothing baked" || ok
 grep -q '"baked_texels": 0,' "$cli_tmp/bake-off.json" && ok || bad "bake off: something baked"
+# ... and the direct light on the box's quads too, laid once (the lights
+# held): the picture above is drawn from those textures as well.
+[ "$(stat_of direct_light_bakes "$cli_tmp/bake-on.json")" = 1 ] && ok || bad "bake: the direct light laid $(stat_of direct_light_bakes "$cli_tmp/bake-on.json") times"
+[ "$(stat_of direct_light_bakes "$cli_tmp/bake-off.json")" = 0 ] && ok || bad "bake off: the direct light laid"
 cmp_line=$("$bin/photosplat-compare" "$cli_tmp/bake-on.png" "$cli_tmp/bake-off.png")
 echo "window after an orbit, maps baked against splatted: $cmp_line"
 rmse=$(echo "$cmp_line" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')

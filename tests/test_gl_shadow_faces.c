@@ -372,12 +372,21 @@ static void baked_against_lit(const char *text, const char *what, ps_vec3 other_
     ps_camera cam0 = *ps_scene_camera(g.s), cam1 = cam0;
     cam1.eye = other_eye;
     ps_camera_frame frames[2] = {ps_camera_frame_make(&cam0, W, H), ps_camera_frame_make(&cam1, W, H)};
-    /* The first view makes the shadow maps (the lights new): lit passes,
-     * the same pixels; the next lays the textures; a moving one after
-     * another camera draws them, and a still one there too. */
+    /* Nothing to lay before a frame has made the shadow maps; the first
+     * view draws the lit passes (the same pixels); then the textures are
+     * laid (in parts, as the window does while it waits), and the views
+     * draw them: the first camera's again, a moving one after another
+     * camera, and a still one there. */
+    assert_false(ps_gl_direct_bake_lay(baked, 1.0, HUGE_VAL));
     ps_image first = draw_at(baked, &frames[0], false), want0 = draw_at(lit, &frames[0], false);
     assert_false(ps_gl_get_stats(baked).direct_baked_last);
     assert_true(same_pixels(&first, &want0));
+    int parts = 1;
+    while (ps_gl_direct_bake_lay(baked, 1.0, 0.0))
+        parts++;
+    assert_true(parts > 1); /* a side a call at least */
+    assert_false(ps_gl_direct_bake_lay(baked, 1.0, 0.0)); /* laid: nothing left */
+    assert_int_equal(ps_gl_get_stats(baked).direct_bakes, 1);
     for (int v = 0; v < 3; v++) {
         const ps_camera_frame *f = &frames[v == 0 ? 0 : 1];
         ps_image got = draw_at(baked, f, v == 1), want = draw_at(lit, f, false);
@@ -408,6 +417,10 @@ static void baked_against_lit(const char *text, const char *what, ps_vec3 other_
     assert_false(ps_gl_get_stats(baked).direct_baked_last);
     assert_true(same_pixels(&got, &want));
     ps_image_destroy(&got);
+    /* Laid again, but a change halfway starts it over: the exposure. */
+    assert_true(ps_gl_direct_bake_lay(baked, 2.0, 0.0));
+    while (ps_gl_direct_bake_lay(baked, 1.0, 0.0))
+        ;
     got = draw_at(baked, &frames[1], false);
     assert_true(ps_gl_get_stats(baked).direct_baked_last);
     assert_int_equal(ps_gl_get_stats(baked).direct_bakes, 2);

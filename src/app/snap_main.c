@@ -70,8 +70,7 @@ static const char usage[] =
     "                           on the surfaces (glossy lobes still splatted) (default splats)\n"
     "  --bake on|off            float layers: once a map is traced to its end and its\n"
     "                           photons all lie on diffuse quads, lay its splats into\n"
-    "                           textures on them, and the direct light on diffuse quads,\n"
-    "                           drawn for each later view (default off)\n"
+    "                           textures on them, drawn for each later view (default off)\n"
     "  --hdr-layers PREFIX      also each layer alone, linear: PREFIX-direct.pfm,\n"
     "                           PREFIX-caustic.pfm, PREFIX-global.pfm, PREFIX-specular.pfm\n"
     "  --checkpoints T1,T2,...  progressive mode: at each of these seconds, write the\n"
@@ -1261,7 +1260,10 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
      * 16 shadow cubes; a fixed photon count draws once, with all of them. */
     set.progressive_lights = progressive;
     ps_status st = ps_session_create(scene, &set, &s.session, err);
-    ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0, false, o->p.bake};
+    /* Never the direct light's textures: snap's pictures are compared with
+     * the reference's, and with them a picture would depend on when they
+     * were laid. */
+    ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0, false, false};
     if (st == PS_OK) {
         ps_gl_scene gs = ps_gl_scene_of(s.session);
         st = ps_gl_renderer_create(&gs, ps_session_kernel(s.session), &gopt, &s.gl, err);

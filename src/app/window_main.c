@@ -190,6 +190,7 @@ typedef struct app {
     /* When the camera last moved (an orbit, pan or zoom, a script's or the
      * user's), and from then to the full picture after the last such move. */
     double camera_step, full_after_step;
+    bool relight; /* the direct light's textures were just laid: the direct layer drawn again */
     bool full_pending;
     ps_latency lat; /* an edit's first refreshed frame, phase by phase (app/latency.h) */
     /* Illuminance in false colour (key F): the last refresh's lux, a pixel
@@ -505,6 +506,12 @@ static ps_status refresh(app *a, ps_error *err)
     ps_latency_add_faces(&a->lat, gst.shadow_faces_last);
     ps_gl_clear_shadow_timing(a->gl);
     ps_gl_layers_draw(a->layers, a->gl, &cam, &a->frame);
+    /* The direct light's textures just laid: the same view's direct layer
+     * from them (a new view or new lights drew it already). */
+    if (a->relight && !a->frame.new_view && !a->frame.lights_changed)
+        ps_gl_layers_relight(a->layers, a->gl, a->frame.view.width > 0 ? &a->frame.view : &cam,
+                             a->frame.direct_exposure, a->frame.direct);
+    a->relight = false;
     if (a->frame.splats > 0)
         ps_gl_finish();
     double draw_seconds = ps_now_seconds() - t_draw;
@@ -1042,7 +1049,10 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
  * nothing the window itself has still to redraw. */
 static bool script_wait_over(app *a)
 {
-    return !a->redraw && ps_session_settled(a->session) && ps_gl_specular_done(a->spec, a->session);
+    /* The direct light's textures laid and shown too, so that what the
+     * picture is then does not depend on when they were. */
+    return !a->redraw && ps_session_settled(a->session) && ps_gl_specular_done(a->spec, a->session) &&
+           !ps_gl_direct_bake_pending(a->gl, a->frame.direct_exposure);
 }
 
 /* ---- the session ---------------------------------------------------------------------- */
@@ -1106,9 +1116,17 @@ static ps_status session(app *a, ps_error *err)
         if (a->work.pending)
             wake = fmin(wake, a->work.due);
         bool idle = now < wake && !a->redraw && !ps_session_edited(a->session);
-        /* The still view's first work while the camera may have stopped
-         * (session.h), a little at a time, events polled between. */
-        if (idle && !ps_session_prepare_still(a->session, PS_SESSION_PREPARE_VERTICES) && ps_now_seconds() < wake)
+        /* While waiting, work done ahead a little at a time, events polled
+         * between: the still view's first work while the camera may have
+         * stopped (session.h), and the direct light's textures once the
+         * lights hold (gl_render.h); not while photons are traced. */
+        unsigned bakes = ps_gl_get_stats(a->gl).direct_bakes;
+        bool worked = idle && (ps_session_prepare_still(a->session, PS_SESSION_PREPARE_VERTICES) ||
+                               (a->frames > 0 && !ps_session_tracing(a->session) &&
+                                ps_gl_direct_bake_lay(a->gl, a->frame.direct_exposure, PS_GL_DIRECT_BAKE_STEP_SECONDS)));
+        if (ps_gl_get_stats(a->gl).direct_bakes != bakes)
+            a->relight = a->redraw = true; /* the view's direct layer from them at once */
+        if (idle && !worked && ps_now_seconds() < wake)
             glfwWaitEventsTimeout(wake - ps_now_seconds());
         else
             glfwPollEvents();

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/clock.h"
 #include "gl/gl_internal.h"
 
 /* How far the lay's eye stands off the quad, in quad sizes: its depth range
@@ -113,23 +114,93 @@ static void lay_matrices(const ps_bake_target *t, double view[16], double proj[1
     proj[15] = 1.0;
 }
 
-bool ps_gl_direct_bake_ready(ps_gl_renderer *r, double exposure, bool may_lay)
+/* Whether what the textures were (or are being) laid for still stands. */
+static bool current(const ps_gl_renderer *r, double exposure)
+{
+    const ps_gl_direct_bake *b = &r->direct_bake;
+    return b->epoch == r->lit_epoch && b->exposure == exposure && b->shadows == r->opt.shadows;
+}
+
+bool ps_gl_direct_bake_ready(const ps_gl_renderer *r, double exposure)
+{
+    return r->opt.bake_direct && r->direct_bake.laid && current(r, exposure);
+}
+
+bool ps_gl_direct_bake_pending(const ps_gl_renderer *r, double exposure)
+{
+    const ps_gl_direct_bake *b = &r->direct_bake;
+    return r->opt.bake_direct && exposure > 0.0 && !(current(r, exposure) && (b->laid || b->none));
+}
+
+/* Target t laid: the lit passes of its quad alone under its matrices. */
+static void lay_target(ps_gl_renderer *r, size_t t, double exposure)
 {
     ps_gl_direct_bake *b = &r->direct_bake;
-    bool shadows = r->opt.shadows;
-    if (b->laid && b->epoch == r->lit_epoch && b->exposure == exposure && b->shadows == shadows)
-        return true;
-    /* Laid once the shadow maps are fresh: the lights as they will stay. */
-    if (!may_lay || (shadows && !r->shadows_valid))
+    const ps_bake_target *q = &b->targets[t];
+    double view[16], proj[16];
+    ps_vec3 eye;
+    lay_matrices(q, view, proj, &eye, &b->flip[t]);
+    double nearest, farthest;
+    ps_gl_box_range(r->in.bounds, eye, &nearest, &farthest);
+    r->eye_extent = ps_v3_len(eye) + farthest;
+    glBindFramebuffer(GL_FRAMEBUFFER, b->fbo[t]);
+    glViewport(0, 0, q->width, q->height);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(proj);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(view);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    /* The fine mesh, whatever the last frame lit (a moving one's is coarser). */
+    const ps_preview_mesh *lit = r->lit;
+    r->lit = r->in.mesh;
+    r->only_object = q->object;
+    ps_gl_draw_direct(r, exposure, r->opt.shadows);
+    r->only_object = UINT32_MAX;
+    r->lit = lit;
+    glDisable(GL_BLEND);
+}
+
+/* What the textures are being laid for: what stands now. */
+static void stamp(ps_gl_renderer *r, double exposure)
+{
+    ps_gl_direct_bake *b = &r->direct_bake;
+    b->epoch = r->lit_epoch;
+    b->exposure = exposure;
+    b->shadows = r->opt.shadows;
+}
+
+bool ps_gl_direct_bake_lay(ps_gl_renderer *r, double exposure, double max_seconds)
+{
+    ps_gl_direct_bake *b = &r->direct_bake;
+    if (!r->opt.bake_direct || !(exposure > 0.0) || (current(r, exposure) && (b->laid || b->none)))
         return false;
-    ps_gl_direct_bake_free(r);
-    if (!make_targets(r))
+    /* The lights as they stand, every shadow map fresh (a frame makes them). */
+    if (r->opt.shadows && !r->shadows_valid)
         return false;
-    GLint old_fbo = 0, vp[4];
+    if (!current(r, exposure) || b->count == 0) {
+        /* Begun again for what stands now; where nothing is to be laid, not
+         * tried again until something changes. */
+        ps_gl_direct_bake_free(r);
+        bool made = make_targets(r);
+        stamp(r, exposure);
+        if (!made) {
+            b->none = true;
+            return false;
+        }
+    }
+    double t0 = ps_now_seconds();
+    /* Between two frames: what the last one left is left as it was (an
+     * incremental refresh adds splats under its matrices and state). */
+    GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
-    glGetIntegerv(GL_VIEWPORT, vp);
+    glPushAttrib(GL_ALL_ATTRIB_BITS);
+    glMatrixMode(GL_PROJECTION);
+    glPushMatrix();
+    glMatrixMode(GL_MODELVIEW);
+    glPushMatrix();
     double old_extent = r->eye_extent;
-    bool scissor = glIsEnabled(GL_SCISSOR_TEST);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_STENCIL_TEST);
     glDisable(GL_SCISSOR_TEST);
@@ -138,42 +209,24 @@ bool ps_gl_direct_bake_ready(ps_gl_renderer *r, double exposure, bool may_lay)
     glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
     glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
     glClearColor(0, 0, 0, 0);
-    for (size_t t = 0; t < b->count; t++) {
-        const ps_bake_target *q = &b->targets[t];
-        double view[16], proj[16];
-        ps_vec3 eye;
-        lay_matrices(q, view, proj, &eye, &b->flip[t]);
-        double nearest, farthest;
-        ps_gl_box_range(r->in.bounds, eye, &nearest, &farthest);
-        r->eye_extent = ps_v3_len(eye) + farthest;
-        glBindFramebuffer(GL_FRAMEBUFFER, b->fbo[t]);
-        glViewport(0, 0, q->width, q->height);
-        glClear(GL_COLOR_BUFFER_BIT);
-        glMatrixMode(GL_PROJECTION);
-        glLoadMatrixd(proj);
-        glMatrixMode(GL_MODELVIEW);
-        glLoadMatrixd(view);
-        glEnable(GL_BLEND);
-        glBlendFunc(GL_ONE, GL_ONE);
-        r->only_object = q->object;
-        ps_gl_draw_direct(r, exposure, shadows);
-        r->only_object = UINT32_MAX;
-        glDisable(GL_BLEND);
-    }
-    glDisable(GL_LIGHTING);
+    /* A target at least, then as many as the time allows (each finished:
+     * the time is the lay's, not queued for the next frame). */
+    do {
+        lay_target(r, b->next++, exposure);
+        glFinish();
+    } while (b->next < b->count && ps_now_seconds() - t0 < max_seconds);
     r->eye_extent = old_extent;
-    glEnable(GL_DEPTH_TEST);
-    glDepthMask(GL_TRUE);
-    if (scissor)
-        glEnable(GL_SCISSOR_TEST);
+    glMatrixMode(GL_PROJECTION);
+    glPopMatrix();
+    glMatrixMode(GL_MODELVIEW);
+    glPopMatrix();
+    glPopAttrib();
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
-    glViewport(vp[0], vp[1], vp[2], vp[3]);
+    if (b->next < b->count)
+        return true;
     b->laid = true;
-    b->epoch = r->lit_epoch;
-    b->exposure = exposure;
-    b->shadows = shadows;
     r->stats.direct_bakes++;
-    return true;
+    return false;
 }
 
 void ps_gl_direct_bake_draw(const ps_gl_renderer *r, ps_vec3 eye)

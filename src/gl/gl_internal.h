@@ -19,8 +19,10 @@ typedef struct ps_gl_direct_bake {
     bool *flip;          /* a target's texture rows run against edge2 (its lay kept GL's winding) */
     bool *object_baked;  /* per scene object: the textures are its direct light */
     size_t objects;
-    bool laid;
-    uint64_t epoch;
+    size_t next;         /* targets laid so far */
+    bool laid;           /* all of them */
+    bool none;           /* nothing to lay (no diffuse quad, too many texels, no memory) */
+    uint64_t epoch;      /* what they are laid for */
     double exposure;
     bool shadows;
 } ps_gl_direct_bake;
@@ -74,6 +76,7 @@ struct ps_gl_renderer {
      * its textures; and without the objects drawn from them. */
     uint32_t only_object;
     bool skip_baked;
+    bool direct_bake_off; /* this frame draws the lit passes whatever is laid (cube faces) */
 };
 
 /* Textures (gl_albedo.c). The lit passes and the splats use the materials'
@@ -163,10 +166,9 @@ void ps_gl_bake_lay(ps_gl_bake *g, ps_gl_renderer *r, const ps_bake *plan);
 void ps_gl_bake_draw(const ps_gl_bake *g, const ps_gl_renderer *r, ps_vec3 eye);
 
 void ps_gl_direct_bake_free(ps_gl_renderer *r);
-/* Before a view's direct layer: whether the textures hold this exposure's
- * direct light (laid now where `may_lay` and they do not: the lights, the
- * geometry and the materials as they stand, every shadow map fresh). */
-bool ps_gl_direct_bake_ready(ps_gl_renderer *r, double exposure, bool may_lay);
+/* Whether the textures hold this exposure's direct light for the lights,
+ * geometry and materials as they stand: a view then draws them. */
+bool ps_gl_direct_bake_ready(const ps_gl_renderer *r, double exposure);
 /* The textures on their quads, the side the eye sees, added to the bound
  * framebuffer under the view's matrices against the prepass's depth. */
 void ps_gl_direct_bake_draw(const ps_gl_renderer *r, ps_vec3 eye);

@@ -189,6 +189,17 @@ void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
     new_view(l, r, cam, exposure, direct, r->opt.shadows, false);
 }
 
+void ps_gl_layers_relight(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
+{
+    /* Its pass redraws the shared depth prepass too, the same depths, so the
+     * map layers' splats stay right. */
+    GLint old_fbo = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_DIRECT_TEX]);
+    ps_gl_begin_frame(r, cam, exposure, direct);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
 void ps_gl_layers_clear_map(ps_gl_layers *l, int map)
 {
     GLint old_fbo = 0;
@@ -344,14 +355,7 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
         new_view(l, r, cam, f->direct_exposure, f->direct, r->opt.shadows && !moving, moving);
         shrink_maps(l, f);
     } else if (f->lights_changed) {
-        /* New lights, the same view: only the direct layer again. Its pass
-         * redraws the shared depth prepass too, the same depths, so the map
-         * layers' splats stay right. */
-        GLint old_fbo = 0;
-        glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
-        glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_DIRECT_TEX]);
-        ps_gl_begin_frame(r, cam, f->direct_exposure, f->direct);
-        glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+        ps_gl_layers_relight(l, r, cam, f->direct_exposure, f->direct);
     }
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         const ps_session_layer *m = &f->map[k];

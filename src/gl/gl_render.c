@@ -233,15 +233,12 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
     r->lit = moving && r->in.moving ? r->in.moving : r->in.mesh;
     r->stats.light_passes = 0;
     r->stats.light_vertices = 0;
-    uint64_t epoch = r->lit_epoch;
     if (direct && shadows && !r->shadows_valid)
         ps_gl_make_shadow_maps(r);
-    /* The direct light of diffuse quads from their textures (bake_direct),
-     * laid by a still view with shadows whose lights stand as the last
-     * frame's (not the first after an edit: a light dragged would lay them
-     * each frame), drawn by every view while they hold. */
-    bool baked = direct && r->opt.bake_direct &&
-                 ps_gl_direct_bake_ready(r, exposure, shadows && !moving && epoch == r->lit_epoch);
+    /* The direct light of diffuse quads from their textures (bake_direct,
+     * laid while the program waits: ps_gl_direct_bake_lay), drawn by every
+     * view while they hold, moving ones with their shadows. */
+    bool baked = direct && !r->direct_bake_off && ps_gl_direct_bake_ready(r, exposure);
     r->stats.direct_baked_last = baked;
     r->width = cam->width;
     r->height = cam->height;

@@ -57,9 +57,9 @@ typedef struct ps_gl_options {
                              * triangles a lookup gives no light, all of which
                              * add nothing there, are left out: the same pixels) */
     bool bake_direct;       /* the direct light of diffuse quads from textures laid once
-                             * (preview/bake.h): a still view with shadows lays them, and
-                             * every view (moving ones too) draws them until the lights,
-                             * the geometry or the materials change (default false) */
+                             * (preview/bake.h, ps_gl_direct_bake_lay), which every view,
+                             * moving ones too, draws until the lights, the geometry or
+                             * the materials change (default false) */
 } ps_gl_options;
 
 /* What the renderer draws, prepared GL-free; everything pointed to must
@@ -149,6 +149,9 @@ void ps_gl_layers_destroy(ps_gl_layers *l);
 /* A new view: the direct layer (times exposure) or black, the prepass, and
  * empty map layers. */
 void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct);
+/* The direct layer alone drawn again for the same view (new lights, or the
+ * direct light's textures just laid), the map layers kept. */
+void ps_gl_layers_relight(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct);
 void ps_gl_layers_clear_map(ps_gl_layers *l, int map);
 /* Adds splats to a map's layer, tested against the view's depth and stencil. */
 void ps_gl_layers_add(ps_gl_layers *l, ps_gl_renderer *r, int map, const ps_splat_batch *b, ps_splat_mode mode,
@@ -195,5 +198,21 @@ typedef struct ps_gl_stats {
 } ps_gl_stats;
 void ps_gl_clear_shadow_timing(ps_gl_renderer *r);
 ps_gl_stats ps_gl_get_stats(const ps_gl_renderer *r);
+
+/* With bake_direct: the direct light of diffuse quads laid into their
+ * textures (preview/bake.h), a quad side at a time for about max_seconds
+ * (at least one side; HUGE_VAL: all), for exposure (the frames' direct
+ * exposure) and the lights, geometry and materials as they stand, once a
+ * frame has made every shadow map; anything changed meanwhile starts it
+ * over. Returns whether any is left. The window and snap call it while they
+ * would wait, nothing being traced: the default box's ten sides took 0.11 s,
+ * the gallery's 42 0.63 s, which a still view laying them would have
+ * waited for. */
+bool ps_gl_direct_bake_lay(ps_gl_renderer *r, double exposure, double max_seconds);
+/* Whether they are still to be laid for exposure and what stands now
+ * (false without bake_direct, or with nothing to lay). */
+bool ps_gl_direct_bake_pending(const ps_gl_renderer *r, double exposure);
+/* Seconds a call while the window waits: a side or two of the default box. */
+#define PS_GL_DIRECT_BAKE_STEP_SECONDS 0.01
 
 #endif

@@ -335,7 +335,12 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
      * virtual lights (its faces 5-6x the default box's). The rounds after
      * draw them (the area box's specular relMSE 0.052 without, 0.016 with). */
     bool shadows = r->opt.shadows && !(quick && r->shadow_lights > PS_GL_SPECULAR_QUICK_SHADOW_LIGHTS);
+    /* The lit passes, not the direct light's textures (gl_direct_bake.c):
+     * a face drawn before they are laid and one after would differ by their
+     * sampling, and the faces of one round come over many refreshes. */
+    r->direct_bake_off = true;
     ps_gl_begin_frame_shadows(r, &cam, 1.0, fr->direct, shadows, false);
+    r->direct_bake_off = false;
     ps_status st = PS_OK;
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
         double radius;

@@ -1070,20 +1070,24 @@ bool ps_session_catching_up(ps_session *s)
     return ended;
 }
 
+bool ps_session_tracing(ps_session *s)
+{
+    if (!incremental(s) || s->user_paused || s->counter_stopped)
+        return false;
+    ps_feed_lock(s->feed);
+    bool ended = ps_feed_ended(s->feed);
+    ps_feed_unlock(s->feed);
+    return !ended;
+}
+
 bool ps_session_prepare_still(ps_session *s, size_t max_vertices)
 {
     /* Only for the camera the last (moving) picture drew; an edit's level
      * of detail is followed by its full view at once, with no wait. */
     if (!s->moving || !s->have_cam || !incremental(s) || s->edited || s->illuminance ||
-        !(s->set.layers & PS_LAYER_SPECULAR) || ps_specular_range_count(s->spec) == 0)
+        !(s->set.layers & PS_LAYER_SPECULAR) || ps_specular_range_count(s->spec) == 0 || ps_session_tracing(s))
         return false;
-    bool traced = !(s->user_paused || s->counter_stopped);
-    if (traced) {
-        ps_feed_lock(s->feed);
-        traced = !ps_feed_ended(s->feed);
-        ps_feed_unlock(s->feed);
-    }
-    return !traced && ps_specular_update(s->spec, s->world, s->cam.eye, max_vertices) > 0;
+    return ps_specular_update(s->spec, s->world, s->cam.eye, max_vertices) > 0;
 }
 
 double ps_session_next_refresh(const ps_session *s, double at)

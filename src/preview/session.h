@@ -356,6 +356,12 @@ void ps_session_drawn(ps_session *s, double draw_seconds);
  * move freely. */
 bool ps_session_catching_up(ps_session *s);
 
+/* Whether photons are being traced now (an incremental session's tracer
+ * running: its maps short of their caps, not paused, not stopped by the
+ * error counter). Work done ahead of need waits while they are: it would
+ * take the tracer's cores. */
+bool ps_session_tracing(ps_session *s);
+
 /* While the program would sleep after a moving camera's picture (until
  * ps_session_next_refresh), the work that camera's still view starts with,
  * done ahead: the specular layer's lookups for its eye, at most max_vertices
