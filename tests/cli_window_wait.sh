@@ -106,4 +106,16 @@ expect_success "wait while paused" timeout 60 xvfb-run -a -s "-screen 0 1024x768
     --script "$cli_tmp/paused.txt" --stats "$cli_tmp/paused.json"
 [ "$(stat_of cap_reached "$cli_tmp/paused.json")" = 0 ] && ok || bad "paused: stats say the cap was reached"
 
+# The direct layer hidden: its shadow maps are never made and the direct
+# light's textures never laid (--bake), and the wait does not wait for them
+# (it did: the window hung here).
+printf '0 wait done
+0.1 orbit 10 0
+0.2 wait done
+0.3 quit
+' >"$cli_tmp/nodirect.txt"
+expect_success "wait with the direct layer hidden" timeout 60 xvfb-run -a -s "-screen 0 1024x768x24" "$win" "$scene" \
+    "${common[@]}" --layers caustic --script "$cli_tmp/nodirect.txt" --stats "$cli_tmp/nodirect.json"
+[ "$(stat_of direct_light_bakes "$cli_tmp/nodirect.json")" = 0 ] && ok || bad "direct layer hidden: its light laid"
+
 cli_summary

@@ -1049,10 +1049,12 @@ static ps_status run_action(app *a, const ps_script_action *act, ps_error *err)
  * nothing the window itself has still to redraw. */
 static bool script_wait_over(app *a)
 {
-    /* The direct light's textures laid and shown too, so that what the
-     * picture is then does not depend on when they were. */
+    /* The direct light's textures laid and shown too (where the direct
+     * layer shows: else its shadow maps are never made, and nothing is
+     * laid), so that what the picture is then does not depend on when they
+     * were. */
     return !a->redraw && ps_session_settled(a->session) && ps_gl_specular_done(a->spec, a->session) &&
-           !ps_gl_direct_bake_pending(a->gl, a->frame.direct_exposure);
+           !(a->frame.direct && ps_gl_direct_bake_pending(a->gl, a->frame.direct_exposure));
 }
 
 /* ---- the session ---------------------------------------------------------------------- */
@@ -1122,7 +1124,7 @@ static ps_status session(app *a, ps_error *err)
          * lights hold (gl_render.h); not while photons are traced. */
         unsigned bakes = ps_gl_get_stats(a->gl).direct_bakes;
         bool worked = idle && (ps_session_prepare_still(a->session, PS_SESSION_PREPARE_VERTICES) ||
-                               (a->frames > 0 && !ps_session_tracing(a->session) &&
+                               (a->frames > 0 && a->frame.direct && !ps_session_tracing(a->session) &&
                                 ps_gl_direct_bake_lay(a->gl, a->frame.direct_exposure, PS_GL_DIRECT_BAKE_STEP_SECONDS)));
         if (ps_gl_get_stats(a->gl).direct_bakes != bakes)
             a->relight = a->redraw = true; /* the view's direct layer from them at once */
