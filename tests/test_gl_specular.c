@@ -206,15 +206,23 @@ static void furnace_glass_sphere(void **state)
  * which this bound fails. */
 #define DEFAULT_RELMSE_LIMIT 0.015
 
-static void default_scene_against_reference(void **state)
+/* The default scene's rig with the direct and specular layers. */
+static ps_scene *default_rig(rig *r)
 {
-    (void)state;
     ps_scene *scene;
     ps_error err;
     assert_int_equal(ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err), PS_OK);
+    rig_make(r, scene, DEFAULT_SIZE, DEFAULT_SIZE);
+    ps_session_set_layers(r->session, PS_LAYER_DIRECT | PS_LAYER_SPECULAR);
+    return scene;
+}
+
+static void default_scene_against_reference(void **state)
+{
+    (void)state;
+    ps_error err;
     rig r;
-    rig_make(&r, scene, DEFAULT_SIZE, DEFAULT_SIZE);
-    ps_session_set_layers(r.session, PS_LAYER_DIRECT | PS_LAYER_SPECULAR);
+    ps_scene *scene = default_rig(&r);
     ps_image got = specular_alone(&r, false);
     const ps_world *w = ps_session_world(r.session);
     ps_light_sampler *ls;
@@ -303,12 +311,9 @@ static void default_scene_against_reference(void **state)
 static void lit_triangles_draw_the_same(void **state)
 {
     (void)state;
-    ps_scene *scene;
     ps_error err;
-    assert_int_equal(ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err), PS_OK);
     rig r;
-    rig_make(&r, scene, DEFAULT_SIZE, DEFAULT_SIZE);
-    ps_session_set_layers(r.session, PS_LAYER_DIRECT | PS_LAYER_SPECULAR);
+    default_rig(&r);
     ps_session_frame f;
     assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
     assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 0, &err), PS_OK);

@@ -39,22 +39,26 @@ static bool make_textures(ps_gl_bake *g, const ps_bake *plan)
     glGenTextures((GLsizei)n, g->tex);
     glGenFramebuffers((GLsizei)n, g->fbo);
     bool complete = true;
-    for (size_t t = 0; t < n; t++) {
-        glBindTexture(GL_TEXTURE_2D, g->tex[t]);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, g->targets[t].width, g->targets[t].height, 0, GL_RGBA, GL_FLOAT,
-                     NULL);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-        glBindFramebuffer(GL_FRAMEBUFFER, g->fbo[t]);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, g->tex[t], 0);
-        complete = complete && glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
-        glClearColor(0, 0, 0, 0);
-        glClear(GL_COLOR_BUFFER_BIT);
-    }
-    glBindTexture(GL_TEXTURE_2D, 0);
+    for (size_t t = 0; t < n; t++)
+        complete = ps_gl_float_target(g->tex[t], g->fbo[t], g->targets[t].width, g->targets[t].height) && complete;
     g->complete = complete;
+    return complete;
+}
+
+bool ps_gl_float_target(GLuint tex, GLuint fbo, int width, int height)
+{
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+    bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
     return complete;
 }
 
@@ -81,12 +85,14 @@ void ps_gl_bake_lay(ps_gl_bake *g, ps_gl_renderer *r, const ps_bake *plan)
 {
     if (ps_bake_splats(plan) == 0)
         return;
-    if (g->count == 0 && !make_textures(g, plan))
-        return;
-    if (!g->complete || g->count != ps_bake_target_count(plan))
-        return;
+    /* The caller's framebuffer, before making the textures binds theirs. */
     GLint old_fbo = 0, vp[4];
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    bool made = g->count > 0 || make_textures(g, plan);
+    if (!made || !g->complete || g->count != ps_bake_target_count(plan)) {
+        glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+        return;
+    }
     glGetIntegerv(GL_VIEWPORT, vp);
     /* Every splat lies in its quad's plane: no depth, no clipping but the
      * texture's edges (the quad's), the kernel texture's alpha summed. */

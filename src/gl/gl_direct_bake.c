@@ -60,19 +60,8 @@ static bool make_targets(ps_gl_renderer *r)
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     bool complete = true;
-    for (size_t t = 0; t < b->count && complete; t++) {
-        glBindTexture(GL_TEXTURE_2D, b->tex[t]);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, b->targets[t].width, b->targets[t].height, 0, GL_RGBA, GL_FLOAT,
-                     NULL);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-        glBindFramebuffer(GL_FRAMEBUFFER, b->fbo[t]);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, b->tex[t], 0);
-        complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
-    }
-    glBindTexture(GL_TEXTURE_2D, 0);
+    for (size_t t = 0; t < b->count && complete; t++)
+        complete = ps_gl_float_target(b->tex[t], b->fbo[t], b->targets[t].width, b->targets[t].height);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     if (!complete) {
         ps_gl_direct_bake_free(r);

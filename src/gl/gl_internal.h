@@ -159,6 +159,10 @@ typedef struct ps_gl_bake {
     bool complete; /* every FBO could be made (else nothing is baked or drawn) */
 } ps_gl_bake;
 void ps_gl_bake_reset(ps_gl_bake *g);
+/* tex an RGBA32F texture of width x height, bilinear and clamped to its
+ * edge, cleared, and fbo's colour attachment (left bound): whether GL can
+ * render into it. The baked maps' and the direct light's. */
+bool ps_gl_float_target(GLuint tex, GLuint fbo, int width, int height);
 /* The plan's splats of this refresh added to its textures (made first). */
 void ps_gl_bake_lay(ps_gl_bake *g, ps_gl_renderer *r, const ps_bake *plan);
 /* Each target on the side the eye sees, textured, added to the bound
