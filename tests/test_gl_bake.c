@@ -405,7 +405,7 @@ static void direct_light_targets(void **state)
         assert_int_equal(obj[t[i].object].type, PS_OBJ_QUAD);
         assert_int_equal(t[i].width, (int)ceil(ps_v3_len(t[i].edge1) / texel));
         assert_int_equal(t[i].height, (int)ceil(ps_v3_len(t[i].edge2) / texel));
-        assert_true(t[i].width > 500 && t[i].width < 1000); /* 2 m walls, a 3.2 m diagonal (the light's too) */
+        assert_int_equal(t[i].width, 592); /* 2 m walls over a 3.46 m diagonal */
     }
     /* The floor as written: corner (-1, 0, -1), edge1 (0, 0, 2), edge2 (2, 0, 0). */
     assert_true(ps_v3_equal(t[0].corner, ps_v3(-1, 0, -1)) && ps_v3_equal(t[0].edge1, ps_v3(0, 0, 2)) &&

@@ -91,8 +91,8 @@ size_t ps_bake_splats(const ps_bake *b);
  * whatever the eye, too: src/gl lays it once into a texture a quad side and
  * draws the textures for every view until the lights, the geometry or the
  * materials change. Its texels: the scene's bounding-box diagonal over
- * this many (the default box's walls 592 a side, 9.4 mm, where a pixel of
- * its 512^2 view covers about 11 mm). */
+ * this many (the default box's 2 m walls 592 a side, 3.4 mm, where a pixel
+ * of its 512^2 view covers 4-6 mm). */
 #define PS_BAKE_DIRECT_TEXELS_PER_DIAG 1024.0
 
 /* Both sides of every quad whose material (materials, indexed by the
