@@ -246,6 +246,12 @@ ps_status ps_bake_build(ps_bake *b, const ps_photon *photons, const uint16_t *id
 
 /* ---- the direct light on diffuse quads -------------------------------------------- */
 
+/* Whether object o's direct light is the same from any eye on a plane. */
+static bool diffuse_quad(const ps_object *o, const ps_material *materials)
+{
+    return o->type == PS_OBJ_QUAD && materials[o->material].type == PS_MAT_DIFFUSE;
+}
+
 ps_status ps_bake_direct_targets(const ps_scene *scene, const ps_material *materials, ps_bake_target **out,
                                  size_t *count, ps_error *err)
 {
@@ -254,7 +260,7 @@ ps_status ps_bake_direct_targets(const ps_scene *scene, const ps_material *mater
     size_t nobj, n = 0;
     const ps_object *obj = ps_scene_objects(scene, &nobj);
     for (size_t o = 0; o < nobj; o++)
-        n += obj[o].type == PS_OBJ_QUAD && materials[obj[o].material].type == PS_MAT_DIFFUSE ? 2 : 0;
+        n += diffuse_quad(&obj[o], materials) ? 2 : 0;
     if (n == 0)
         return PS_OK;
     ps_bake_target *t = malloc(n * sizeof *t);
@@ -264,7 +270,7 @@ ps_status ps_bake_direct_targets(const ps_scene *scene, const ps_material *mater
     double texel = diag > 0.0 && isfinite(diag) ? diag / PS_BAKE_DIRECT_TEXELS_PER_DIAG : 1.0;
     size_t k = 0, texels = 0;
     for (size_t o = 0; o < nobj; o++) {
-        if (obj[o].type != PS_OBJ_QUAD || materials[obj[o].material].type != PS_MAT_DIFFUSE)
+        if (!diffuse_quad(&obj[o], materials))
             continue;
         for (int side = 0; side < 2; side++) {
             ps_bake_target *q = &t[k++];
