@@ -604,19 +604,70 @@ static void idle_draws_the_round_in_a_wait(void **state)
     ps_session *s = r.session;
     ps_session_frame f;
     ps_error err;
+    /* The eye paths wait, as both programs' do (the first picture has no
+     * cube face): the waits trace them too. */
+    ps_session_set_specular_wait(s, true);
     assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
     assert_true(f.new_view);
     /* A wait already over, or too short for the guess: none. */
     assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() - 1.0, 0.0, &err), PS_OK);
     assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
+    assert_false(ps_specular_pixel_points(ps_session_specular(s)).ready);
     assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() + 1.0, 10.0, &err), PS_OK);
     assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
     assert_false(ps_gl_specular_all_shown(r.spec, s));
-    /* A long one: the whole first round, the mirror shown, and no more. */
+    /* A long one: the whole first round, the mirror shown, and no more;
+     * the eye paths traced. */
     assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() + 1000.0, 1e-3, &err), PS_OK);
     assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 6);
     assert_true(ps_gl_specular_all_shown(r.spec, s));
+    assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready);
     rig_free(&r);
+}
+
+/* Both programs' sessions leave the specular layer's eye paths owed while
+ * no cube is shown (ps_session_set_specular_wait): the layer is black then
+ * and traces nothing; once a cube is shown it traces them and draws the
+ * same floats as a session that traced them in its refresh. */
+static void eye_paths_wait_for_a_cube(void **state)
+{
+    (void)state;
+    ps_error err;
+    rig r[2];
+    for (int v = 0; v < 2; v++)
+        default_rig(&r[v]);
+    ps_session *s = r[0].session;
+    ps_session_set_specular_wait(s, true);
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
+    assert_true(f.specular);
+    ps_image pic[2];
+    ps_gl_begin_frame(r[0].gl, &r[0].cam, 1.0, false);
+    ps_gl_specular_draw(r[0].spec, r[0].gl, s, 1.0);
+    assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
+    size_t n = 3 * (size_t)r[0].w * (size_t)r[0].h, lit = 0;
+    for (size_t i = 0; i < n; i++)
+        lit += pic[0].rgb[i] != 0.0f;
+    assert_int_equal(lit, 0);
+    ps_image_destroy(&pic[0]);
+    assert_false(ps_specular_pixel_points(ps_session_specular(s)).ready);
+    /* Every face rendered, the cubes shown: traced, and drawn. */
+    assert_int_equal(ps_gl_specular_refresh(r[0].spec, r[0].gl, s, &f, 0, &err), PS_OK);
+    ps_gl_begin_frame(r[0].gl, &r[0].cam, 1.0, false);
+    ps_gl_specular_draw(r[0].spec, r[0].gl, s, 1.0);
+    assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
+    assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready);
+    pic[1] = specular_alone(&r[1], false);
+    for (size_t i = 0; i < n; i++)
+        lit += pic[1].rgb[i] > 0.0f;
+    print_message("eye paths owed until a cube is shown: %zu lit channels, the two pictures %s\n", lit,
+                  memcmp(pic[0].rgb, pic[1].rgb, n * sizeof(float)) ? "DIFFER" : "the same");
+    assert_true(lit > 3000);
+    assert_memory_equal(pic[0].rgb, pic[1].rgb, n * sizeof(float));
+    for (int v = 0; v < 2; v++) {
+        ps_image_destroy(&pic[v]);
+        rig_free(&r[v]);
+    }
 }
 
 /* A face foreseen from its fill (ps_gl_specular_face_foreseen): longer as
@@ -649,6 +700,7 @@ int main(void)
         cmocka_unit_test(refined_lights_mid_first_round),
         cmocka_unit_test(unheld_first_round_stops_at_the_deadline),
         cmocka_unit_test(idle_draws_the_round_in_a_wait),
+        cmocka_unit_test(eye_paths_wait_for_a_cube),
         cmocka_unit_test(refined_shadows_keep_the_round),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

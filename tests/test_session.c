@@ -963,6 +963,76 @@ static size_t lookup_vertices(ps_session *s)
     return r->offset + ps_session_mesh(s)->ranges[r->range].count;
 }
 
+/* The specular layer's eye paths of two sessions (lookups and per-pixel
+ * points) are the same bytes. */
+static void assert_same_eye_paths(ps_session *a, ps_session *b)
+{
+    size_t n = lookup_vertices(a);
+    assert_int_equal(n, lookup_vertices(b));
+    for (int k = 0; k < PS_SPECULAR_TERMS; k++) {
+        assert_memory_equal(ps_specular_weights(ps_session_specular(a), k),
+                            ps_specular_weights(ps_session_specular(b), k), 3 * n * sizeof(float));
+        assert_memory_equal(ps_specular_dirs(ps_session_specular(a), k), ps_specular_dirs(ps_session_specular(b), k),
+                            3 * n * sizeof(float));
+    }
+    ps_specular_points pa = ps_specular_pixel_points(ps_session_specular(a));
+    ps_specular_points pb = ps_specular_pixel_points(ps_session_specular(b));
+    assert_true(pa.ready && pb.ready);
+    assert_int_equal(pa.count, pb.count);
+    assert_true(pa.count > 0);
+    assert_memory_equal(pa.xy, pb.xy, 2 * pa.count * sizeof(float));
+    assert_memory_equal(pa.dirs, pb.dirs, 3 * pa.count * sizeof(float));
+    assert_memory_equal(pa.weights, pb.weights, 3 * pa.count * sizeof(float));
+    assert_memory_equal(pa.cube, pb.cube, pa.count * sizeof(int));
+}
+
+static void eye_paths_owed_while_waiting(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    for (int inc = 0; inc < 2; inc++) {
+        /* s[0] waits (a drawing side with no cube face yet); s[1] traces
+         * them in its refresh, as before. */
+        ps_session_settings set = settings(scene, inc != 0);
+        ps_session *s[2];
+        ps_camera_frame cam;
+        ps_session_frame f;
+        for (int v = 0; v < 2; v++) {
+            set.specular_wait = v == 0;
+            s[v] = start_and_refresh(scene, &set, &cam, &f);
+            assert_true(f.specular);
+        }
+        const struct ps_specular *sp = ps_session_specular(s[0]);
+        size_t rays = ps_specular_pixel_rays_left(ps_session_specular(s[0]), &cam);
+        assert_false(ps_specular_pixel_points(sp).ready);
+        assert_true(rays > 0);
+        assert_true(ps_specular_pixel_points(ps_session_specular(s[1])).ready);
+        /* A wait already over traces nothing. */
+        ps_session_trace_specular_until(s[0], ps_now_seconds() - 1.0);
+        assert_int_equal(ps_specular_pixel_rays_left(ps_session_specular(s[0]), &cam), rays);
+        if (inc) {
+            /* Ahead of need, with time to spare: all of them. */
+            ps_session_trace_specular_until(s[0], ps_now_seconds() + 60.0);
+        } else {
+            ps_session_trace_specular(s[0]);
+        }
+        assert_same_eye_paths(s[0], s[1]);
+        /* Nothing owed any more: tracing again changes nothing. */
+        ps_session_trace_specular(s[0]);
+        assert_same_eye_paths(s[0], s[1]);
+        /* No longer waiting: the next refresh traces them itself. */
+        ps_session_set_specular_wait(s[0], false);
+        cam.eye.x += 0.05;
+        for (int v = 0; v < 2; v++)
+            refresh(s[v], &cam, &f);
+        if (!inc)
+            assert_same_eye_paths(s[0], s[1]);
+        for (int v = 0; v < 2; v++)
+            ps_session_destroy(s[v]);
+    }
+    ps_scene_destroy(scene);
+}
+
 static void still_lookups_prepared_while_waiting(void **state)
 {
     (void)state;
@@ -1246,6 +1316,7 @@ int main(void)
         cmocka_unit_test(catching_up_only_when_nothing_is_traced),
         cmocka_unit_test(still_view_due_sooner_after_a_move),
         cmocka_unit_test(still_lookups_prepared_while_waiting),
+        cmocka_unit_test(eye_paths_owed_while_waiting),
         cmocka_unit_test(env_fill_counts_each_face),
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(coarse_shadows_first),

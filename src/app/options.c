@@ -190,6 +190,10 @@ ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_pre
     set.exposure = c->exposure;
     set.tau = o->tau;
     set.shadow_size = o->shadows ? PS_SHADOW_SIZE_DEFAULT : 0;
+    /* Both programs draw the specular layer with src/gl's, which keeps it
+     * from there: their first pictures, which no cube face is rendered for
+     * yet, trace no eye paths for it. */
+    set.specular_wait = true;
     return set;
 }
 

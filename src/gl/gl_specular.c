@@ -46,6 +46,10 @@ struct ps_gl_specular {
     bool frozen;       /* filled by a test: never rendered over */
     bool cubes_changed;  /* a cube completed (or all faces drawn): the layer to redraw */
     unsigned faces_rendered;
+    /* A front map holds a picture (a cube shown, or filled by a test): until
+     * then every cube is black and the layer adds nothing, so its eye paths
+     * wait (ps_session_set_specular_wait). New cubes are black again. */
+    bool lit;
     /* The time budget: seconds a face took (the last one, finished), and
      * the share of tau saved up for the next. */
     double face_seconds, credit;
@@ -236,6 +240,7 @@ static void ensure_cubes(ps_gl_specular *g, int n)
     g->fill_known = false;
     g->since_change = g->since_settled = 0;
     g->shown = 0; /* black cubes: a first round */
+    g->lit = g->frozen;
     memset(g->back_faces, 0, sizeof g->back_faces);
     if (n == 0)
         return;
@@ -265,6 +270,7 @@ static void show_back(ps_gl_specular *g, ps_session *s, int c)
     g->back[c] = t;
     g->back_faces[c] = 0;
     g->shown |= 1u << c;
+    g->lit = true;
     ps_session_set_specular_centre(s, c, g->back_centre[c]);
     g->cubes_changed = true;
 }
@@ -294,7 +300,7 @@ void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value)
                 ps_gl_glossy_read_face(g->glossy, c, f, g->cube[c], g->size);
         ps_gl_glossy_blur(g->glossy, 0);
     }
-    g->frozen = true;
+    g->frozen = g->lit = true;
     g->cubes_changed = true;
 }
 
@@ -423,6 +429,11 @@ ps_status ps_gl_specular_idle(ps_gl_specular *g, ps_gl_renderer *r, ps_session *
     ps_status st = ps_gl_specular_refresh(g, r, s, &idle, 6 * PS_SPECULAR_MAX_CUBES, err);
     g->idle = false;
     g->deadline = keep;
+    /* The eye paths the session left owed, here rather than in the picture
+     * that first shows a cube (the default box's 0.045 s, which made it
+     * late for its checkpoint). */
+    if (st == PS_OK && f->specular)
+        ps_session_trace_specular_until(s, deadline);
     return st;
 }
 
@@ -821,9 +832,21 @@ static void draw_full(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, doubl
     }
 }
 
+/* Whether a cube shows a picture to look up: until one does, the layer is
+ * black and the session leaves its eye paths owed (ps_session_set_specular_wait);
+ * once one does, what it left owed is traced before the layer is drawn. */
+static bool eye_paths_for_cubes(ps_gl_specular *g, ps_session *s)
+{
+    if (g->lit)
+        ps_session_trace_specular(s);
+    ps_session_set_specular_wait(s, !g->lit);
+    return g->lit;
+}
+
 void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure)
 {
-    draw_full(g, r, s, exposure);
+    if (eye_paths_for_cubes(g, s)) /* black cubes add nothing */
+        draw_full(g, r, s, exposure);
 }
 
 ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_renderer *r, ps_session *s,
@@ -857,6 +880,7 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
             return ps_error_set(err, PS_ERR_IO, "the GL implementation cannot render the specular layer (RGBA32F %dx%d)",
                                 g->layer_w, g->layer_h);
     }
+    bool faces = !f->specular || eye_paths_for_cubes(g, s);
     bool changed = ps_specular_take_changed(ps_session_specular(s));
     if (f->specular && (changed || g->cubes_changed || f->new_view || f->lights_changed || !g->layer_valid)) {
         GLint old_fbo = 0;
@@ -868,7 +892,7 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
         glClear(GL_COLOR_BUFFER_BIT); /* colour only: the depth is the view's prepass */
         /* A moving camera's level of detail: the heaviest lookup only (one
          * pass instead of PS_SPECULAR_TERMS); all again once it stops. */
-        if (g->faces_rendered == 0 && !g->frozen) {
+        if (!faces) {
             /* black cubes draw black: the first picture saves them */
         } else if (f->moving) {
             draw_terms(g, r, s, f->direct_exposure, 1, false);

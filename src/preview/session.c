@@ -56,6 +56,11 @@ struct ps_session {
     bool catch_up;         /* still after a move, the view not yet drawn in full */
     int still_refreshes;   /* ... and the refreshes drawn since the camera stopped */
     ps_camera_frame cam;
+    /* ps_session_set_specular_wait: while it holds, a refresh leaves the
+     * specular layer's eye paths owed, for the view and moving state kept
+     * here, until ps_session_trace_specular. */
+    bool specular_wait, specular_owed, owed_moving;
+    ps_camera_frame owed_view;
     bool edited, geometry_edited;
     uint64_t edits;
     /* Tracing: the feed is held while any of these holds. */
@@ -337,6 +342,7 @@ ps_status ps_session_create(ps_scene *scene, const ps_session_settings *set, ps_
         return ps_error_set(err, PS_ERR_NOMEM, "%s: out of memory for the preview", ps_scene_path(scene));
     s->scene = scene;
     s->set = *set;
+    s->specular_wait = set->specular_wait;
     s->budget = PS_SESSION_BUDGET_START;
     s->budget_share = 1.0;
     for (int k = 0; k < PS_MAP_COUNT; k++)
@@ -714,6 +720,49 @@ bool ps_session_baked(const ps_session *s, ps_map_kind k, size_t *texels)
     return done;
 }
 
+/* The specular layer's eye paths for a refresh's view `cam` (the still
+ * camera `still`'s, or its level of detail while `moving`): its lookups, in
+ * incremental sessions (the window) at most PS_SESSION_SPECULAR_VERTICES a
+ * refresh, the rest in the next ones (the default scene's two spheres: 10^4,
+ * 12 ms); per-pixel paths once the camera holds still (specular.h), a
+ * budget a refresh, or whole when few are left (PS_SESSION_PIXEL_RAYS_WHOLE). */
+static void trace_eye_paths(ps_session *s, const ps_camera_frame *cam, const ps_camera_frame *still, bool moving)
+{
+    bool inc = incremental(s);
+    ps_specular_update(s->spec, s->world, cam->eye,
+                       !inc ? 0 : moving ? PS_SESSION_SPECULAR_VERTICES_MOVING : PS_SESSION_SPECULAR_VERTICES);
+    if (!moving) {
+        bool at_once = !inc || ps_specular_pixel_rays_left(s->spec, still) <= s->set.pixel_rays_whole;
+        ps_specular_update_pixels(s->spec, s->world, still, at_once ? 0 : PS_SPECULAR_PIXEL_RAYS,
+                                  at_once ? 0.0 : PS_SPECULAR_PIXEL_TIME_SHARE * s->set.tau);
+    }
+}
+
+void ps_session_set_specular_wait(ps_session *s, bool wait) { s->specular_wait = wait; }
+
+void ps_session_trace_specular(ps_session *s)
+{
+    if (!s->specular_owed)
+        return;
+    s->specular_owed = false;
+    trace_eye_paths(s, &s->owed_view, &s->cam, s->owed_moving);
+}
+
+void ps_session_trace_specular_until(ps_session *s, double deadline)
+{
+    /* Lookups a slice at a time, then the per-pixel paths to the deadline:
+     * both go on from where they stopped (specular.h). Whatever is left
+     * stays owed, as the refresh would have traced it. */
+    while (s->specular_owed && ps_now_seconds() < deadline) {
+        if (ps_specular_update(s->spec, s->world, s->owed_view.eye, PS_SESSION_PREPARE_VERTICES) > 0)
+            continue;
+        if (s->owed_moving || ps_specular_update_pixels(s->spec, s->world, &s->cam, 0,
+                                                        fmax(deadline - ps_now_seconds(), 1e-6)) == 0)
+            s->specular_owed = false;
+        break;
+    }
+}
+
 ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_session_frame *out, ps_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -913,19 +962,17 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     if (st != PS_OK)
         return st;
     out->direct = (s->set.layers & PS_LAYER_DIRECT) != 0;
-    /* The specular layer: its lookups for this eye, in incremental sessions
-     * (the window) at most PS_SESSION_SPECULAR_VERTICES a refresh, the rest
-     * in the next ones (the default scene's two spheres: 10^4, 12 ms). */
+    /* The specular layer: its eye paths for this view, or owed while the
+     * drawing side has nothing for them to look up (ps_session_set_specular_wait). */
     out->specular = (s->set.layers & PS_LAYER_SPECULAR) && !s->illuminance && ps_specular_range_count(s->spec) > 0;
-    if (out->specular)
-        ps_specular_update(s->spec, s->world, cam->eye,
-                           !inc ? 0 : s->moving ? PS_SESSION_SPECULAR_VERTICES_MOVING : PS_SESSION_SPECULAR_VERTICES);
-    /* Per-pixel paths once the camera holds still (specular.h): a budget a
-     * refresh, or whole when few are left (PS_SESSION_PIXEL_RAYS_WHOLE). */
-    if (out->specular && !out->moving) {
-        bool at_once = !inc || ps_specular_pixel_rays_left(s->spec, still) <= s->set.pixel_rays_whole;
-        ps_specular_update_pixels(s->spec, s->world, still, at_once ? 0 : PS_SPECULAR_PIXEL_RAYS,
-                                  at_once ? 0.0 : PS_SPECULAR_PIXEL_TIME_SHARE * s->set.tau);
+    s->specular_owed = false;
+    if (out->specular) {
+        s->owed_view = *cam;
+        s->owed_moving = out->moving;
+        if (s->specular_wait)
+            s->specular_owed = true;
+        else
+            trace_eye_paths(s, &s->owed_view, still, s->owed_moving);
     }
     out->direct_exposure = inc ? 1.0 : exposure(s);
     out->direct_gain = inc ? exposure(s) : 1.0;

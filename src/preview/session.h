@@ -195,6 +195,10 @@ typedef struct ps_session_settings {
                                     * textures on them (bake.h), a budget a refresh once the
                                     * view shows all of it, and each later view draws the
                                     * textures instead of its splats (the window; default off) */
+    bool specular_wait;            /* the first refreshes leave the specular layer's eye paths
+                                    * owed (ps_session_set_specular_wait): a drawing side that
+                                    * keeps that setting (src/gl's specular layer) has no cube
+                                    * face yet; default off */
 } ps_session_settings;
 
 /* A progressive start's first shadow maps: this many times fewer texels a
@@ -361,6 +365,19 @@ bool ps_session_catching_up(ps_session *s);
  * error counter). Work done ahead of need waits while they are: it would
  * take the tracer's cores. */
 bool ps_session_tracing(ps_session *s);
+
+/* While `wait` holds (a drawing side whose specular layer has no cube face
+ * yet, and so draws black), a refresh leaves the layer's eye paths (its
+ * lookups and per-pixel paths, specular.h) owed; ps_session_trace_specular
+ * traces what the last refresh left owed, once the layer is drawn. They
+ * depend on the eye alone, so the layer is the same picture; the first
+ * pictures, which no cube face is rendered for yet, come sooner (the default
+ * box's first at 256^2: 0.045 s of its 0.11 s). From settings.specular_wait. */
+void ps_session_set_specular_wait(ps_session *s, bool wait);
+void ps_session_trace_specular(ps_session *s);
+/* The same ahead of need, in a wait that ends at `deadline` (on
+ * ps_now_seconds' clock): as much of them as fits, the rest still owed. */
+void ps_session_trace_specular_until(ps_session *s, double deadline);
 
 /* While the program would sleep after a moving camera's picture (until
  * ps_session_next_refresh), the work that camera's still view starts with,
