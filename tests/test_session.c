@@ -963,6 +963,39 @@ static size_t lookup_vertices(ps_session *s)
     return r->offset + ps_session_mesh(s)->ranges[r->range].count;
 }
 
+/* The first round on threads of its own (settings.first_round_threads,
+ * every core in both programs, where the tracing after it leaves one to the
+ * drawing): the same photons, and the tracer's threads after it as set. */
+static void first_round_on_its_own_threads(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    set.threads = 1;
+    ps_session *s[2];
+    ps_error err;
+    for (int v = 0; v < 2; v++) {
+        set.first_round_threads = v == 0 ? 1 : 2;
+        s[v] = open_session(scene, &set);
+        /* Held until a refresh is drawn: the maps are the first round. */
+        assert_int_equal(ps_session_start(s[v], true, &err), PS_OK);
+        assert_int_equal(ps_tracer_threads(ps_session_tracer(s[v])), 1);
+    }
+    const ps_photon_map *m[2];
+    for (int v = 0; v < 2; v++)
+        m[v] = ps_session_lock_maps(s[v]);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        assert_true(m[0][k].count > 0);
+        assert_int_equal(m[0][k].count, m[1][k].count);
+        assert_memory_equal(m[0][k].photons, m[1][k].photons, m[0][k].count * sizeof(ps_photon));
+    }
+    for (int v = 0; v < 2; v++) {
+        ps_session_unlock_maps(s[v]);
+        ps_session_destroy(s[v]);
+    }
+    ps_scene_destroy(scene);
+}
+
 /* The specular layer's eye paths of two sessions (lookups and per-pixel
  * points) are the same bytes. */
 static void assert_same_eye_paths(ps_session *a, ps_session *b)
@@ -1317,6 +1350,7 @@ int main(void)
         cmocka_unit_test(still_view_due_sooner_after_a_move),
         cmocka_unit_test(still_lookups_prepared_while_waiting),
         cmocka_unit_test(eye_paths_owed_while_waiting),
+        cmocka_unit_test(first_round_on_its_own_threads),
         cmocka_unit_test(env_fill_counts_each_face),
         cmocka_unit_test(area_lights_refine),
         cmocka_unit_test(coarse_shadows_first),

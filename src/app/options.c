@@ -174,6 +174,7 @@ ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_pre
     }
     set.seed = (uint64_t)c->seed;
     set.threads = (int)c->threads;
+    set.first_round_threads = (int)c->threads; /* the programs may leave a core to drawing after it */
     set.max_map_photons = ps_photon_cap(PS_PREVIEW_MAPS, PS_PREVIEW_PHOTON_BYTES);
     set.layers = o->layers;
     set.splat = o->splat;

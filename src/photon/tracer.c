@@ -288,8 +288,7 @@ ps_status ps_tracer_create(const ps_world *w, const ps_tracer_options *opt, ps_t
     t->materials = ps_scene_materials(s, &nm);
     t->opt = opt ? *opt : ps_tracer_default_options();
     t->quant = ps_path_quant_make(t->opt.record_box, ps_world_epsilon(w));
-    t->threads = t->opt.threads > 0 ? (t->opt.threads < PS_TRACER_MAX_THREADS ? t->opt.threads : PS_TRACER_MAX_THREADS)
-                                    : ps_online_cores();
+    ps_tracer_set_threads(t, t->opt.threads);
     ps_status st = ps_light_sampler_create(s, &t->lights, err);
     if (st == PS_OK)
         st = plan_maps(t, err);
@@ -354,6 +353,11 @@ const ps_skip *ps_tracer_skips(const ps_tracer *t, size_t *count)
 }
 
 int ps_tracer_threads(const ps_tracer *t) { return t->threads; }
+
+void ps_tracer_set_threads(ps_tracer *t, int threads)
+{
+    t->threads = threads > 0 ? (threads < PS_TRACER_MAX_THREADS ? threads : PS_TRACER_MAX_THREADS) : ps_online_cores();
+}
 
 ps_status ps_tracer_note_skip(ps_tracer *t, const char *pass, const char *reason)
 {

@@ -99,6 +99,9 @@ const ps_skip *ps_tracer_skips(const ps_tracer *t, size_t *count);
 ps_status ps_tracer_note_skip(ps_tracer *t, const char *pass, const char *reason);
 /* Threads that ps_tracer_trace uses. */
 int ps_tracer_threads(const ps_tracer *t);
+/* Sets them (0: one per online core), between calls only: the photons are
+ * the same for any count, only sooner or later. */
+void ps_tracer_set_threads(ps_tracer *t, int threads);
 
 /* Traces photons [first, first + count) of map `kind` and appends those stored
  * to m in index order. `total` is the number of photons the whole map will

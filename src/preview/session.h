@@ -142,6 +142,8 @@ typedef struct ps_session_settings {
     double radius[PS_MAP_COUNT];   /* r0, scene units (> 0) */
     uint64_t seed;
     int threads;                   /* tracing threads; 0: every core */
+    int first_round_threads;       /* ... of the first round (ps_session_start), which nothing
+                                    * is drawn beside; 0: every core (the default) */
     const ps_cancel_flag *cancel;  /* NULL, or a flag that stops tracing */
     size_t max_stored;             /* the feed's store limit for both maps (0: none) */
     uint64_t max_map_photons;      /* the most photons one map may hold (the memory budget's
