@@ -670,6 +670,50 @@ static void eye_paths_wait_for_a_cube(void **state)
     }
 }
 
+/* The layered path (both programs' float pictures): while every cube is
+ * black the layer is neither drawn nor added, and its eye paths wait; once
+ * a cube is shown it is, the same floats as the direct drawing's. */
+static void layer_waits_for_a_cube(void **state)
+{
+    (void)state;
+    ps_error err;
+    rig r;
+    default_rig(&r);
+    ps_session *s = r.session;
+    ps_session_set_specular_wait(s, true);
+    ps_gl_layers *l;
+    assert_int_equal(ps_gl_layers_create(r.w, r.h, true, &l, &err), PS_OK);
+    const double none[PS_MAP_COUNT] = {0.0, 0.0};
+    size_t n = 3 * (size_t)r.w * (size_t)r.h, lit = 0;
+    ps_image pic[2];
+    for (int v = 0; v < 2; v++) {
+        ps_session_frame f;
+        assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+        assert_true(f.specular);
+        if (v == 1) /* every face, the cubes shown */
+            assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 0, &err), PS_OK);
+        ps_gl_layers_view(l, r.gl, &r.cam, 1.0, false);
+        assert_int_equal(ps_gl_specular_layer(r.spec, l, r.gl, s, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_layers_composite(l, 0.0, none, &pic[v], &err), PS_OK);
+        assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready == (v == 1));
+        lit = 0;
+        for (size_t i = 0; i < n; i++)
+            lit += pic[v].rgb[i] != 0.0f;
+        assert_true(v == 0 ? lit == 0 : lit > 3000);
+        ps_image_destroy(&pic[v]);
+    }
+    /* The same floats as drawn directly. */
+    assert_int_equal(ps_gl_layers_composite(l, 0.0, none, &pic[0], &err), PS_OK);
+    ps_gl_begin_frame(r.gl, &r.cam, 1.0, false);
+    ps_gl_specular_draw(r.spec, r.gl, s, 1.0);
+    assert_int_equal(ps_gl_read(r.gl, &pic[1], &err), PS_OK);
+    assert_memory_equal(pic[0].rgb, pic[1].rgb, n * sizeof(float));
+    for (int v = 0; v < 2; v++)
+        ps_image_destroy(&pic[v]);
+    ps_gl_layers_destroy(l);
+    rig_free(&r);
+}
+
 /* A face foreseen from its fill (ps_gl_specular_face_foreseen): longer as
  * (fill now / fill then)^PS_GL_SPECULAR_FILL_GROWTH, never shorter, and as
  * it took when its fill is not known. */
@@ -701,6 +745,7 @@ int main(void)
         cmocka_unit_test(unheld_first_round_stops_at_the_deadline),
         cmocka_unit_test(idle_draws_the_round_in_a_wait),
         cmocka_unit_test(eye_paths_wait_for_a_cube),
+        cmocka_unit_test(layer_waits_for_a_cube),
         cmocka_unit_test(refined_shadows_keep_the_round),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -854,6 +854,13 @@ void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, do
 ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_renderer *r, ps_session *s,
                                const ps_session_frame *f, ps_error *err)
 {
+    /* Black cubes add nothing: no layer is drawn (nor made, the first
+     * pictures' time) until a cube is shown. */
+    if (f->specular && !eye_paths_for_cubes(g, s)) {
+        g->layer_valid = false;
+        ps_gl_specular_set_gain(g, l, 0.0);
+        return PS_OK;
+    }
     /* As big as the other layers, drawn at the refresh's view in its corner
      * (a moving camera's level of detail is smaller: gl_layers.c). */
     GLuint depth = ps_gl_layers_depth_stencil(l);
@@ -882,7 +889,6 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
             return ps_error_set(err, PS_ERR_IO, "the GL implementation cannot render the specular layer (RGBA32F %dx%d)",
                                 g->layer_w, g->layer_h);
     }
-    bool faces = !f->specular || eye_paths_for_cubes(g, s);
     bool changed = ps_specular_take_changed(ps_session_specular(s));
     if (f->specular && (changed || g->cubes_changed || f->new_view || f->lights_changed || !g->layer_valid)) {
         GLint old_fbo = 0;
@@ -894,9 +900,7 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
         glClear(GL_COLOR_BUFFER_BIT); /* colour only: the depth is the view's prepass */
         /* A moving camera's level of detail: the heaviest lookup only (one
          * pass instead of PS_SPECULAR_TERMS); all again once it stops. */
-        if (!faces) {
-            /* black cubes draw black: the first picture saves them */
-        } else if (f->moving) {
+        if (f->moving) {
             draw_terms(g, r, s, f->direct_exposure, 1, false);
         } else {
             draw_full(g, r, s, f->direct_exposure);
@@ -911,5 +915,7 @@ ps_status ps_gl_specular_layer(ps_gl_specular *g, ps_gl_layers *l, ps_gl_rendere
 
 void ps_gl_specular_set_gain(ps_gl_specular *g, ps_gl_layers *l, double gain)
 {
-    ps_gl_layers_set_extra(l, g->layer_tex, gain);
+    /* Not while every cube is black: the layer holds nothing of them (or an
+     * older cube set's picture). */
+    ps_gl_layers_set_extra(l, g->layer_tex, g->lit ? gain : 0.0);
 }
