@@ -303,6 +303,27 @@ static void default_scene_against_reference(void **state)
     rig_free(&r);
 }
 
+/* Two pictures of the default scene's spheres the same floats, the
+ * second lighting more than 3000 channels. */
+static size_t lit_channels(const ps_image *img)
+{
+    size_t n = 3 * (size_t)img->width * (size_t)img->height, lit = 0;
+    for (size_t i = 0; i < n; i++)
+        lit += img->rgb[i] != 0.0f;
+    return lit;
+}
+
+static void assert_same_lit_pictures(const char *what, const ps_image pic[2])
+{
+    size_t n = 3 * (size_t)pic[0].width * (size_t)pic[0].height, lit = lit_channels(&pic[1]);
+    assert_int_equal(pic[0].width, pic[1].width);
+    assert_int_equal(pic[0].height, pic[1].height);
+    print_message("%s: %zu lit channels, the two pictures %s\n", what, lit,
+                  memcmp(pic[0].rgb, pic[1].rgb, n * sizeof(float)) ? "DIFFER" : "the same");
+    assert_true(lit > 3000);
+    assert_memory_equal(pic[0].rgb, pic[1].rgb, n * sizeof(float));
+}
+
 /* The per-vertex lookups' passes (the window's until the per-pixel paths
  * are whole) draw only the triangles each term lights
  * (ps_specular_weighted_triangles): the same pixels, float for float, as
@@ -330,13 +351,7 @@ static void lit_triangles_draw_the_same(void **state)
         ps_gl_specular_draw(r.spec, by[v], r.session, 1.0);
         assert_int_equal(ps_gl_read(by[v], &pic[v], &err), PS_OK);
     }
-    size_t n = 3 * (size_t)r.w * (size_t)r.h, lit = 0;
-    for (size_t i = 0; i < n; i++)
-        lit += pic[1].rgb[i] > 0.0f;
-    print_message("lookup terms: %zu lit channels, the two pictures %s\n", lit,
-                  memcmp(pic[0].rgb, pic[1].rgb, n * sizeof(float)) ? "DIFFER" : "the same");
-    assert_true(lit > 3000);
-    assert_memory_equal(pic[0].rgb, pic[1].rgb, n * sizeof(float));
+    assert_same_lit_pictures("lookup terms", pic);
     ps_image_destroy(&pic[0]);
     ps_image_destroy(&pic[1]);
     ps_gl_renderer_destroy(whole);
@@ -645,10 +660,7 @@ static void eye_paths_wait_for_a_cube(void **state)
     ps_gl_begin_frame(r[0].gl, &r[0].cam, 1.0, false);
     ps_gl_specular_draw(r[0].spec, r[0].gl, s, 1.0);
     assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
-    size_t n = 3 * (size_t)r[0].w * (size_t)r[0].h, lit = 0;
-    for (size_t i = 0; i < n; i++)
-        lit += pic[0].rgb[i] != 0.0f;
-    assert_int_equal(lit, 0);
+    assert_int_equal(lit_channels(&pic[0]), 0);
     ps_image_destroy(&pic[0]);
     assert_false(ps_specular_pixel_points(ps_session_specular(s)).ready);
     /* Every face rendered, the cubes shown: traced, and drawn. */
@@ -658,12 +670,7 @@ static void eye_paths_wait_for_a_cube(void **state)
     assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
     assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready);
     pic[1] = specular_alone(&r[1], false);
-    for (size_t i = 0; i < n; i++)
-        lit += pic[1].rgb[i] > 0.0f;
-    print_message("eye paths owed until a cube is shown: %zu lit channels, the two pictures %s\n", lit,
-                  memcmp(pic[0].rgb, pic[1].rgb, n * sizeof(float)) ? "DIFFER" : "the same");
-    assert_true(lit > 3000);
-    assert_memory_equal(pic[0].rgb, pic[1].rgb, n * sizeof(float));
+    assert_same_lit_pictures("eye paths owed until a cube is shown", pic);
     for (int v = 0; v < 2; v++) {
         ps_image_destroy(&pic[v]);
         rig_free(&r[v]);
@@ -684,7 +691,6 @@ static void layer_waits_for_a_cube(void **state)
     ps_gl_layers *l;
     assert_int_equal(ps_gl_layers_create(r.w, r.h, true, &l, &err), PS_OK);
     const double none[PS_MAP_COUNT] = {0.0, 0.0};
-    size_t n = 3 * (size_t)r.w * (size_t)r.h, lit = 0;
     ps_image pic[2];
     for (int v = 0; v < 2; v++) {
         ps_session_frame f;
@@ -696,20 +702,19 @@ static void layer_waits_for_a_cube(void **state)
         assert_int_equal(ps_gl_specular_layer(r.spec, l, r.gl, s, &f, &err), PS_OK);
         assert_int_equal(ps_gl_layers_composite(l, 0.0, none, &pic[v], &err), PS_OK);
         assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready == (v == 1));
-        lit = 0;
-        for (size_t i = 0; i < n; i++)
-            lit += pic[v].rgb[i] != 0.0f;
-        assert_true(v == 0 ? lit == 0 : lit > 3000);
-        ps_image_destroy(&pic[v]);
+        if (v == 0) {
+            assert_int_equal(lit_channels(&pic[v]), 0);
+            ps_image_destroy(&pic[v]);
+        }
     }
     /* The same floats as drawn directly. */
-    assert_int_equal(ps_gl_layers_composite(l, 0.0, none, &pic[0], &err), PS_OK);
+    ps_image drawn[2] = {pic[1]};
     ps_gl_begin_frame(r.gl, &r.cam, 1.0, false);
     ps_gl_specular_draw(r.spec, r.gl, s, 1.0);
-    assert_int_equal(ps_gl_read(r.gl, &pic[1], &err), PS_OK);
-    assert_memory_equal(pic[0].rgb, pic[1].rgb, n * sizeof(float));
+    assert_int_equal(ps_gl_read(r.gl, &drawn[1], &err), PS_OK);
+    assert_same_lit_pictures("the layered path once a cube is shown", drawn);
     for (int v = 0; v < 2; v++)
-        ps_image_destroy(&pic[v]);
+        ps_image_destroy(&drawn[v]);
     ps_gl_layers_destroy(l);
     rig_free(&r);
 }

@@ -15,6 +15,7 @@
 #include "photon/tracer.h"
 #include "preview/feed.h"
 #include "preview/session.h"
+#include "specular_points.h"
 #include "preview/specular.h"
 #include "scene/scene.h"
 
@@ -1008,15 +1009,8 @@ static void assert_same_eye_paths(ps_session *a, ps_session *b)
         assert_memory_equal(ps_specular_dirs(ps_session_specular(a), k), ps_specular_dirs(ps_session_specular(b), k),
                             3 * n * sizeof(float));
     }
-    ps_specular_points pa = ps_specular_pixel_points(ps_session_specular(a));
-    ps_specular_points pb = ps_specular_pixel_points(ps_session_specular(b));
-    assert_true(pa.ready && pb.ready);
-    assert_int_equal(pa.count, pb.count);
-    assert_true(pa.count > 0);
-    assert_memory_equal(pa.xy, pb.xy, 2 * pa.count * sizeof(float));
-    assert_memory_equal(pa.dirs, pb.dirs, 3 * pa.count * sizeof(float));
-    assert_memory_equal(pa.weights, pb.weights, 3 * pa.count * sizeof(float));
-    assert_memory_equal(pa.cube, pb.cube, pa.count * sizeof(int));
+    assert_points_equal(ps_specular_pixel_points(ps_session_specular(a)),
+                        ps_specular_pixel_points(ps_session_specular(b)), 0);
 }
 
 static void eye_paths_owed_while_waiting(void **state)

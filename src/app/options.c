@@ -192,8 +192,8 @@ ps_session_settings ps_preview_settings(const ps_shared_options *c, const ps_pre
     set.tau = o->tau;
     set.shadow_size = o->shadows ? PS_SHADOW_SIZE_DEFAULT : 0;
     /* Both programs draw the specular layer with src/gl's, which keeps it
-     * from there: their first pictures, which no cube face is rendered for
-     * yet, trace no eye paths for it. */
+     * from there: their first pictures, before any cube map is shown (all
+     * black), trace no eye paths for it. */
     set.specular_wait = true;
     return set;
 }

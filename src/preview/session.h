@@ -199,8 +199,8 @@ typedef struct ps_session_settings {
                                     * textures instead of its splats (the window; default off) */
     bool specular_wait;            /* the first refreshes leave the specular layer's eye paths
                                     * owed (ps_session_set_specular_wait): a drawing side that
-                                    * keeps that setting (src/gl's specular layer) has no cube
-                                    * face yet; default off */
+                                    * keeps that setting (src/gl's specular layer) shows no
+                                    * cube map yet; default off */
 } ps_session_settings;
 
 /* A progressive start's first shadow maps: this many times fewer texels a
@@ -368,13 +368,13 @@ bool ps_session_catching_up(ps_session *s);
  * take the tracer's cores. */
 bool ps_session_tracing(ps_session *s);
 
-/* While `wait` holds (a drawing side whose specular layer has no cube face
- * yet, and so draws black), a refresh leaves the layer's eye paths (its
+/* While `wait` holds (a drawing side that shows no cube map yet, every one
+ * black, and so adds nothing), a refresh leaves the layer's eye paths (its
  * lookups and per-pixel paths, specular.h) owed; ps_session_trace_specular
  * traces what the last refresh left owed, once the layer is drawn. They
  * depend on the eye alone, so the layer is the same picture; the first
- * pictures, which no cube face is rendered for yet, come sooner (the default
- * box's first at 256^2: 0.045 s of its 0.11 s). From settings.specular_wait. */
+ * pictures, before any cube map is shown, come sooner (the default box's
+ * first at 256^2: 0.045 s of its 0.11 s). From settings.specular_wait. */
 void ps_session_set_specular_wait(ps_session *s, bool wait);
 void ps_session_trace_specular(ps_session *s);
 /* The same ahead of need, in a wait that ends at `deadline` (on
