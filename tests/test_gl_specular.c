@@ -303,8 +303,7 @@ static void default_scene_against_reference(void **state)
     rig_free(&r);
 }
 
-/* Two pictures of the default scene's spheres the same floats, the
- * second lighting more than 3000 channels. */
+/* The channels of a picture that are not black. */
 static size_t lit_channels(const ps_image *img)
 {
     size_t n = 3 * (size_t)img->width * (size_t)img->height, lit = 0;
@@ -313,6 +312,8 @@ static size_t lit_channels(const ps_image *img)
     return lit;
 }
 
+/* Two pictures of the default scene's spheres the same floats, the
+ * second lighting more than 3000 channels. */
 static void assert_same_lit_pictures(const char *what, const ps_image pic[2])
 {
     size_t n = 3 * (size_t)pic[0].width * (size_t)pic[0].height, lit = lit_channels(&pic[1]);
@@ -619,8 +620,8 @@ static void idle_draws_the_round_in_a_wait(void **state)
     ps_session *s = r.session;
     ps_session_frame f;
     ps_error err;
-    /* The eye paths wait, as both programs' do (the first picture has no
-     * cube face): the waits trace them too. */
+    /* The eye paths wait, as both programs' do (no cube map is shown in
+     * the first picture): the waits trace them too. */
     ps_session_set_specular_wait(s, true);
     assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
     assert_true(f.new_view);
