@@ -608,6 +608,29 @@ static void unheld_first_round_stops_at_the_deadline(void **state)
     rig_free(&r);
 }
 
+/* A held first round (photosplat-snap's checkpoint frames) foresees a face
+ * never timed at the guess given (ps_gl_specular_set_face_guess): one that
+ * would pass the deadline waits; with none given it may start until the
+ * deadline, as before. */
+static void held_round_guesses_an_untimed_face(void **state)
+{
+    (void)state;
+    rig r;
+    one_mirror_refining(&r);
+    ps_session_frame f;
+    ps_gl_specular_hold_first_round(r.spec, true);
+    ps_gl_specular_set_face_guess(r.spec, 10.0);
+    for (int i = 0; i < 3; i++) {
+        ps_gl_specular_set_deadline(r.spec, ps_now_seconds() + 1.0);
+        assert_int_equal(refresh_faces(&r, &f), 0);
+    }
+    assert_false(f.new_view);
+    ps_gl_specular_set_face_guess(r.spec, 0.0);
+    ps_gl_specular_set_deadline(r.spec, ps_now_seconds() + 1.0);
+    assert_true(refresh_faces(&r, &f) > 0);
+    rig_free(&r);
+}
+
 /* ps_gl_specular_idle: a program's wait given to the cube faces
  * (photosplat-snap's, both colour depths): each face only while it is
  * foreseen to end by the wait's end, a face never timed at the guess given;
@@ -626,15 +649,17 @@ static void idle_draws_the_round_in_a_wait(void **state)
     assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
     assert_true(f.new_view);
     /* A wait already over, or too short for the guess: none. */
-    assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() - 1.0, 0.0, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() - 1.0, &err), PS_OK);
     assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
     assert_false(ps_specular_pixel_points(ps_session_specular(s)).ready);
-    assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() + 1.0, 10.0, &err), PS_OK);
+    ps_gl_specular_set_face_guess(r.spec, 10.0);
+    assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() + 1.0, &err), PS_OK);
     assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
     assert_false(ps_gl_specular_all_shown(r.spec, s));
     /* A long one: the whole first round, the mirror shown, and no more;
      * the eye paths traced. */
-    assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() + 1000.0, 1e-3, &err), PS_OK);
+    ps_gl_specular_set_face_guess(r.spec, 1e-3);
+    assert_int_equal(ps_gl_specular_idle(r.spec, r.gl, s, &f, ps_now_seconds() + 1000.0, &err), PS_OK);
     assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 6);
     assert_true(ps_gl_specular_all_shown(r.spec, s));
     assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready);
@@ -751,6 +776,7 @@ int main(void)
         cmocka_unit_test(unheld_first_round_stops_at_the_deadline),
         cmocka_unit_test(idle_draws_the_round_in_a_wait),
         cmocka_unit_test(eye_paths_wait_for_a_cube),
+        cmocka_unit_test(held_round_guesses_an_untimed_face),
         cmocka_unit_test(layer_waits_for_a_cube),
         cmocka_unit_test(refined_shadows_keep_the_round),
     };

@@ -61,6 +61,14 @@
  * 0.68 s). What it leaves, the next refreshes draw. */
 #define PS_PACE_SHOWN_BUDGET 0.25
 
+/* A cube face never timed, where a deadline foresees it (a wait, a held
+ * first round: ps_gl_specular_set_face_guess), as this share of the last
+ * refresh's time without faces. (The bench's first faces took 0.1-0.4x the
+ * first frame at 256^2; let start at once, the first rode in the 0.1 s
+ * checkpoint's frame and made it late. Taken as the whole frame, as long
+ * waits came only after 0.2 s, and the mirrors stayed black there.) */
+#define PS_PACE_FACE_GUESS 0.5
+
 /* Whole refreshes cost more a photon the more they draw (building 4*10^6
  * photons' splats, their diffusion in screen order, took 0.59 us a photon
  * against 0.26 at 7.6*10^5): predicted from a smaller one, the photons'

@@ -698,6 +698,7 @@ static ps_pace_plan plan_refresh(snap_run *s, double clock, double due, int cp, 
      * draws them (held only where the plan says, refine). */
     if (s->layers)
         ps_gl_specular_hold_first_round(s->spec, false);
+    ps_gl_specular_set_face_guess(s->spec, PS_PACE_FACE_GUESS * s->pace.seconds);
     s->pace.unheld = ps_gl_specular_unheld_seconds(s->spec, s->session);
     ps_pace_plan plan = ps_pace_next(&s->pace, now, photons, due, s->o->checkpoints + cp, s->o->checkpoint_count - cp);
     /* The first picture at once. Float: the tracer is held until it is
@@ -834,10 +835,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
          * budget's share of tau, as the window's. */
         bool faces_wait = !s->layers || !ps_gl_specular_all_shown(s->spec, s->session);
         if (faces_wait && s->frames > 0 && plan.start > ps_now_seconds() - clock) {
-            /* A face never timed: as long as the last frame (the first,
-             * at 256^2, 0.4 s: one started in a 0.2 s wait made the 1 s
-             * checkpoint 0.35 s late). */
-            st = ps_gl_specular_idle(s->spec, s->gl, s->session, &s->frame, clock + plan.start, s->pace.seconds, err);
+            st = ps_gl_specular_idle(s->spec, s->gl, s->session, &s->frame, clock + plan.start, err);
             if (st != PS_OK)
                 break;
             plan = plan_refresh(s, clock, fmin(next, end) - clock, cp, &rate);

@@ -74,7 +74,7 @@ struct ps_gl_specular {
      * face not timed yet. */
     double deadline;
     bool idle; /* ps_gl_specular_idle: faces while they fit, the first round's too */
-    double idle_guess; /* ... a face never timed taking this long */
+    double face_guess; /* ps_gl_specular_set_face_guess */
     bool first_held; /* ps_gl_specular_hold_first_round */
     /* Cubes shown since the last edit, layer set or cube set (bit c). The
      * first round shows each once, quick and whatever the budget; new
@@ -151,12 +151,12 @@ static double face_foreseen(const ps_gl_specular *g, int i)
     return then > 0.0 && now > 0.0 ? t * pow(now / then, PS_GL_SPECULAR_FILL_GROWTH) : t;
 }
 
-/* The face at the cursor's predicted time (0: nothing timed yet, the first
- * comes; ps_gl_specular_idle's guess for a face never timed there). */
+/* The face at the cursor's predicted time (nothing timed yet: the guess
+ * where a wait or a held first round foresees it, else 0, the first comes). */
 static double face_estimate(ps_gl_specular *g, ps_session *s)
 {
     if (g->face_time[g->cursor] <= 0.0 && g->face_max <= 0.0)
-        return g->idle ? g->idle_guess : 0.0;
+        return g->idle || g->first_held ? g->face_guess : 0.0;
     update_fill(g, s);
     return face_foreseen(g, g->cursor);
 }
@@ -164,6 +164,8 @@ static double face_estimate(ps_gl_specular *g, ps_session *s)
 void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes) { g->first_refreshes = refreshes > 0 ? refreshes : 0; }
 
 void ps_gl_specular_hold_first_round(ps_gl_specular *g, bool held) { g->first_held = held; }
+
+void ps_gl_specular_set_face_guess(ps_gl_specular *g, double seconds) { g->face_guess = seconds > 0.0 ? seconds : 0.0; }
 
 ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err)
 {
@@ -415,7 +417,7 @@ double ps_gl_specular_all_seconds(const ps_gl_specular *g)
 }
 
 ps_status ps_gl_specular_idle(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
-                              double deadline, double guess, ps_error *err)
+                              double deadline, ps_error *err)
 {
     if (deadline <= 0.0)
         return PS_OK;
@@ -425,7 +427,6 @@ ps_status ps_gl_specular_idle(ps_gl_specular *g, ps_gl_renderer *r, ps_session *
     double keep = g->deadline;
     g->deadline = deadline;
     g->idle = true;
-    g->idle_guess = guess;
     ps_status st = ps_gl_specular_refresh(g, r, s, &idle, 6 * PS_SPECULAR_MAX_CUBES, err);
     g->idle = false;
     g->deadline = keep;

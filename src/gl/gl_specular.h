@@ -80,6 +80,12 @@ void ps_gl_specular_set_first_round(ps_gl_specular *g, int refreshes);
  * (ps_gl_specular_set_deadline) in a refresh: for a program that gives them
  * its waits instead (ps_gl_specular_idle). */
 void ps_gl_specular_hold_first_round(ps_gl_specular *g, bool held);
+/* A face never timed yet, where a deadline foresees it (ps_gl_specular_idle's
+ * waits, a held first round's refreshes), taken to last `seconds`; 0, the
+ * default: it may start until the deadline. (Allowed so, the first face of
+ * the 0.1 s checkpoint's frame, 0.01-0.025 s with llvmpipe's first variants
+ * of the face pass, made that frame late where it fitted without.) */
+void ps_gl_specular_set_face_guess(ps_gl_specular *g, double seconds);
 
 /* The next refreshes' cube faces past the first round after a change end
  * by `at` (ps_now_seconds' clock; 0: no limit), as each face's last time
@@ -128,10 +134,10 @@ double ps_gl_specular_all_seconds(const ps_gl_specular *g);
 /* While the program waits anyway (photosplat-snap before the frame a
  * checkpoint shows, app/pace.h), after refresh f: faces, the first round's
  * too, each while it is predicted to end by `deadline` (before any face was
- * timed, a face predicted to take `guess` seconds). Nothing else of the
+ * timed, at the guess: ps_gl_specular_set_face_guess). Nothing else of the
  * frame is drawn. */
 ps_status ps_gl_specular_idle(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, const ps_session_frame *f,
-                              double deadline, double guess, ps_error *err);
+                              double deadline, ps_error *err);
 
 /* Before drawing refresh f of session s: up to `faces` cube faces rendered
  * (0: every face of every cube), when f shows the specular layer. Leaves the
