@@ -1,8 +1,9 @@
 /* test_specular.c: the specular layer's lookups (preview/specular.h), no GL:
  * Fresnel weights at normal incidence, energy kept through a glass sphere,
  * the distance-corrected lookup of a planar mirror in closed form, the
- * lookups of the default scene's mesh, and lookups re-aimed from another
- * centre against fresh ones. */
+ * lookups of the default scene's mesh, lookups re-aimed from another
+ * centre against fresh ones, and the per-pixel paths of the pixels near the
+ * triangles against those of every pixel of their boxes. */
 #include "test.h"
 
 #include <math.h>
@@ -263,6 +264,76 @@ static void reaimed_lookups_equal_fresh_ones(void **state)
     default_rig_free(&d);
 }
 
+/* Only pixels near a range's triangles are traced: the same points, byte
+ * for byte, as tracing every pixel of each range's box (the ring's box holds
+ * 4x the pixels its triangles cover), from the scene's camera, zoomed in on
+ * a chord of the silhouette (a sphere's exact surface bulging past it by
+ * some pixels), and looking at it from the range's cube centre (triangles
+ * behind the eye give their box's whole rectangle). */
+static void pixels_near_triangles_hold_every_point(void **state)
+{
+    (void)state;
+    const char *scenes[] = {"data/scenes/ring-caustic.scn", "data/scenes/cornell-caustic.scn"};
+    for (int sc = 0; sc < 2; sc++) {
+        ps_error err;
+        ps_scene *scene;
+        ps_world *world;
+        ps_preview_mesh mesh;
+        assert_int_equal(ps_scene_load(scenes[sc], NULL, &scene, &err), PS_OK);
+        assert_int_equal(ps_world_create(scene, NULL, &world, &err), PS_OK);
+        ps_mesh_options mo = ps_mesh_default_options(scene);
+        assert_int_equal(ps_preview_mesh_build(scene, &mo, &mesh, &err), PS_OK);
+        size_t nm;
+        ps_specular *near, *boxes;
+        assert_int_equal(ps_specular_create(&mesh, ps_scene_materials(scene, &nm), &near, &err), PS_OK);
+        assert_int_equal(ps_specular_create(&mesh, ps_scene_materials(scene, &nm), &boxes, &err), PS_OK);
+        ps_specular_set_pixel_boxes(boxes, true);
+        ps_specular_set_threads(near, 2);
+        /* The first range's triangle seen most nearly edge on, its first
+         * edge's midpoint (on the silhouette, where the exact surface
+         * bulges past the chord the most) and length. */
+        const ps_specular_range *first = &ps_specular_ranges(near)[0];
+        const ps_mesh_range *rg = &mesh.ranges[first->range];
+        ps_vec3 eye = ps_scene_camera(scene)->eye, edge = eye;
+        double best = HUGE_VAL, chord = 0.0;
+        for (size_t t = rg->first; t + 2 < rg->first + rg->count; t += 3) {
+            ps_vec3 q[3];
+            for (int k = 0; k < 3; k++)
+                q[k] = ps_v3(mesh.positions[3 * (t + k)], mesh.positions[3 * (t + k) + 1],
+                             mesh.positions[3 * (t + k) + 2]);
+            ps_vec3 n = ps_v3_norm(ps_v3_cross(ps_v3_sub(q[1], q[0]), ps_v3_sub(q[2], q[0])));
+            /* Edge on, its first edge long (not a sliver at a pole). */
+            double c = fabs(ps_v3_dot(n, ps_v3_norm(ps_v3_sub(q[0], eye)))) / ps_v3_len(ps_v3_sub(q[1], q[0]));
+            if (c < best)
+                best = c, edge = ps_v3_scale(ps_v3_add(q[0], q[1]), 0.5), chord = ps_v3_len(ps_v3_sub(q[1], q[0]));
+        }
+        for (int v = 0; v < 3; v++) {
+            ps_camera c = *ps_scene_camera(scene);
+            if (v == 1) { /* zoomed in on it, the view a quarter of the chord high */
+                c.target = edge;
+                c.fov_deg = 2.0 * atan(0.125 * chord / ps_v3_len(ps_v3_sub(edge, eye))) * 180.0 / PS_PI;
+            }
+            if (v == 2) { /* from the range's cube centre, looking at it */
+                c.eye = ps_specular_cube_centre(near, first->cube);
+                c.target = edge;
+            }
+            ps_camera_frame cam = ps_camera_frame_make(&c, 97, 80);
+            for (int k = 0; k < 2; k++) {
+                ps_specular *sp = k ? boxes : near;
+                assert_int_equal(ps_specular_update(sp, world, cam.eye, 0), 0);
+                assert_int_equal(ps_specular_update_pixels(sp, world, &cam, 0, 0.0), 0);
+            }
+            print_message("%s, camera %d: %zu points\n", scenes[sc], v, ps_specular_pixel_points(near).count);
+            assert_points_equal(ps_specular_pixel_points(near), ps_specular_pixel_points(boxes), 100);
+        }
+        ps_specular_destroy(near);
+        ps_specular_destroy(boxes);
+        ps_preview_mesh_free(&mesh);
+        ps_world_destroy(world);
+        ps_scene_destroy(scene);
+    }
+}
+
 /* The triangles a term lights (ps_specular_weighted_triangles): any corner
  * with any channel above 0 keeps the triangle whole (GL interpolates the
  * weight from it across the triangle), a NaN too (never hidden); all-zero
@@ -293,6 +364,7 @@ int main(void)
         cmocka_unit_test(mirror_lookup_is_distance_corrected),
         cmocka_unit_test(default_scene_lookups),
         cmocka_unit_test(reaimed_lookups_equal_fresh_ones),
+        cmocka_unit_test(pixels_near_triangles_hold_every_point),
         cmocka_unit_test(weighted_triangles),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -148,7 +148,8 @@ struct ps_specular {
     size_t next_unique;
     /* Per-pixel paths: each listed range's vertex box, the camera frame being
      * traced, its pixel rectangles and the cursor over them (range, pixel),
-     * the pixels done (ranges' rectangles overlap), the points being built
+     * the pixels done or left out (ranges' rectangles overlap; pixels near
+     * none of the triangles, unless pix_boxes), the points being built
      * and those of the last frame traced whole (ready: that frame is the
      * current one). */
     ps_aabb *range_box;
@@ -158,6 +159,7 @@ struct ps_specular {
     size_t pix_range, pix_next;
     unsigned char *pix_seen;
     size_t pix_seen_cap;
+    bool pix_boxes;
     point_set pix_build, pix_done;
     /* Tracing them on `threads` threads: the pixels of a chunk and each
      * job's points (joined in job order). */
@@ -410,6 +412,12 @@ bool ps_specular_set_lookup_centre(ps_specular *sp, int cube, ps_vec3 centre)
     point_set_reaim(&sp->pix_done, cube, centre);
     sp->changed = true;
     return true;
+}
+
+void ps_specular_set_pixel_boxes(ps_specular *sp, bool boxes)
+{
+    sp->pix_boxes = boxes;
+    sp->pix_have_cam = false;
 }
 
 void ps_specular_set_threads(ps_specular *sp, int threads)
@@ -729,6 +737,11 @@ void ps_specular_invalidate(ps_specular *sp)
  * surface bulges past the mesh's chords, and a sample's pixel may lie just
  * outside the box's projected corners. */
 #define PIXEL_MARGIN 2
+/* ... and a triangle's by this share of its projected size besides: a
+ * sphere's exact surface bulges past its chords by sqrt(t / 8) of a chord
+ * when tessellated to sagitta / radius t (0.011 at the preview's 10^-3),
+ * some pixels where a chord spans hundreds (a view zoomed in far). */
+#define PIXEL_CHORD_BULGE 0.05
 
 static bool same_frame(const ps_camera_frame *a, const ps_camera_frame *b)
 {
@@ -737,27 +750,20 @@ static bool same_frame(const ps_camera_frame *a, const ps_camera_frame *b)
            a->width == b->width && a->height == b->height;
 }
 
-/* Range i's pixel rectangle [x0, x1) x [y0, y1): its box's eight corners
- * projected; the whole image when a corner lies behind the eye. */
-static void range_rect(const ps_aabb *b, const ps_camera_frame *cam, int r[4])
+/* The pixel rectangle [x0, x1) x [y0, y1) of `count` points projected,
+ * PIXEL_MARGIN and `bulge` of its larger side wider; false when one lies
+ * behind the eye (no rectangle). */
+static bool points_rect(const ps_vec3 *p, int count, const ps_camera_frame *cam, double bulge, int r[4])
 {
     double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
-    bool all = false;
-    for (int k = 0; k < 8 && !all; k++) {
-        ps_vec3 p = ps_v3(k & 1 ? b->hi.x : b->lo.x, k & 2 ? b->hi.y : b->lo.y, k & 4 ? b->hi.z : b->lo.z);
+    for (int k = 0; k < count; k++) {
         double x, y;
-        if (!ps_camera_project(cam, p, &x, &y) || !isfinite(x) || !isfinite(y)) {
-            all = true;
-            break;
-        }
+        if (!ps_camera_project(cam, p[k], &x, &y) || !isfinite(x) || !isfinite(y))
+            return false;
         x0 = fmin(x0, x), x1 = fmax(x1, x), y0 = fmin(y0, y), y1 = fmax(y1, y);
     }
-    if (all) {
-        r[0] = 0, r[1] = 0, r[2] = cam->width, r[3] = cam->height;
-        return;
-    }
-    double lo[2] = {floor(x0) - PIXEL_MARGIN, floor(y0) - PIXEL_MARGIN};
-    double hi[2] = {ceil(x1) + PIXEL_MARGIN, ceil(y1) + PIXEL_MARGIN};
+    double grow = PIXEL_MARGIN + bulge * fmax(x1 - x0, y1 - y0);
+    double lo[2] = {floor(x0 - grow), floor(y0 - grow)}, hi[2] = {ceil(x1 + grow), ceil(y1 + grow)};
     double size[2] = {cam->width, cam->height};
     for (int a = 0; a < 2; a++) {
         r[a] = (int)fmin(fmax(lo[a], 0.0), size[a]);
@@ -765,6 +771,25 @@ static void range_rect(const ps_aabb *b, const ps_camera_frame *cam, int r[4])
         if (r[a + 2] < r[a])
             r[a + 2] = r[a];
     }
+    return true;
+}
+
+/* Range i's pixel rectangle: its box's eight corners projected; the whole
+ * image when a corner lies behind the eye. */
+static void range_rect(const ps_aabb *b, const ps_camera_frame *cam, int r[4])
+{
+    ps_vec3 corner[8];
+    for (int k = 0; k < 8; k++)
+        corner[k] = ps_v3(k & 1 ? b->hi.x : b->lo.x, k & 2 ? b->hi.y : b->lo.y, k & 4 ? b->hi.z : b->lo.z);
+    if (!points_rect(corner, 8, cam, 0.0, r))
+        r[0] = 0, r[1] = 0, r[2] = cam->width, r[3] = cam->height;
+}
+
+/* Rectangle r's pixels set to `value` in `mask` (`width` bytes a row). */
+static void mark_rect(unsigned char *mask, int width, const int r[4], unsigned char value)
+{
+    for (int y = r[1]; y < r[3]; y++)
+        memset(mask + (size_t)y * (size_t)width + r[0], value, (size_t)(r[2] - r[0]));
 }
 
 /* The cube of the listed range of scene object `object`; -1: none. */
@@ -857,7 +882,13 @@ static bool start_pixels(ps_specular *sp, const ps_camera_frame *cam)
         sp->pix_seen = seen;
         sp->pix_seen_cap = pixels;
     }
-    memset(sp->pix_seen, 0, pixels);
+    /* Only pixels near a range's triangles are traced (the others are
+     * marked seen): a box's rectangle holds many that no triangle of its
+     * covers, whose rays meet something else (the ring's 1.3*10^5 rays at
+     * 256^2 gave 2.9*10^4 points, 0.10 s on one core; 0.046 s so). Each
+     * triangle's rectangle is wider by PIXEL_MARGIN, as the box's is, and
+     * by PIXEL_CHORD_BULGE of itself. */
+    memset(sp->pix_seen, !sp->pix_boxes, pixels);
     sp->pix_have_cam = true;
     sp->pix_ready = false;
     sp->pix_cam = *cam;
@@ -867,8 +898,23 @@ static bool start_pixels(ps_specular *sp, const ps_camera_frame *cam)
         range_rect(&sp->range_box[i], cam, sp->rect[i]);
         /* Glossy ranges keep their per-vertex lobe lookups (the GL draws
          * them beside the points): no pixel of theirs is traced. */
-        if (ps_glossy_wants(range_material(sp, sp->ranges[i].range)))
+        if (ps_glossy_wants(range_material(sp, sp->ranges[i].range))) {
             sp->rect[i][2] = sp->rect[i][0], sp->rect[i][3] = sp->rect[i][1];
+            continue;
+        }
+        if (sp->pix_boxes)
+            continue;
+        const ps_mesh_range *rg = &sp->mesh->ranges[sp->ranges[i].range];
+        for (size_t v = 0; v + 2 < rg->count; v += 3) {
+            ps_vec3 tri[3] = {vertex_pos(sp->mesh, rg->first + v), vertex_pos(sp->mesh, rg->first + v + 1),
+                              vertex_pos(sp->mesh, rg->first + v + 2)};
+            int r[4];
+            if (!points_rect(tri, 3, cam, PIXEL_CHORD_BULGE, r)) { /* behind the eye: the box's whole rectangle */
+                mark_rect(sp->pix_seen, cam->width, sp->rect[i], 0);
+                break;
+            }
+            mark_rect(sp->pix_seen, cam->width, r, 0);
+        }
     }
     return true;
 }

@@ -169,6 +169,11 @@ ps_specular_points ps_specular_pixel_points(const ps_specular *sp);
 
 /* ---- for tests --------------------------------------------------------------- */
 
+/* Whether every pixel of each range's box rectangle is traced (true), not
+ * only those near its triangles (false, the default): the oracle for the
+ * pixels the triangles leave out. The current camera frame starts over. */
+void ps_specular_set_pixel_boxes(ps_specular *sp, bool boxes);
+
 /* One path's end: its lookup direction from `centre` (or the direction it
  * leaves in, far away, when it meets nothing) and its weight; and what the
  * direction is made of, so that it can be taken from another centre
