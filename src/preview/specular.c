@@ -785,11 +785,11 @@ static void range_rect(const ps_aabb *b, const ps_camera_frame *cam, int r[4])
         r[0] = 0, r[1] = 0, r[2] = cam->width, r[3] = cam->height;
 }
 
-/* Rectangle r's pixels set to `value` in `mask` (`width` bytes a row). */
-static void mark_rect(unsigned char *mask, int width, const int r[4], unsigned char value)
+/* Rectangle r's pixels cleared in `mask` (`width` bytes a row). */
+static void clear_rect(unsigned char *mask, int width, const int r[4])
 {
     for (int y = r[1]; y < r[3]; y++)
-        memset(mask + (size_t)y * (size_t)width + r[0], value, (size_t)(r[2] - r[0]));
+        memset(mask + (size_t)y * (size_t)width + r[0], 0, (size_t)(r[2] - r[0]));
 }
 
 /* The cube of the listed range of scene object `object`; -1: none. */
@@ -910,10 +910,10 @@ static bool start_pixels(ps_specular *sp, const ps_camera_frame *cam)
                               vertex_pos(sp->mesh, rg->first + v + 2)};
             int r[4];
             if (!points_rect(tri, 3, cam, PIXEL_CHORD_BULGE, r)) { /* behind the eye: the box's whole rectangle */
-                mark_rect(sp->pix_seen, cam->width, sp->rect[i], 0);
+                clear_rect(sp->pix_seen, cam->width, sp->rect[i]);
                 break;
             }
-            mark_rect(sp->pix_seen, cam->width, r, 0);
+            clear_rect(sp->pix_seen, cam->width, r);
         }
     }
     return true;

@@ -124,14 +124,14 @@ size_t ps_specular_weighted_triangles(const float *weights, size_t vertices, uns
  * what refraction through a curved glass shows and what a sphere's mirror
  * shows past a reflected edge, and leaves a silhouette's pixels all or
  * nothing where the reference averages 16 samples. Once the camera holds
- * still, each pixel that an object of the layer may cover (its vertices'
- * bounding box projected, PIXEL_MARGIN pixels wider) is traced on the CPU
- * instead, PS_SPECULAR_PIXEL_SAMPLES^2 stratified eye rays a pixel through
- * the exact surfaces, each path ending as above; every kept path of every
- * sample is one point of the layer: its pixel, its lookup direction and its
- * weight over the samples a pixel (a box filter; the reference's Mitchell
- * filter is wider by a pixel). src/gl draws those points instead of the
- * objects once a camera frame is traced whole. */
+ * still, each pixel that an object of the layer may cover (near one of its
+ * triangles: each one's projected rectangle, a little wider) is traced on
+ * the CPU instead, PS_SPECULAR_PIXEL_SAMPLES^2 stratified eye rays a pixel
+ * through the exact surfaces, each path ending as above; every kept path of
+ * every sample is one point of the layer: its pixel, its lookup direction
+ * and its weight over the samples a pixel (a box filter; the reference's
+ * Mitchell filter is wider by a pixel). src/gl draws those points instead of
+ * the objects once a camera frame is traced whole. */
 #define PS_SPECULAR_PIXEL_SAMPLES 2
 /* Eye rays a refresh in incremental sessions (the window), at most, and
  * the share of tau they may take (a guard: at half of tau the sanitizer
