@@ -740,7 +740,10 @@ void ps_specular_invalidate(ps_specular *sp)
 /* ... and a triangle's by this share of its projected size besides: a
  * sphere's exact surface bulges past its chords by sqrt(t / 8) of a chord
  * when tessellated to sagitta / radius t (0.011 at the preview's 10^-3),
- * some pixels where a chord spans hundreds (a view zoomed in far). */
+ * some pixels where a chord spans hundreds (a view zoomed in far). A guard:
+ * no view tried needed either (test_specular: the same points with both
+ * at 0; the box's margin is needed, the design room's and the gallery's
+ * points at 256^2 differ without it). */
 #define PIXEL_CHORD_BULGE 0.05
 
 static bool same_frame(const ps_camera_frame *a, const ps_camera_frame *b)
