@@ -269,9 +269,11 @@ static void reaimed_lookups_equal_fresh_ones(void **state)
  * 4x the pixels its triangles cover), from the scene's camera, zoomed in on
  * a chord near a silhouette until it spans four view heights, and looking
  * at it from its range's cube centre (triangles behind the eye give their
- * box's whole rectangle). (It fails when every other triangle is left out;
- * it passes with the triangles' rectangles no wider than their corners:
- * none of these views needs their margins.) */
+ * box's whole rectangle); the spheres in the scene's view, more than four
+ * triangles a pixel of their boxes, trace the boxes. (It fails when the
+ * second half of each range's triangles is left out; it passes with the
+ * triangles' rectangles no wider than their corners: none of these views
+ * needs their margins.) */
 static void pixels_near_triangles_hold_every_point(void **state)
 {
     (void)state;
