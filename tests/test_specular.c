@@ -269,8 +269,9 @@ static void reaimed_lookups_equal_fresh_ones(void **state)
  * 4x the pixels its triangles cover), from the scene's camera, zoomed in on
  * a chord near a silhouette until it spans four view heights, and looking
  * at it from its range's cube centre (triangles behind the eye give their
- * box's whole rectangle); the spheres in the scene's view, more than four
- * triangles a pixel of their boxes, trace the boxes. (It fails when the
+ * box's whole rectangle); and the scene's view at 32x26, where the spheres
+ * and the ring have more than PIXEL_TRIANGLES_MAX (16) triangles a pixel of
+ * their boxes and trace the boxes. (It fails when the
  * second half of each range's triangles is left out; it passes with the
  * triangles' rectangles no wider than their corners: none of these views
  * needs their margins.) */
@@ -315,7 +316,7 @@ static void pixels_near_triangles_hold_every_point(void **state)
             if (c < best)
                 best = c, edge = ps_v3_scale(ps_v3_add(q[0], q[1]), 0.5), chord = ps_v3_len(ps_v3_sub(q[1], q[0]));
         }
-        for (int v = 0; v < 3; v++) {
+        for (int v = 0; v < 4; v++) {
             ps_camera c = *ps_scene_camera(scene);
             if (v == 1) { /* zoomed in on it, the view a quarter of the chord high */
                 c.target = edge;
@@ -325,7 +326,7 @@ static void pixels_near_triangles_hold_every_point(void **state)
                 c.eye = ps_specular_cube_centre(near, first->cube);
                 c.target = edge;
             }
-            ps_camera_frame cam = ps_camera_frame_make(&c, 97, 80);
+            ps_camera_frame cam = v == 3 ? ps_camera_frame_make(&c, 32, 26) : ps_camera_frame_make(&c, 97, 80);
             for (int k = 0; k < 2; k++) {
                 ps_specular *sp = k ? boxes : near;
                 assert_int_equal(ps_specular_update(sp, world, cam.eye, 0), 0);
