@@ -746,10 +746,10 @@ void ps_specular_invalidate(ps_specular *sp)
  * points at 256^2 differ without it). */
 #define PIXEL_CHORD_BULGE 0.05
 /* A range with more triangles than this many a pixel of its box traces the
- * whole box: a triangle projected and its rectangle cleared cost 0.2-0.5 us
- * here (the default box's 10^4 at 256^2 in 2 ms, the ring's 2048 long ones
- * in 1.1 ms), a pixel's rays some 3 us. */
-#define PIXEL_TRIANGLES_MAX 4
+ * whole box: a triangle projected and its rectangle cleared cost about
+ * 0.1 us here (the default box's 2*10^4 at 256^2 in 1.5-2 ms, the ring's
+ * 10^4 in 0.9-1.1 ms), a pixel's four rays some 3 us. */
+#define PIXEL_TRIANGLES_MAX 16
 
 static bool same_frame(const ps_camera_frame *a, const ps_camera_frame *b)
 {
