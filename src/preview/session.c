@@ -1144,7 +1144,11 @@ bool ps_session_prepare_still(ps_session *s, size_t max_vertices)
     if (!s->moving || !s->have_cam || !incremental(s) || s->edited || s->illuminance ||
         !(s->set.layers & PS_LAYER_SPECULAR) || ps_specular_range_count(s->spec) == 0 || ps_session_tracing(s))
         return false;
-    return ps_specular_update(s->spec, s->world, s->cam.eye, max_vertices) > 0;
+    if (ps_specular_update(s->spec, s->world, s->cam.eye, max_vertices) > 0)
+        return true;
+    /* Then its per-pixel paths, for the camera at its full pixels (the
+     * still refresh's trace_eye_paths goes on from where these stop). */
+    return ps_specular_update_pixels(s->spec, s->world, &s->cam, 0, PS_SESSION_PREPARE_SECONDS) > 0;
 }
 
 double ps_session_next_refresh(const ps_session *s, double at)

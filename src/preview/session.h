@@ -384,14 +384,19 @@ void ps_session_trace_specular_until(ps_session *s, double deadline);
 /* While the program would sleep after a moving camera's picture (until
  * ps_session_next_refresh), the work that camera's still view starts with,
  * done ahead: the specular layer's lookups for its eye, at most max_vertices
- * a call. They depend on the eye alone (specular.h), so the still view is
- * the same picture, only sooner (the default box's 9 804 sphere vertices were
- * 13-15 ms of its 0.07 s at 512^2). Only while nothing is traced: the tracer
- * would lose the cores. Returns whether any is left (false: done, or nothing
- * to do); a camera step meanwhile makes them the next eye's. */
+ * a call, then its per-pixel paths, PS_SESSION_PREPARE_SECONDS a call. They
+ * depend on the camera alone (specular.h), so the still view is the same
+ * picture, only sooner (the default box's 9 804 sphere vertices were 13-15
+ * ms of its 0.07 s at 512^2; its per-pixel paths, 3.5-4.5 ms of the 0.02-
+ * 0.04 s still view left after the lookups). Only while nothing is traced:
+ * the tracer would lose the cores. Returns whether any is left (false:
+ * done, or nothing to do); a camera step meanwhile makes them the next
+ * camera's. */
 bool ps_session_prepare_still(ps_session *s, size_t max_vertices);
 /* Vertices a call while the window waits: 2-3 ms, its events polled between. */
 #define PS_SESSION_PREPARE_VERTICES 1024
+/* The per-pixel paths' time a call, as the vertices'. */
+#define PS_SESSION_PREPARE_SECONDS 0.002
 
 /* After a moving camera's picture, the next refresh is due this share of tau
  * later (else a tau): a camera step before then draws its own picture at
