@@ -8,6 +8,7 @@
 
 #include "core/memory.h"
 
+#include "preview/feed.h"
 #include "preview/illummap.h"
 #include "preview/session.h"
 #include "preview/mesh.h"
@@ -274,7 +275,7 @@ static void refuses_over_budget(void **state)
 
 /* ---- through the session ------------------------------------------------------- */
 
-static ps_session *open_session(ps_scene *scene, bool incremental, ps_radius_schedule schedule)
+static ps_session_settings maps_settings(ps_scene *scene, bool incremental, ps_radius_schedule schedule)
 {
     ps_session_settings set = ps_session_default_settings(scene);
     set.caps[PS_MAP_CAUSTIC] = 5000;
@@ -284,13 +285,25 @@ static ps_session *open_session(ps_scene *scene, bool incremental, ps_radius_sch
     set.float_buffer = set.incremental = incremental;
     set.radius_schedule = schedule;
     set.global_layer = PS_GLOBAL_MAPS;
+    return set;
+}
+
+/* A session of set, traced to its caps. */
+static ps_session *open_session_with(ps_scene *scene, const ps_session_settings *set)
+{
     ps_session *s;
     ps_error err;
-    if (ps_session_create(scene, &set, &s, &err) != PS_OK)
+    if (ps_session_create(scene, set, &s, &err) != PS_OK)
         fail_msg("session: %s", err.msg);
     if (ps_session_trace_all(s, &err) != PS_OK)
         fail_msg("trace: %s", err.msg);
     return s;
+}
+
+static ps_session *open_session(ps_scene *scene, bool incremental, ps_radius_schedule schedule)
+{
+    ps_session_settings set = maps_settings(scene, incremental, schedule);
+    return open_session_with(scene, &set);
 }
 
 /* Refreshes until everything is shown; the number of refreshes. */
@@ -367,13 +380,49 @@ static void session_fills_the_maps(void **state)
     ps_scene_destroy(scene);
 }
 
+/* ps_session_set_budget_share: the maps take that share of their budget
+ * (a batch at least), as the splats do (photosplat-snap's checkpoint frames:
+ * pace.h). With tau so long that their budget is every photon, a second
+ * incremental refresh at the whole budget adds all the rest; at a share of
+ * 10^-9, one batch. */
+static void maps_take_the_budget_share(void **state)
+{
+    (void)state;
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 32, 32);
+    ps_session_settings set = maps_settings(scene, true, PS_RADIUS_FIXED);
+    set.tau = 1e4;
+    size_t added[2];
+    for (int v = 0; v < 2; v++) {
+        ps_session *s = open_session_with(scene, &set);
+        size_t stored = ps_session_maps(s)[PS_MAP_GLOBAL].count;
+        ps_session_frame f;
+        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK); /* PS_SESSION_BUDGET_START: a batch */
+        ps_session_drawn(s, 0.001);
+        size_t first = ps_illummap_count(ps_session_illummap(s));
+        assert_true(first > 0 && first < stored);
+        ps_session_set_budget_share(s, v == 0 ? 1.0 : 1e-9);
+        assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+        added[v] = ps_illummap_count(ps_session_illummap(s)) - first;
+        if (v == 0)
+            assert_int_equal(first + added[v], stored);
+        ps_session_destroy(s);
+    }
+    printf("maps' second refresh: %zu photons at the whole budget, %zu at a share of 1e-9\n", added[0], added[1]);
+    assert_true(added[1] > 0 && added[1] <= PS_FEED_BATCH && added[1] < added[0]);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(furnace_is_uniform),   cmocka_unit_test(box_flux_is_the_photons),
         cmocka_unit_test(batches_do_not_matter), cmocka_unit_test(colours_are_radiance),
         cmocka_unit_test(radius_levels),        cmocka_unit_test(refuses_over_budget),
-        cmocka_unit_test(session_fills_the_maps),
+        cmocka_unit_test(session_fills_the_maps), cmocka_unit_test(maps_take_the_budget_share),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

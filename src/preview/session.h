@@ -439,8 +439,9 @@ void ps_session_set_tau(ps_session *s, double tau);
  * Incremental refreshes ignore it. */
 void ps_session_set_whole_most(ps_session *s, const double most[PS_MAP_COUNT]);
 /* Incremental refreshes draw at most this share of their budget of new
- * splats (at least one batch a map still), until set again: 1, the default,
- * is the whole budget. For a refresh that must end by a time with little
+ * splats (at least one batch a map still), and the illumination maps take
+ * this share of theirs, until set again: 1, the default, is the whole
+ * budget. For a refresh that must end by a time with little
  * room for the budget's error (photosplat-snap's float checkpoints: the
  * splat rate the budget comes from varied 2x from one refresh to the next,
  * and a refresh meant to take 0.09 s of splats took 0.15). Whole refreshes
