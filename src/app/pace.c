@@ -6,10 +6,11 @@
 /* Of a whole refresh's time, what does not grow with the photons. */
 static double scene_part(const ps_pace_model *m) { return fmax(0.0, m->seconds - m->per_photon * m->photons); }
 
-/* The photons' part of a whole refresh drawing n, beyond the n0 it was
- * learned at growing as n (n / n0)^PS_PACE_GROWTH. */
+/* The photons' part of a whole refresh drawing n (never fewer than
+ * m->least), beyond the n0 it was learned at growing as n (n / n0)^PS_PACE_GROWTH. */
 static double photons_part(const ps_pace_model *m, double n)
 {
+    n = fmax(n, m->least);
     double part = m->per_photon * fmax(0.0, n);
     return n > m->photons && m->photons > 0.0 ? part * pow(n / m->photons, PS_PACE_GROWTH) : part;
 }

@@ -88,6 +88,10 @@ typedef struct ps_pace_model {
     double rate;       /* photons emitted a second */
     double lead;       /* of seconds, what comes before the faces (the session's splats) */
     int learned;       /* whole refreshes learned in a row */
+    double least;      /* whole: the photons emitted the next refresh draws at least, which its
+                        * time is foreseen for (snap's checkpoints never show fewer than the last
+                        * one did: a plan for fewer foresaw the default box's 0.1 s frame at
+                        * 0.019-0.023 s, it took 0.023-0.032 s and landed at 0.11-0.13 s) */
     double unheld;     /* the next refresh's cube faces that no deadline holds back, seconds
                         * (the first round's: ps_gl_specular_unheld_seconds; HUGE_VAL: not
                         * known yet), unless it shows a checkpoint (ps_pace_plan.shows) */

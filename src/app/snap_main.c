@@ -705,6 +705,8 @@ static ps_pace_plan plan_refresh(snap_run *s, double clock, double due, int cp, 
         ps_gl_specular_hold_first_round(s->spec, false);
     ps_gl_specular_set_face_guess(s->spec, PS_PACE_FACE_GUESS * s->pace.seconds);
     s->pace.unheld = ps_gl_specular_unheld_seconds(s->spec, s->session);
+    /* A refresh draws no fewer photons than the last checkpoint showed (refine's most[]). */
+    s->pace.least = s->shown[0] + s->shown[1];
     ps_pace_plan plan = ps_pace_next(&s->pace, now, photons, due, s->o->checkpoints + cp, s->o->checkpoint_count - cp);
     /* The first picture at once. Float: the tracer is held until it is
      * drawn (refine), so waiting would only idle. 8 bits: waiting for the
