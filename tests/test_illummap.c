@@ -323,17 +323,26 @@ static int settle(ps_session *s, const ps_camera_frame *cam)
     return n;
 }
 
+/* The default box, and its camera at 32 x 32. */
+static ps_scene *load_box(ps_camera_frame *cam)
+{
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    *cam = ps_camera_frame_make(ps_scene_camera(scene), 32, 32);
+    return scene;
+}
+
 /* The session's maps: every photon once, at the schedule's level for the
  * photons emitted; the same sums from incremental refreshes as from one
  * whole refresh; other settings and edits start them over. */
 static void session_fills_the_maps(void **state)
 {
     (void)state;
-    ps_scene *scene;
+    ps_camera_frame cam;
+    ps_scene *scene = load_box(&cam);
     ps_error err;
-    if (ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 32, 32);
     for (int sched = 0; sched < PS_RADIUS_SCHEDULE_COUNT; sched++) {
         ps_session *inc = open_session(scene, true, (ps_radius_schedule)sched);
         ps_session *whole = open_session(scene, false, (ps_radius_schedule)sched);
@@ -388,11 +397,9 @@ static void session_fills_the_maps(void **state)
 static void maps_take_the_budget_share(void **state)
 {
     (void)state;
-    ps_scene *scene;
+    ps_camera_frame cam;
+    ps_scene *scene = load_box(&cam);
     ps_error err;
-    if (ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), 32, 32);
     ps_session_settings set = maps_settings(scene, true, PS_RADIUS_FIXED);
     set.tau = 1e4;
     size_t added[2];
