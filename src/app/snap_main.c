@@ -765,13 +765,12 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
          * not shown. The first frame's time holds llvmpipe's first compiles
          * and the first specular traces (its scene's part 0.2-0.4 s at 256^2
          * against 0.04-0.06 s after), which left the 1 s checkpoint's frame
-         * one batch. Only where it ends before the frame the plan starts,
-         * foreseen at PS_PACE_FACE_GUESS of the first frame (a batch took
-         * 0.023-0.030 s after a first frame of 0.05-0.058 s): started in
-         * any wait, it delayed the 0.1 s checkpoints' frames, the default
-         * box's to 0.12-0.14 s and the ring's to 0.13-0.15 s. */
+         * one batch. Only where it ends before the frame the plan starts
+         * (PS_PACE_BATCH_GUESS): started in any wait, it delayed the 0.1 s
+         * checkpoints' frames, the default box's to 0.12-0.14 s and the
+         * ring's to 0.13-0.15 s. */
         if (!s->layers && s->pace.learned == 1 && cp < o->checkpoint_count &&
-            plan.start > ps_now_seconds() - clock + PS_PACE_FACE_GUESS * s->pace.seconds) {
+            plan.start > ps_now_seconds() - clock + PS_PACE_BATCH_GUESS * s->pace.seconds) {
             st = unseen_batch(s, err);
             if (st != PS_OK)
                 break;
