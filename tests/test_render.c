@@ -545,6 +545,18 @@ static void camera_matches_projection(void **state)
     assert_near(ps_v3_dot(mid.d, to), 1.0, 1e-12);
     ps_ray top = ps_camera_ray(&f, 160, 0);
     assert_near(acos(ps_v3_dot(top.d, to)) * 180 / PS_PI, 20.0, 1e-9);
+    /* One view equals itself made again, and no longer once its eye, field
+     * of view or pixels differ. */
+    ps_camera_frame g = ps_camera_frame_make(&c, 320, 200);
+    assert_true(ps_camera_frame_equal(&f, &g));
+    g.eye.x += 1e-12;
+    assert_false(ps_camera_frame_equal(&f, &g));
+    ps_camera wide = c;
+    wide.fov_deg = 41;
+    g = ps_camera_frame_make(&wide, 320, 200);
+    assert_false(ps_camera_frame_equal(&f, &g));
+    g = ps_camera_frame_make(&c, 320, 201);
+    assert_false(ps_camera_frame_equal(&f, &g));
 }
 
 /* A raised cancel flag stops the render between rows: PS_ERR_INTERRUPTED

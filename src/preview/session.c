@@ -461,13 +461,6 @@ bool ps_session_counter_stopped(const ps_session *s, uint64_t *at_photons)
 
 /* ---- refreshing ------------------------------------------------------------------- */
 
-static bool same_camera(const ps_camera_frame *a, const ps_camera_frame *b)
-{
-    return ps_v3_equal(a->eye, b->eye) && ps_v3_equal(a->forward, b->forward) && ps_v3_equal(a->right, b->right) &&
-           ps_v3_equal(a->up, b->up) && a->tan_half_fov == b->tan_half_fov && a->aspect == b->aspect &&
-           a->width == b->width && a->height == b->height;
-}
-
 /* How far into map k this refresh draws, from `from` photons (`from_emitted`
  * emitted): whole batches as the feed handed them over, at most `budget`
  * photons beyond `from` (HUGE_VAL: all of them), but at least one batch.
@@ -781,7 +774,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
 {
     memset(out, 0, sizeof *out);
     bool inc = incremental(s);
-    if (!s->have_cam || !same_camera(cam, &s->cam)) {
+    if (!s->have_cam || !ps_camera_frame_equal(cam, &s->cam)) {
         /* A camera move (not the first view): draw the level of detail. */
         s->moving = inc && s->have_cam;
         s->cam = *cam;

@@ -751,13 +751,6 @@ void ps_specular_invalidate(ps_specular *sp)
  * 10^4 in 0.9-1.1 ms), a pixel's four rays some 3 us. */
 #define PIXEL_TRIANGLES_MAX 16
 
-static bool same_frame(const ps_camera_frame *a, const ps_camera_frame *b)
-{
-    return ps_v3_equal(a->eye, b->eye) && ps_v3_equal(a->forward, b->forward) && ps_v3_equal(a->right, b->right) &&
-           ps_v3_equal(a->up, b->up) && a->tan_half_fov == b->tan_half_fov && a->aspect == b->aspect &&
-           a->width == b->width && a->height == b->height;
-}
-
 /* The pixel rectangle [x0, x1) x [y0, y1) of `count` points projected,
  * PIXEL_MARGIN and `bulge` of its larger side wider; false when one lies
  * behind the eye (no rectangle). */
@@ -878,7 +871,7 @@ static void pixel_job(void *ctx, size_t job)
 /* A new camera frame: its rectangles, nothing traced yet. */
 static bool start_pixels(ps_specular *sp, const ps_camera_frame *cam)
 {
-    if (sp->pix_have_cam && same_frame(cam, &sp->pix_cam))
+    if (sp->pix_have_cam && ps_camera_frame_equal(cam, &sp->pix_cam))
         return true;
     size_t pixels = (size_t)cam->width * (size_t)cam->height;
     if (sp->pix_seen_cap < pixels) {

@@ -17,6 +17,13 @@ ps_camera_frame ps_camera_frame_make(const ps_camera *c, int width, int height)
     return f;
 }
 
+bool ps_camera_frame_equal(const ps_camera_frame *a, const ps_camera_frame *b)
+{
+    return ps_v3_equal(a->eye, b->eye) && ps_v3_equal(a->forward, b->forward) && ps_v3_equal(a->right, b->right) &&
+           ps_v3_equal(a->up, b->up) && a->tan_half_fov == b->tan_half_fov && a->aspect == b->aspect &&
+           a->width == b->width && a->height == b->height;
+}
+
 ps_ray ps_camera_ray(const ps_camera_frame *f, double x, double y)
 {
     double nx = 2.0 * x / f->width - 1.0, ny = 1.0 - 2.0 * y / f->height;

@@ -22,6 +22,11 @@ typedef struct ps_camera_frame {
 /* width, height >= 1. */
 ps_camera_frame ps_camera_frame_make(const ps_camera *c, int width, int height);
 
+/* Whether a and b are the same view: eye, axes, field of view and pixels
+ * (what the preview compares to tell a camera move, and the specular
+ * layer's per-pixel paths to tell their frame). */
+bool ps_camera_frame_equal(const ps_camera_frame *a, const ps_camera_frame *b);
+
 /* The ray from the eye through image position (x, y); unit direction. */
 ps_ray ps_camera_ray(const ps_camera_frame *f, double x, double y);
 
