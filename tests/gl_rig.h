@@ -1,6 +1,7 @@
-/* gl_rig.h: a scene's preview session traced to its caps, with a current
- * OSMesa context, for the tests that draw a session's frames into the GL
- * layers (test_gl_moving, test_gl_bake). Any failure fails the test with the
+/* gl_rig.h: a scene's preview session traced to its caps (or not yet
+ * traced), with a current OSMesa context, for the tests that draw a
+ * session's frames into the GL layers (test_gl_moving, test_gl_bake,
+ * test_gl_ahead). Any failure fails the test with the
  * message. Include after test.h. */
 #ifndef PS_TESTS_GL_RIG_H
 #define PS_TESTS_GL_RIG_H
@@ -35,21 +36,28 @@ static inline ps_session_settings gl_rig_load(gl_rig *g, const char *text, const
     return set;
 }
 
-/* The session of `set`, traced to its caps, and a current context whose
+/* The session of `set`, nothing traced yet, and a current context whose
  * buffer is side x side. */
-static inline void gl_rig_start(gl_rig *g, const ps_session_settings *set, int side)
+static inline void gl_rig_untraced(gl_rig *g, const ps_session_settings *set, int side)
 {
     ps_error err;
     if (ps_session_create(g->scene, set, &g->s, &err) != PS_OK)
         fail_msg("session: %s", err.msg);
-    if (ps_session_trace_all(g->s, &err) != PS_OK)
-        fail_msg("trace: %s", err.msg);
     g->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
     assert_non_null(g->ctx);
     g->buffer = malloc(4 * (size_t)side * (size_t)side);
     assert_non_null(g->buffer);
     assert_true(OSMesaMakeCurrent(g->ctx, g->buffer, GL_UNSIGNED_BYTE, side, side));
     g->cam = ps_camera_frame_make(ps_scene_camera(g->scene), side, side);
+}
+
+/* The same, the session traced to its caps. */
+static inline void gl_rig_start(gl_rig *g, const ps_session_settings *set, int side)
+{
+    gl_rig_untraced(g, set, side);
+    ps_error err;
+    if (ps_session_trace_all(g->s, &err) != PS_OK)
+        fail_msg("trace: %s", err.msg);
 }
 
 static inline void gl_rig_close(gl_rig *g)

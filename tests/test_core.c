@@ -1,7 +1,10 @@
 /* test_core.c: vectors, boxes, transforms, strict numbers, atomic output, the
- * memory budget and large blocks, the interrupt flag and the name map. */
+ * memory budget and large blocks, the interrupt flag, the name map and a
+ * thread's low priority. */
+#define _GNU_SOURCE /* gettid: a thread's own nice value */
 #include "test.h"
 
+#include <errno.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdbool.h>
@@ -9,6 +12,7 @@
 #include <string.h>
 #include <dirent.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #ifdef __GLIBC__
@@ -17,6 +21,7 @@
 
 #include "app/interrupt.h"
 #include "core/fileio.h"
+#include "core/jobs.h"
 #include "core/memory.h"
 #include "core/namemap.h"
 #include "core/number.h"
@@ -412,6 +417,49 @@ static void *spin_until_cancelled(void *arg)
     return NULL;
 }
 
+/* A thread's own nice value. */
+static int own_nice(void)
+{
+    errno = 0;
+    return getpriority(PRIO_PROCESS, (id_t)gettid());
+}
+
+static void *nice_of_started(void *arg)
+{
+    *(int *)arg = own_nice();
+    return NULL;
+}
+
+static void *lowered(void *arg)
+{
+    int *seen = arg;
+    seen[0] = own_nice();
+    ps_thread_low_priority();
+    seen[1] = own_nice();
+    pthread_t t;
+    if (pthread_create(&t, NULL, nice_of_started, &seen[2]) == 0)
+        pthread_join(t, NULL);
+    return NULL;
+}
+
+/* ps_thread_low_priority: the calling thread at nice 10 (or nicer), the threads it
+ * starts after it too (the tracer's workers under a first round traced
+ * beside the drawing), the thread that started it as it was. */
+static void low_priority_thread(void **state)
+{
+    (void)state;
+    int before = own_nice(), seen[3] = {-100, -100, -100};
+    pthread_t t;
+    assert_int_equal(pthread_create(&t, NULL, lowered, seen), 0);
+    pthread_join(t, NULL);
+    printf("nice: %d before, %d after, %d in a thread it started; the caller %d\n", seen[0], seen[1], seen[2],
+           own_nice());
+    assert_int_equal(seen[0], before);
+    assert_int_equal(seen[1], before > PS_THREAD_LOW_NICE ? before : PS_THREAD_LOW_NICE);
+    assert_int_equal(seen[2], seen[1]);
+    assert_int_equal(own_nice(), before);
+}
+
 static void cancel_flag_across_threads(void **state)
 {
     (void)state;
@@ -606,6 +654,7 @@ int main(void)
         cmocka_unit_test(large_heap),
         cmocka_unit_test(output_checks),
         cmocka_unit_test(cancel_flag_across_threads), cmocka_unit_test(interrupt_flag),
+        cmocka_unit_test(low_priority_thread),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,7 +1,11 @@
 /* jobs.c: jobs on a few threads (jobs.h). */
+#define _GNU_SOURCE /* gettid: a thread's own nice value (Linux) */
 #include "core/jobs.h"
 
+#include <errno.h>
 #include <pthread.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 typedef struct job_list {
     ps_job_fn fn;
@@ -37,4 +41,14 @@ void ps_run_jobs(size_t count, int threads, ps_job_fn fn, void *ctx)
     job_thread(&lists[0]);
     for (int t = 1; t < started; t++)
         pthread_join(tid[t], NULL);
+}
+
+void ps_thread_low_priority(void)
+{
+    /* Never higher than it was (a process started nicer stays so). */
+    id_t self = (id_t)gettid();
+    errno = 0;
+    int was = getpriority(PRIO_PROCESS, self);
+    if (errno == 0 && was < PS_THREAD_LOW_NICE)
+        setpriority(PRIO_PROCESS, self, PS_THREAD_LOW_NICE);
 }

@@ -231,6 +231,7 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
                                bool shadows, bool moving)
 {
     r->lit = moving && r->in.moving ? r->in.moving : r->in.mesh;
+    r->stats.views++;
     r->stats.light_passes = 0;
     r->stats.light_vertices = 0;
     if (direct && shadows && !r->shadows_valid)

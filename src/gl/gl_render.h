@@ -149,6 +149,13 @@ void ps_gl_layers_destroy(ps_gl_layers *l);
 /* A new view: the direct layer (times exposure) or black, the prepass, and
  * empty map layers. */
 void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct);
+/* The same, ahead of the refresh that will ask for it (while the first
+ * round is traced: ps_session_start_beside): the next ps_gl_layers_draw, if
+ * its frame's new view is this still one (the same camera, exposure, direct
+ * flag and renderer, its lights, shadow maps and direct light's textures
+ * unchanged), does not draw it again; any other view, relight or splat added in between drops it. */
+void ps_gl_layers_view_ahead(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure,
+                             bool direct);
 /* The direct layer alone drawn again for the same view (new lights, or the
  * direct light's textures just laid), the map layers kept. */
 void ps_gl_layers_relight(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct);
@@ -195,6 +202,7 @@ typedef struct ps_gl_stats {
     double shadow_seconds_last;
     unsigned direct_bakes;   /* times the direct light's textures were laid (bake_direct) */
     bool direct_baked_last;  /* the last view's direct layer drew them */
+    uint64_t views;          /* views begun (ps_gl_begin_frame*: clear, prepass, direct light), all told */
 } ps_gl_stats;
 void ps_gl_clear_shadow_timing(ps_gl_renderer *r);
 ps_gl_stats ps_gl_get_stats(const ps_gl_renderer *r);

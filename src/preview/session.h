@@ -252,6 +252,18 @@ ps_status ps_session_trace_all(ps_session *s, ps_error *err);
  * first refresh after this has been drawn (ps_session_drawn), so that the
  * refresh has every core. */
 ps_status ps_session_start(ps_session *s, bool held, ps_error *err);
+/* Work a caller does while the first round is traced. */
+typedef void ps_session_beside_fn(void *ctx);
+/* ps_session_start, the first round traced on a thread of its own while
+ * beside(ctx) runs on this one: the first picture's work that needs no
+ * photon, such as its view (ps_gl_layers_view_ahead). The round runs at a
+ * low priority (ps_thread_low_priority) on the first round's threads, so
+ * the work takes the cores it wants and the round the rest: llvmpipe's
+ * first compiles leave all but one idle. beside must not call this
+ * session. With nothing to trace first (after a repair), or no thread for
+ * it, beside runs after the round. The photons are the same either way. */
+ps_status ps_session_start_beside(ps_session *s, bool held, ps_session_beside_fn *beside, void *ctx,
+                                  ps_error *err);
 /* Stops the background thread and waits for it; how tracing ended. */
 ps_status ps_session_stop(ps_session *s, ps_error *err);
 /* How tracing went so far: the tracer's error if it failed, else PS_OK. */
@@ -413,6 +425,10 @@ bool ps_session_prepare_still(ps_session *s, size_t max_vertices);
  * instant it counts tau from): at + tau, or at + PS_SESSION_STILL_SHARE tau
  * after a moving camera's picture. */
 double ps_session_next_refresh(const ps_session *s, double at);
+
+/* The direct layer as the next refresh draws it (ps_session_frame.direct_exposure
+ * and .direct). */
+void ps_session_direct_view(const ps_session *s, double *exposure, bool *direct);
 
 /* Whether everything is shown: no edit or new view pending, and every map at
  * its end and drawn (and baked, where settings.bake lays it), or tracing

@@ -1,0 +1,154 @@
+/* test_gl_ahead.c: the first picture's view drawn while its first round is
+ * traced (ps_session_start_beside, ps_gl_layers_view_ahead), as
+ * photosplat-snap's float layers draw it:
+ *  - the first refresh's composite is the same floats as a session started
+ *    the plain way, from the same photons, and its view is drawn once, not
+ *    again by the refresh (ps_gl_stats.views);
+ *  - a view drawn ahead for another camera, or for another exposure, is
+ *    drawn again for the refresh's own, the picture again the same;
+ *  - the work beside the round runs once. */
+#include "test.h"
+
+#include <GL/osmesa.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl/gl_render.h"
+#include "image/image.h"
+#include "preview/session.h"
+#include "scene/scene.h"
+#include "gl_rig.h"
+
+#define SIDE 64
+
+/* A box's floor under a point light, a glass sphere focusing a caustic on
+ * it: both maps in the first round, shadows in the view. */
+static const char *const ROOM = "camera eye 0 1 3 target 0 0.5 0 fov 45\n"
+                                "material white diffuse albedo 0.75 0.75 0.75\n"
+                                "material glass dielectric ior 1.5\n"
+                                "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
+                                "quad corner -1 0 -1 edge1 2 0 0 edge2 0 2 0 material white\n"
+                                "sphere center 0 0.4 0 radius 0.3 material glass\n"
+                                "light point position 0 1.5 0.3 power 50 50 50\n"
+                                "photons caustic 40000 global 10000\n";
+
+typedef struct ahead_job {
+    ps_gl_layers *layers;
+    ps_gl_renderer *gl;
+    ps_camera_frame cam;
+    double exposure;
+    bool direct;
+    int calls;
+} ahead_job;
+
+static void view_ahead(void *ctx)
+{
+    ahead_job *j = ctx;
+    j->calls++;
+    ps_gl_layers_view_ahead(j->layers, j->gl, &j->cam, j->exposure, j->direct);
+}
+
+typedef struct first_picture {
+    ps_image img;
+    uint64_t views; /* the renderer's views drawn in all */
+    uint64_t emitted[PS_MAP_COUNT];
+    int calls;      /* view_ahead's */
+} first_picture;
+
+/* The first refresh's composite, the session started the plain way, or
+ * with the view drawn beside its round (ahead) for the scene's camera, its
+ * eye moved eye_dx along x, at the refresh's exposure times exposure_factor. */
+static first_picture first(bool ahead, double eye_dx, double exposure_factor)
+{
+    gl_rig g;
+    ps_session_settings set = gl_rig_load(&g, ROOM, "ahead.scn");
+    set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
+    gl_rig_untraced(&g, &set, SIDE);
+    ps_gl_scene gs = ps_gl_scene_of(g.s);
+    ps_gl_options go = {true, true, 0, false, false};
+    ps_gl_renderer *gl;
+    ps_gl_layers *l;
+    ps_error err;
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g.s), &go, &gl, &err), PS_OK);
+    assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &l, &err), PS_OK);
+    first_picture out = {0};
+    if (ahead) {
+        ahead_job job = {l, gl, g.cam, 1.0, false, 0};
+        job.cam.eye.x += eye_dx;
+        ps_session_direct_view(g.s, &job.exposure, &job.direct);
+        job.exposure *= exposure_factor;
+        assert_int_equal(ps_session_start_beside(g.s, true, view_ahead, &job, &err), PS_OK);
+        out.calls = job.calls;
+    } else {
+        assert_int_equal(ps_session_start(g.s, true, &err), PS_OK);
+    }
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(g.s, &g.cam, &f, &err), PS_OK);
+    assert_true(f.new_view && !f.moving);
+    ps_gl_layers_draw(l, gl, &g.cam, &f);
+    double gains[PS_MAP_COUNT];
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        gains[k] = f.map[k].gain;
+        out.emitted[k] = f.emitted[k];
+        assert_true(f.emitted[k] > 0);
+    }
+    assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, gains, &out.img, &err), PS_OK);
+    out.views = ps_gl_get_stats(gl).views;
+    ps_gl_layers_destroy(l);
+    ps_gl_renderer_destroy(gl);
+    gl_rig_close(&g);
+    return out;
+}
+
+static void same_picture(const first_picture *a, const first_picture *b)
+{
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        assert_int_equal(a->emitted[k], b->emitted[k]);
+    assert_int_equal(a->img.width, b->img.width);
+    assert_int_equal(a->img.height, b->img.height);
+    size_t n = 3 * (size_t)a->img.width * (size_t)a->img.height;
+    assert_true(gl_rig_image_mean(&a->img) > 0.0);
+    assert_memory_equal(a->img.rgb, b->img.rgb, n * sizeof *a->img.rgb);
+}
+
+static void view_drawn_beside_the_round(void **state)
+{
+    (void)state;
+    first_picture plain = first(false, 0.0, 1.0), ahead = first(true, 0.0, 1.0);
+    printf("first picture: %llu caustic and %llu global photons, views drawn %llu plain, %llu ahead\n",
+           (unsigned long long)ahead.emitted[PS_MAP_CAUSTIC], (unsigned long long)ahead.emitted[PS_MAP_GLOBAL],
+           (unsigned long long)plain.views, (unsigned long long)ahead.views);
+    assert_int_equal(ahead.calls, 1);
+    assert_int_equal(plain.views, 1);
+    assert_int_equal(ahead.views, 1); /* drawn beside the round, not again */
+    same_picture(&ahead, &plain);
+    ps_image_destroy(&plain.img);
+    ps_image_destroy(&ahead.img);
+}
+
+static void another_view_drawn_again(void **state)
+{
+    (void)state;
+    first_picture plain = first(false, 0.0, 1.0);
+    /* Ahead for an eye moved a little: the refresh draws its own. */
+    first_picture other = first(true, 0.05, 1.0);
+    assert_int_equal(other.calls, 1);
+    assert_int_equal(other.views, 2);
+    same_picture(&other, &plain);
+    /* Ahead for the camera at another exposure: drawn again too. */
+    first_picture brighter = first(true, 0.0, 2.0);
+    assert_int_equal(brighter.views, 2);
+    same_picture(&brighter, &plain);
+    ps_image_destroy(&plain.img);
+    ps_image_destroy(&other.img);
+    ps_image_destroy(&brighter.img);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(view_drawn_beside_the_round),
+        cmocka_unit_test(another_view_drawn_again),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
