@@ -108,15 +108,6 @@ first=$(sed -n 's/.*"first_frame_seconds": \([0-9.e+-]*\).*/\1/p' "$cli_tmp/fa.j
 # alone): still before tau, which a wait for it would not be.
 if [[ $bin == *asan* ]]; then first_by=1.4; else first_by=1.0; fi
 awk_true "$first < $first_by" && ok || bad "float checkpoints: the first picture came at $first s, after tau"
-# Float checkpoints: a refresh that finds nothing new to draw (the first
-# picture done before the checkpoint, the next batch not traced yet) waits
-# for the tracer, a millisecond at a time, rather than running again at
-# once: the area box here spun through 4354 refreshes in 0.3 s before, 18
-# after.
-expect_success "float checkpoints wait for photons" "$snap" data/scenes/cornell-caustic-area.scn --size 32x32 \
-    --color-depth float --time 0.3 --checkpoints 0.05,0.1 --checkpoint-prefix "$cli_tmp/sp" --stats "$cli_tmp/sp.json"
-frames=$(sed -n 's/.*"frames": \([0-9]*\).*/\1/p' "$cli_tmp/sp.json")
-awk_true "$frames <= 200" && ok || bad "float checkpoints: $frames refreshes in 0.3 s, spinning while photons are traced"
 # Progressive in float draws only new photons into layers kept between
 # refreshes (as the window): at the caps the same picture as drawing them all
 # at once, but for the order of float additions.

@@ -96,9 +96,6 @@ static const char usage[] =
  * waiting, 0.36 and 1.6 million, ended at 6 s (2, 4 and 8 refreshes alike;
  * 8 bits redraw whatever is there). */
 #define SNAP_BACKLOG_REFRESHES 4.0
-/* Float, chasing a checkpoint: after a refresh that drew nothing, seconds
- * to wait for the tracer's next batch before the next (refine). */
-#define SNAP_EMPTY_WAIT 0.001
 
 /* --time in 8 bits: of the time left once every checkpoint is shown, the
  * most the redraw that teaches the last picture's cost (probe_redraw) is
@@ -913,7 +910,6 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         bool hold = !s->layers && cp < o->checkpoint_count;
         if (hold)
             ps_session_hold(s->session, true);
-        unsigned faces_before = ps_gl_specular_faces_rendered(s->spec);
         st = refresh(s, err);
         if (hold)
             ps_session_hold(s->session, false);
@@ -943,16 +939,6 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
                 break;
         }
         next = ps_pace_next_due(next, ps_now_seconds(), o->p.tau);
-        /* Float: a refresh that found nothing to draw (no photon arrived,
-         * no cube face, the view and maps as they were) is not run again at
-         * once: snap waits a little for the tracer's next batch, not past
-         * the next checkpoint. (The area box spun through 840 empty
-         * refreshes between its first picture, done at 0.040 s, and its
-         * 0.05 s checkpoint.) */
-        bool empty = s->layers && s->frame.splats == 0 && !s->frame.new_view && !s->frame.lights_changed &&
-                     !s->frame.imap_redraw && ps_gl_specular_faces_rendered(s->spec) == faces_before;
-        if (empty && cp < o->checkpoint_count)
-            sleep_until(fmin(ps_now_seconds() + SNAP_EMPTY_WAIT, t_start + excluded + o->checkpoints[cp]));
         /* Every photon traced, or the error counter stopped the tracer:
          * checkpoints still to come get their own frames, on time, and the
          * last picture follows. (An 8-bit redraw of them all takes seconds;
