@@ -765,7 +765,8 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
      * while the first round is traced (view_ahead). An 8-bit frame draws
      * its view again whole: drawn beside the round as well (llvmpipe's
      * first compiles and the shadow maps done there), the default box's
-     * and the design room's first 8-bit checkpoints came 4-7 ms later. */
+     * and the design room's first 8-bit checkpoints came 5-7 ms later
+     * (medians of eight runs). */
     view_ahead_job ahead = {s, 1.0, false};
     ps_session_direct_view(s->session, &ahead.exposure, &ahead.direct);
     ps_status st = s->layers ? ps_session_start_beside(s->session, true, view_ahead, &ahead, err)
