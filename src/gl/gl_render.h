@@ -153,7 +153,8 @@ void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
  * round is traced: ps_session_start_beside): the next ps_gl_layers_draw, if
  * its frame's new view is this still one (the same camera, exposure, direct
  * flag and renderer, its lights, shadow maps and direct light's textures
- * unchanged), does not draw it again; any other view, relight or splat added in between drops it. */
+ * unchanged), does not draw it again; any other view, relight or splat
+ * added in between drops it. */
 void ps_gl_layers_view_ahead(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure,
                              bool direct);
 /* The direct layer alone drawn again for the same view (new lights, or the
