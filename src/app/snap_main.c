@@ -543,6 +543,9 @@ static ps_status last_picture(snap_run *s, ps_status st, ps_error *err)
         st = stop;
     ps_session_full_lights(s->session);
     s->all_faces = true;
+    /* Every face from the photons there, as one whole frame draws them
+     * (last_picture_seconds foresees them all). */
+    ps_gl_specular_redraw_all(s->spec);
     if (st == PS_OK)
         st = refresh(s, err);
     while (st == PS_OK && s->layers && !ps_session_settled(s->session))

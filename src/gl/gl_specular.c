@@ -41,7 +41,6 @@ struct ps_gl_specular {
      * been rendered since the scene last changed and since it settled. */
     int cursor;
     int since_change, since_settled;
-    int waited_settled; /* ... of those since it settled, the ones drawn in waits (ps_gl_specular_idle) */
     unsigned layers;   /* what the cubes were rendered with: the frame's layers */
     uint64_t edits, epoch; /* what the cubes were drawn from (a change starts a round) */
     bool frozen;       /* filled by a test: never rendered over */
@@ -214,6 +213,13 @@ void ps_gl_specular_destroy(ps_gl_specular *g)
 
 unsigned ps_gl_specular_faces_rendered(const ps_gl_specular *g) { return g->faces_rendered; }
 
+void ps_gl_specular_redraw_all(ps_gl_specular *g)
+{
+    /* A settled round from here, its back maps begun afresh. */
+    g->since_change = g->since_settled = 0;
+    memset(g->back_faces, 0, sizeof g->back_faces);
+}
+
 static void new_cube_textures(ps_gl_specular *g, int n, GLuint *tex, const float *black)
 {
     glGenTextures(n, tex);
@@ -241,7 +247,7 @@ static void ensure_cubes(ps_gl_specular *g, int n)
     memset(g->face_time, 0, sizeof g->face_time); /* other cubes: other faces */
     memset(g->face_fill, 0, sizeof g->face_fill);
     g->fill_known = false;
-    g->since_change = g->since_settled = g->waited_settled = 0;
+    g->since_change = g->since_settled = 0;
     g->shown = 0; /* black cubes: a first round */
     g->lit = g->frozen;
     memset(g->back_faces, 0, sizeof g->back_faces);
@@ -468,7 +474,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
         g->layers = layers;
         g->edits = ps_session_edits(s);
         g->epoch = ps_session_maps_epoch(s);
-        g->since_change = g->since_settled = g->waited_settled = 0;
+        g->since_change = g->since_settled = 0;
         memset(g->back_faces, 0, sizeof g->back_faces); /* faces of before the change */
     }
     /* Settled: every photon has arrived (the feed ended; a new view of the
@@ -483,11 +489,9 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
          * with older faces, and leave newer ones unshown at the round's end). */
         if (settled)
             memset(g->back_faces, 0, sizeof g->back_faces);
-        g->since_settled = g->waited_settled = 0;
+        g->since_settled = 0;
     }
-    /* A wait goes on with the settled round past the faces it drew itself. */
-    int settled_faces = g->since_settled + (g->idle ? g->waited_settled : 0);
-    if (settled && settled_faces >= total && g->since_change >= total && !any_partial(g))
+    if (settled && g->since_settled >= total && g->since_change >= total && !any_partial(g))
         return PS_OK;
     /* Settled but not yet drawn from the last photons: the round is finished
      * over the next PS_GL_SPECULAR_SETTLE_REFRESHES refreshes whatever the
@@ -555,7 +559,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
         /* The settled round ends with its whole cubes: a face past it would
          * leave a back map begun, and the layer never done (a window's wait
          * done hung so under ASan's timing). */
-        if (settled && settled_faces + drawn >= total && g->since_change + drawn >= total && !any_partial(g))
+        if (settled && g->since_settled + drawn >= total && g->since_change + drawn >= total && !any_partial(g))
             break;
         /* The first round draws only the cubes not shown yet, and ends
          * once every one is (its other faces wait for the budget). */
@@ -602,17 +606,7 @@ ps_status ps_gl_specular_refresh(ps_gl_specular *g, ps_gl_renderer *r, ps_sessio
         g->face_seconds_fill = fill_drawn / n;
     }
     g->since_change += n;
-    /* Faces drawn in a wait do not end the settled round for a refresh,
-     * which draws them again (a wait does not: waited_settled). Counted,
-     * the default box's last picture (48^2, --time 30) kept four or five of
-     * them from a wait after the feed had ended, and its specular layer
-     * differed from a whole frame's by relMSE 4*10^-8 against 4*10^-9 in
-     * some runs, in most with a busy loop beside (the same photons, splats
-     * and GL state as far as checked; why such a face differs is not found). */
-    if (settled && g->idle)
-        g->waited_settled += n;
-    else
-        g->since_settled += n;
+    g->since_settled += n;
     /* Back to the view. */
     memcpy(r->view, view, sizeof view);
     memcpy(r->proj, proj, sizeof proj);
