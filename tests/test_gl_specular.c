@@ -399,6 +399,22 @@ static void deadline_holds_faces(void **state)
     rig_free(&r);
 }
 
+/* Two mirror spheres over a floor (two cubes, twelve faces), the session
+ * settled, and its first view's refresh, which draws no face. */
+static void two_mirrors_viewed(rig *r, ps_session_frame *f)
+{
+    rig_make(r, load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
+                          "material mirror mirror reflectance 1 1 1\n"
+                          "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0\n"
+                          "sphere center -0.4 0.5 -0.5 radius 0.3 material mirror\n"
+                          "sphere center 0.4 0.5 -0.5 radius 0.3 material mirror\n"
+                          "light point position 0 1.2 0.3 power 50 50 50\n"),
+             64, 64);
+    ps_error err;
+    assert_int_equal(ps_session_refresh(r->session, &r->cam, f, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(r->spec, r->gl, r->session, f, 1, &err), PS_OK); /* a new view: none */
+}
+
 /* A settled round renders every face of every cube once and stops with
  * whole cubes: when a refresh that draws them all (faces 0: snap's whole
  * refreshes) came after one that had drawn three, it drew twelve more, and
@@ -409,17 +425,9 @@ static void a_settled_round_ends_whole(void **state)
 {
     (void)state;
     rig r;
-    rig_make(&r, load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
-                           "material mirror mirror reflectance 1 1 1\n"
-                           "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0\n"
-                           "sphere center -0.4 0.5 -0.5 radius 0.3 material mirror\n"
-                           "sphere center 0.4 0.5 -0.5 radius 0.3 material mirror\n"
-                           "light point position 0 1.2 0.3 power 50 50 50\n"),
-             64, 64);
     ps_error err;
     ps_session_frame f;
-    assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 1, &err), PS_OK); /* a new view: none */
+    two_mirrors_viewed(&r, &f);
     assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
     /* Settled: a quarter of the round a refresh. */
     assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
@@ -442,17 +450,9 @@ static void redraw_all_after_a_wait(void **state)
 {
     (void)state;
     rig r;
-    rig_make(&r, load_text("camera eye 0 0.6 1.5 target 0 0.45 -1 up 0 1 0 fov 50\n"
-                           "material mirror mirror reflectance 1 1 1\n"
-                           "quad corner -2 0 -2 edge1 0 0 4 edge2 4 0 0\n"
-                           "sphere center -0.4 0.5 -0.5 radius 0.3 material mirror\n"
-                           "sphere center 0.4 0.5 -0.5 radius 0.3 material mirror\n"
-                           "light point position 0 1.2 0.3 power 50 50 50\n"),
-             64, 64);
     ps_error err;
     ps_session_frame f;
-    assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 1, &err), PS_OK); /* a new view: none */
+    two_mirrors_viewed(&r, &f);
     assert_int_equal(ps_session_refresh(r.session, &r.cam, &f, &err), PS_OK);
     /* Settled: a long wait draws the round, twelve faces, once. */
     ps_gl_specular_set_face_guess(r.spec, 1e-3);
