@@ -6,7 +6,10 @@
  *    again by the refresh (ps_gl_stats.views);
  *  - a view drawn ahead for another camera, or for another exposure, is
  *    drawn again for the refresh's own, the picture again the same;
- *  - the work beside the round runs once. */
+ *  - the work beside the round runs once;
+ *  - with --global-layer maps, the illumination maps gather the round's
+ *    photons beside the work too, before the first refresh, and its
+ *    picture is still the same floats as a plain start's. */
 #include "test.h"
 
 #include <GL/osmesa.h>
@@ -15,6 +18,7 @@
 
 #include "gl/gl_render.h"
 #include "image/image.h"
+#include "preview/illummap.h"
 #include "preview/session.h"
 #include "scene/scene.h"
 #include "gl_rig.h"
@@ -53,16 +57,21 @@ typedef struct first_picture {
     uint64_t views; /* the renderer's views drawn in all */
     uint64_t emitted[PS_MAP_COUNT];
     int calls;      /* view_ahead's */
+    size_t gathered; /* photons the illumination maps held before the first refresh */
+    size_t shown;    /* ... and after it */
+    double ahead_seconds; /* the session's count of them (ps_session_counts) */
 } first_picture;
 
 /* The first refresh's composite, the session started the plain way, or
  * with the view drawn beside its round (ahead) for the scene's camera, its
- * eye moved eye_dx along x, at the refresh's exposure times exposure_factor. */
-static first_picture first(bool ahead, double eye_dx, double exposure_factor)
+ * eye moved eye_dx along x, at the refresh's exposure times exposure_factor;
+ * the global layer as splats or as illumination maps. */
+static first_picture first_of(bool ahead, double eye_dx, double exposure_factor, ps_global_layer global)
 {
     gl_rig g;
     ps_session_settings set = gl_rig_load(&g, ROOM, "ahead.scn");
     set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
+    set.global_layer = global;
     gl_rig_untraced(&g, &set, SIDE);
     ps_gl_scene gs = ps_gl_scene_of(g.s);
     ps_gl_options go = {true, true, 0, false, false};
@@ -82,9 +91,15 @@ static first_picture first(bool ahead, double eye_dx, double exposure_factor)
     } else {
         assert_int_equal(ps_session_start(g.s, true, &err), PS_OK);
     }
+    const ps_illummap *imap = ps_session_illummap(g.s);
+    out.gathered = imap ? ps_illummap_count(imap) : 0;
+    ps_session_counts counts;
+    ps_session_get_counts(g.s, &counts);
+    out.ahead_seconds = counts.ahead_seconds;
     ps_session_frame f;
     assert_int_equal(ps_session_refresh(g.s, &g.cam, &f, &err), PS_OK);
     assert_true(f.new_view && !f.moving);
+    out.shown = imap ? ps_illummap_count(imap) : 0;
     ps_gl_layers_draw(l, gl, &g.cam, &f);
     double gains[PS_MAP_COUNT];
     for (int k = 0; k < PS_MAP_COUNT; k++) {
@@ -98,6 +113,11 @@ static first_picture first(bool ahead, double eye_dx, double exposure_factor)
     ps_gl_renderer_destroy(gl);
     gl_rig_close(&g);
     return out;
+}
+
+static first_picture first(bool ahead, double eye_dx, double exposure_factor)
+{
+    return first_of(ahead, eye_dx, exposure_factor, PS_GLOBAL_SPLATS);
 }
 
 static void same_picture(const first_picture *a, const first_picture *b)
@@ -144,11 +164,37 @@ static void another_view_drawn_again(void **state)
     ps_image_destroy(&brighter.img);
 }
 
+static void maps_gathered_beside_the_round(void **state)
+{
+    (void)state;
+    first_picture plain = first_of(false, 0.0, 1.0, PS_GLOBAL_MAPS);
+    first_picture ahead = first_of(true, 0.0, 1.0, PS_GLOBAL_MAPS);
+    printf("illumination maps: %zu photons gathered before the first refresh (%.4f s), %zu started plainly\n",
+           ahead.gathered, ahead.ahead_seconds, plain.gathered);
+    assert_int_equal(plain.gathered, 0);
+    assert_true(plain.ahead_seconds == 0.0);
+    /* The whole first round's global photons: the first refresh adds none. */
+    assert_true(ahead.gathered > 0);
+    assert_int_equal(ahead.shown, ahead.gathered);
+    assert_int_equal(plain.shown, ahead.gathered);
+    assert_true(ahead.ahead_seconds > 0.0);
+    assert_int_equal(ahead.views, 1);
+    same_picture(&ahead, &plain);
+    /* The splats' own start gathers nothing. */
+    first_picture splats = first(true, 0.0, 1.0);
+    assert_int_equal(splats.gathered, 0);
+    assert_true(splats.ahead_seconds == 0.0);
+    ps_image_destroy(&plain.img);
+    ps_image_destroy(&ahead.img);
+    ps_image_destroy(&splats.img);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(view_drawn_beside_the_round),
         cmocka_unit_test(another_view_drawn_again),
+        cmocka_unit_test(maps_gathered_beside_the_round),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -261,7 +261,10 @@ typedef void ps_session_beside_fn(void *ctx);
  * the work takes the cores it wants and the round the rest: llvmpipe's
  * first compiles leave all but one idle. beside must not call this
  * session. With nothing to trace first (after a repair), or no thread for
- * it, beside runs after the round. The photons are the same either way. */
+ * it, beside runs after the round. The photons are the same either way.
+ * After the round, on its thread, the illumination maps (--global-layer
+ * maps) gather its global photons, which the first refresh would: they do
+ * not depend on the view (ps_session_counts.ahead_seconds). */
 ps_status ps_session_start_beside(ps_session *s, bool held, ps_session_beside_fn *beside, void *ctx,
                                   ps_error *err);
 /* Stops the background thread and waits for it; how tracing ended. */
@@ -576,6 +579,8 @@ typedef struct ps_session_counts {
     double trace_seconds;/* the feed's time tracing */
     double map_bytes;    /* what the maps hold allocated */
     double splat_seconds;/* building splats, all refreshes */
+    double ahead_seconds;/* of that, the first refresh's done before it, beside the first round
+                          * (ps_session_start_beside: the illumination maps' first gathering) */
     uint64_t refreshes;
 } ps_session_counts;
 void ps_session_get_counts(ps_session *s, ps_session_counts *out);
