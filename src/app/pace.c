@@ -28,10 +28,15 @@ double ps_pace_redraw_seconds(const ps_pace_model *m, double photons)
 }
 
 /* The checkpoint's frame (ps_pace_plan.shows) holds its first round of cube
- * faces to the deadline like any others, and draws a share of the budget. */
+ * faces to the deadline like any others, and draws a share of the budget
+ * (PS_PACE_SHOWN_BUDGET, or `share`). */
+static double share_seconds(const ps_pace_model *m, double photons, double share)
+{
+    return held_seconds(m, photons) - (1.0 - share) * m->splats;
+}
 static double shown_seconds(const ps_pace_model *m, double photons)
 {
-    return held_seconds(m, photons) - (1.0 - PS_PACE_SHOWN_BUDGET) * m->splats;
+    return share_seconds(m, photons, PS_PACE_SHOWN_BUDGET);
 }
 
 void ps_pace_learn(ps_pace_model *m, double seconds, double photons, double photon_seconds, bool whole)
@@ -64,7 +69,7 @@ static double photons_for(const ps_pace_model *m, double d)
 ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, double due, const double *pending,
                           int count)
 {
-    ps_pace_plan p = {fmax(now, due), HUGE_VAL, -1, HUGE_VAL, false, false};
+    ps_pace_plan p = {fmax(now, due), HUGE_VAL, -1, HUGE_VAL, false, 1.0, false};
     if (count <= 0)
         return p;
     p.start = fmax(now, fmin(due, pending[0]));
@@ -108,13 +113,21 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
         p.start = now >= ideal ? now : ideal;
         double n = photons + m->rate * (p.start - now);
         double d = fmin(shown_seconds(m, n), cap);
+        /* Incremental, started late: a smaller share, to end by the aim
+         * (at least one batch a map: the session's prefix). Started late
+         * with its whole share, after a frame that ended just short of the
+         * checkpoint, the design room's and the area box's 0.1 s
+         * checkpoints came at 0.12-0.15 s. */
+        p.share = PS_PACE_SHOWN_BUDGET;
+        if (m->per_photon <= 0.0 && m->splats > 0.0 && p.start + d > aim)
+            p.share = fmax(0.0, PS_PACE_SHOWN_BUDGET - (p.start + d - aim) / m->splats);
         if (m->per_photon > 0.0 && p.start + d > aim)
             d = fmax(aim - p.start, 0.0);
         if (m->per_photon > 0.0 && photons_for(m, d) < n) {
             p.photons = photons_for(m, d);
             n = p.photons;
         }
-        d = shown_seconds(m, n);
+        d = share_seconds(m, n, p.share);
         p.faces_deadline = last_end - d > p.start ? last_end - d + fmin(m->lead, d) : p.start;
     } else {
         /* A refresh that ends before the checkpoint's frame must start:

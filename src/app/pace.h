@@ -135,7 +135,12 @@ typedef struct ps_pace_plan {
     int target;             /* the checkpoint planned for (index into the list: 0), -1: none */
     double photons;         /* whole: the most photons emitted it draws (0: one batch); HUGE_VAL: all */
     bool shows;             /* planned as the checkpoint's frame: an incremental one draws
-                             * PS_PACE_SHOWN_BUDGET of its budget, and holds its faces */
+                             * PS_PACE_SHOWN_BUDGET of its budget (share), and holds its faces */
+    double share;           /* incremental: the share of its budget of new splats it draws
+                             * (ps_session_set_budget_share): 1, or for the checkpoint's frame
+                             * PS_PACE_SHOWN_BUDGET, less when it starts late (after its ideal
+                             * start, as when the frame before ended just short of the
+                             * checkpoint): what still ends it by its aim */
     bool hold_faces;        /* the first round's cube faces, otherwise unheld, keep to
                              * faces_deadline too (ps_gl_specular_hold_first_round): the
                              * checkpoint's frame, and a refresh before it that would

@@ -891,7 +891,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         ps_gl_specular_set_deadline(s->spec, isfinite(plan.faces_deadline) ? clock + plan.faces_deadline : 0.0);
         if (s->layers) {
             ps_gl_specular_hold_first_round(s->spec, plan.hold_faces);
-            ps_session_set_budget_share(s->session, plan.shows ? PS_PACE_SHOWN_BUDGET : 1.0);
+            ps_session_set_budget_share(s->session, plan.share);
         }
         sleep_until(clock + plan.start);
         /* 8 bits: the checkpoint's frame draws what fits from its start,
