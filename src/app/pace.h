@@ -12,7 +12,8 @@
  * low: their scene parts vary as much as the photons' parts differ.) The
  * refresh that will show the checkpoint starts when it would end
  * PS_PACE_MARGIN of its time after it (incremental: drawing
- * PS_PACE_SHOWN_BUDGET of its budget); a refresh that would end after that
+ * PS_PACE_SHOWN_BUDGET of its budget, less if it starts later than that:
+ * ps_pace_plan.share); a refresh that would end after that
  * start holds its first round of cube faces if that is enough, and waits
  * for it otherwise (snap is headless: a wait leaves the cores to the tracer,
  * and to cube faces while they fit in it, ps_gl_specular_idle); cube faces
