@@ -190,6 +190,11 @@ expect_match "bench: rendered the references" "$cli_out" 'reference specular'
 awk -F, 'NR > 1 { for (i = 13; i <= NF; i++) if (!($i >= 0 && $i < 10)) { print "column " i ": " $i; bad = 1 } } END { exit bad }' \
     "$cli_tmp/b/bench.csv" && ok || bad "bench.csv has errors out of range"
 grep -q '^| triangles float progressive |' "$cli_tmp/b/bench.md" && ok || bad "bench.md lacks a table row"
+# ... and the machine it ran on (app/machine.h), said on stdout too.
+expect_match "bench: the machine" "$cli_out" '^machine: .*, [0-9]+ cores.*one core traces [0-9.]+ M photon paths a second \(tiny\)'
+grep -q '^Made by .* on .* cores.*; one core traces [0-9.]* M photon paths a second (tiny).* (app/machine.h' \
+    "$cli_tmp/b/bench.md" && ok ||
+    bad "bench.md does not say the machine"
 [ -s "$cli_tmp/b/data/tiny.dat" ] && [ -s "$cli_tmp/b/data/plots.gp" ] && ok || bad "no plot data"
 if command -v gnuplot >/dev/null 2>&1; then
     [ "$(head -c 8 "$cli_tmp/b/bench.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a ] && ok || bad "no bench.png"

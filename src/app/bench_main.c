@@ -24,6 +24,7 @@
 #include <unistd.h>
 
 #include "app/cli.h"
+#include "app/machine.h"
 #include "app/options.h"
 #include "core/fileio.h"
 #include "image/image.h"
@@ -186,6 +187,7 @@ typedef struct bench_state {
     double ref_seconds[BENCH_MAX_SCENES];
     bool ref_cached[BENCH_MAX_SCENES];
     double started;
+    char machine[512]; /* what the run measured of its machine (app/machine.h; "": --replot) */
 } bench_state;
 
 /* ---- options ----------------------------------------------------------------- */
@@ -859,7 +861,6 @@ static ps_status write_markdown(const bench_state *b, const char *path, double t
     time_t now = time(NULL);
     char date[64];
     strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", gmtime(&now));
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
     bench_on_time all_time = {0};
     fprintf(fp, "# Run time against error (photosplat-bench)\n\n");
     if (o->replot)
@@ -867,8 +868,9 @@ static ps_status write_markdown(const bench_state *b, const char *path, double t
                     "reference times are not in the CSV. ",
                 PROG, date, o->width, o->height);
     else
-        fprintf(fp, "Made by `%s` on %s, %ld cores, %dx%d images, in %.0f s. ", PROG, date, cores, o->width,
-                o->height, total);
+        fprintf(fp, "Made by `%s` on %s, %dx%d images, in %.0f s, on %s (app/machine.h: checkpoints' seconds "
+                    "depend on these). ",
+                PROG, date, o->width, o->height, total, b->machine);
     fprintf(fp, "Error: relMSE against the converged "
                 "reference (photosplat-ref, per component), both images clamped to the display's white "
                 "(1/exposure). Seconds: photosplat-snap's clock from its session's start to the checkpoint's "
@@ -1126,6 +1128,18 @@ static ps_status run(bench_state *b, ps_error *err)
     }
     if (st == PS_OK)
         st = make_dirs(o->cache, err);
+    /* The machine, before anything else has run (app/machine.h): its first
+     * scene's photon paths, and what memory never written costs. */
+    if (st == PS_OK) {
+        ps_machine m;
+        char name[256];
+        st = ps_machine_measure(o->scenes[0].path, &m, err);
+        if (st == PS_OK) {
+            ps_machine_describe(&m, stem(o->scenes[0].path, name, sizeof name), b->machine, sizeof b->machine);
+            printf("machine: %s\n", b->machine);
+            fflush(stdout);
+        }
+    }
     int total_configs = 0;
     for (size_t c = 0; c < BENCH_CONFIGS; c++)
         total_configs += config_wanted(o, c);
