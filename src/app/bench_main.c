@@ -875,7 +875,7 @@ static ps_status write_markdown(const bench_state *b, const char *path, double t
                 "reference (photosplat-ref, per component), both images clamped to the display's white "
                 "(1/exposure). Seconds: photosplat-snap's clock from its session's start to the checkpoint's "
                 "frame: the first photons, tracing and drawing (the scene's loading, its meshes and the GL "
-                "context come before, 0.02-0.04 s, not counted). `whole` is the picture less its specular layer against "
+                "context come before, 0.02-0.06 s, not counted). `whole` is the picture less its specular layer against "
                 "the reference's direct, caustic and indirect terms; `caustic`, `global`, `direct` and `specular` "
                 "each layer alone against the caustic, indirect, direct and specular terms; `full` the whole "
                 "picture against the whole reference, what mirrors and glass reflect and refract included "

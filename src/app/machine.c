@@ -137,7 +137,8 @@ void ps_machine_describe(const ps_machine *m, const char *scene_name, char *buf,
     if (m->load >= 0.0)
         snprintf(load, sizeof load, ", load %.2f", m->load);
     if (m->fresh_ms_per_mib > 0.0 && m->fault_us > 0.0)
-        snprintf(memory, sizeof memory, "; first writes to new memory cost %.2f ms a MiB (2 MiB pages), %.1f us a 4 KiB page",
+        snprintf(memory, sizeof memory,
+                 "; first writes to new memory cost %.2f ms a MiB (2 MiB pages), %.1f us a 4 KiB page",
                  m->fresh_ms_per_mib, m->fault_us);
     snprintf(buf, size, "%s%s%s; one core traces %.2f M photon paths a second (%s)%s",
              m->cpu[0] ? m->cpu : "processor unknown", cores, load, m->paths_per_second / 1e6, scene_name, memory);

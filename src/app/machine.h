@@ -43,8 +43,8 @@ typedef struct ps_machine {
 #define PS_MACHINE_REPEATS 3
 
 /* Measures the machine: memory first (before this process has freed any for
- * the kernel to give back), then photon paths of the scene at scene_path.
- * Under 0.5 s on the machines above. PS_OK, or the scene's error. */
+ * the kernel to give back), then photon paths of the scene at scene_path:
+ * about 0.25 s on the machines above. PS_OK, or the scene's error. */
 ps_status ps_machine_measure(const char *scene_path, ps_machine *out, ps_error *err);
 
 /* One line for a reader: "AMD EPYC, 2 cores, load 0.14; one core traces
