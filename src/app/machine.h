@@ -10,8 +10,8 @@
  * cost 0.12 ms a 2 MiB page: the machines are virtual, their host backs a
  * page only when it is first written and takes freed memory back within a
  * minute. The default box's first view (its shadow maps, llvmpipe's bins and
- * buffers) grew the process by 30-33 MiB, and under perf, zeroing those
- * pages was 0.036-0.041 s of it; the view took 0.046-0.07 s, and drawn a
+ * buffers) grew the process by 29-34 MiB, and under perf, zeroing those
+ * pages was 0.036-0.041 s of it; the view took 0.046-0.076 s, and drawn a
  * second time in the same process 0.009-0.015 s. So the first checkpoints
  * there mostly measure first writes and llvmpipe's first use of each state,
  * which no pacing can move. Memory figures are of new memory when measured:
