@@ -86,16 +86,30 @@ rc=$?
 expect_match "bad scene: reported once" "$(grep -c "^$bad_scene" "$cli_tmp/err")" '^1$'
 [ ! -e "$cli_tmp/f.png" ] && ok || bad "bad scene: f.png written"
 
+# catching_int PID: whether the process catches SIGINT (its handler
+# installed: bit 2 of /proc/PID/status's SigCgt).
+catching_int() {
+    local mask
+    mask=$(awk '/^SigCgt:/ { print $2 }' "/proc/$1/status" 2>/dev/null)
+    [ -n "$mask" ] && (((16#$mask >> 1) & 1))
+}
 # long_run NAME SIGNAL TARGET: a run long enough to stop midway; once both
-# ranks exist, SIGNAL goes to mpirun (TARGET mpirun) or to rank 1 (TARGET rank).
+# ranks catch SIGINT, SIGNAL goes to mpirun (TARGET mpirun) or to rank 1
+# (TARGET rank). (Waiting only for the ranks to exist, then 2 s: a CI run of
+# the sanitizer build beside the other tests, on a slower machine, sent
+# SIGINT before the ranks had their handler, and they ended saying nothing.)
 long_run() {
     rm -f "$cli_tmp/g.png"
     # --quality final: long enough (about 30 s) that the signal comes midway even on an idle machine.
     "${mpirun_[@]}" -np 2 "$mpi" "$scene" --size 400x300 --quality final --threads 1 -o "$cli_tmp/g.png" \
         >"$cli_tmp/out" 2>"$cli_tmp/err" &
-    local m=$! i
-    for i in $(seq 100); do
-        [ "$(pgrep -P $m | wc -l)" -ge 2 ] && break
+    local m=$! i p n
+    for i in $(seq 300); do
+        n=0
+        for p in $(pgrep -P $m -f photosplat-ref-mpi); do
+            catching_int "$p" && n=$((n + 1))
+        done
+        [ $n -ge 2 ] && break
         sleep 0.1
     done
     sleep 2
