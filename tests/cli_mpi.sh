@@ -95,9 +95,10 @@ catching_int() {
 }
 # long_run NAME SIGNAL TARGET: a run long enough to stop midway; once both
 # ranks catch SIGINT, SIGNAL goes to mpirun (TARGET mpirun) or to rank 1
-# (TARGET rank). (Waiting only for the ranks to exist, then 2 s: a CI run of
-# the sanitizer build beside the other tests, on a slower machine, sent
-# SIGINT before the ranks had their handler, and they ended saying nothing.)
+# (TARGET rank). (Waiting only for the ranks to exist, then 2 s, a CI run of
+# the sanitizer build beside the other tests, on a slower machine, had both
+# ranks end saying nothing; likeliest, the signal came before their handler,
+# which here, idle, is in place 0.2-0.5 s after they exist. Not reproduced.)
 long_run() {
     rm -f "$cli_tmp/g.png"
     # --quality final: long enough (about 30 s) that the signal comes midway even on an idle machine.
