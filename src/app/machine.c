@@ -7,7 +7,6 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
-#include <unistd.h>
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
@@ -114,7 +113,7 @@ ps_status ps_machine_measure(const char *scene_path, ps_machine *out, ps_error *
 {
     memset(out, 0, sizeof *out);
     read_cpu(out->cpu, sizeof out->cpu);
-    out->cores = sysconf(_SC_NPROCESSORS_ONLN);
+    out->cores = ps_online_cores(); /* the tracer's own count: it is the tracer's cores that matter */
     out->load = read_load();
 #if defined(__linux__) && defined(MADV_HUGEPAGE) && defined(MADV_NOHUGEPAGE)
     /* Memory first: what this process frees, the kernel would hand back to

@@ -26,7 +26,7 @@
 
 typedef struct ps_machine {
     char cpu[128];           /* the processor's model name ("" unknown) */
-    long cores;              /* online cores */
+    long cores;              /* online cores (ps_online_cores) */
     double load;             /* the 1-minute load average when measured (< 0: unknown) */
     double paths_per_second; /* the scene's photon paths traced a second on one thread */
     double fresh_ms_per_mib; /* first writes to memory never written, in 2 MiB pages where
