@@ -1191,6 +1191,62 @@ static void area_lights_refine(void **state)
     ps_scene_destroy(scene);
 }
 
+/* ps_session_work_pending: what a refresh has to do besides new photons
+ * (photosplat-snap waits for photons only without it): the first camera's
+ * view, lights refined and not yet rebuilt, an edit, a bake once the feed is
+ * over; none once a refresh has drawn them. */
+static void work_pending_besides_photons(void **state)
+{
+    (void)state;
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load("data/scenes/cornell-caustic-area.scn", NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_session_settings set = settings(scene, true);
+    set.progressive_lights = true;
+    ps_session *s = open_session(scene, &set);
+    ps_session_hold_lights(s, true);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    ps_camera_frame cam = camera(scene);
+    ps_session_frame f;
+    assert_true(ps_session_work_pending(s)); /* no view yet */
+    refresh(s, &cam, &f);
+    ps_session_drawn(s, 0.001);
+    assert_false(ps_session_work_pending(s));
+    assert_true(ps_session_refine_lights(s));
+    assert_true(ps_session_work_pending(s));
+    refresh(s, &cam, &f);
+    assert_true(f.lights_changed);
+    ps_session_drawn(s, 0.001);
+    assert_false(ps_session_work_pending(s));
+    assert_int_equal(ps_session_move_light(s, 0, ps_v3(0.1, 1.9, 0.0), &err), PS_OK);
+    assert_true(ps_session_work_pending(s));
+    ps_session_destroy(s);
+    /* Baking: pending while the bake is laid, one batch a refresh here
+     * (the budget's share 0), once the feed is over. */
+    set.progressive_lights = false;
+    set.bake = true;
+    set.splat = PS_SPLAT_TRIANGLES;
+    s = open_session(scene, &set);
+    ps_session_set_budget_share(s, 0.0);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    int laying = 0;
+    for (int i = 0; i < 1000 && !ps_session_settled(s); i++) {
+        refresh(s, &cam, &f);
+        ps_session_drawn(s, 0.001);
+        double p = ps_session_bake_progress(s, PS_MAP_CAUSTIC);
+        if (p >= 0.0 && p < 1.0) {
+            laying++;
+            assert_true(ps_session_work_pending(s));
+        }
+    }
+    assert_true(laying > 0);
+    assert_true(ps_session_settled(s));
+    assert_false(ps_session_work_pending(s));
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 /* A point light's progressive lights: the first picture's shadow maps at
  * PS_SESSION_COARSE_SHADOW_DIVISOR fewer texels a side, then the full side
  * as a level of its own (lights_changed with shadows_refined: the same
@@ -1346,6 +1402,7 @@ int main(void)
         cmocka_unit_test(first_round_on_its_own_threads),
         cmocka_unit_test(env_fill_counts_each_face),
         cmocka_unit_test(area_lights_refine),
+        cmocka_unit_test(work_pending_besides_photons),
         cmocka_unit_test(coarse_shadows_first),
         cmocka_unit_test(moving_camera_level_of_detail),
         cmocka_unit_test(moving_growth_held),

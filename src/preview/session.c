@@ -1234,6 +1234,20 @@ double ps_session_next_refresh(const ps_session *s, double at)
     return at + (s->moving ? PS_SESSION_STILL_SHARE : 1.0) * s->set.tau;
 }
 
+bool ps_session_work_pending(ps_session *s)
+{
+    if (s->edited || s->view_dirty || !s->have_cam || s->lights_pending || s->moving)
+        return true;
+    /* A bake is laid once the feed is over (ps_session_refresh). */
+    ps_feed_lock(s->feed);
+    bool pending = false, over = ps_feed_ended(s->feed) && !ps_feed_merge_pending(s->feed) &&
+                                 ps_feed_generation(s->feed) == s->feed_gen;
+    for (int k = 0; k < PS_MAP_COUNT && over; k++)
+        pending = pending || bake_pending(s, k, &ps_feed_maps(s->feed)[k]);
+    ps_feed_unlock(s->feed);
+    return pending;
+}
+
 bool ps_session_settled(ps_session *s)
 {
     /* A moving camera's picture (or an edit's first) is a level of detail,

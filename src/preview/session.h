@@ -437,6 +437,11 @@ void ps_session_direct_view(const ps_session *s, double *exposure, bool *direct)
  * its end and drawn (and baked, where settings.bake lays it), or tracing
  * held for good (paused, counter stopped). */
 bool ps_session_settled(ps_session *s);
+/* Whether the next refresh has work besides the photons that arrived: an
+ * edit or a new view to draw, lights to rebuild (ps_session_refine_lights),
+ * a bake to start or lay (once the feed is over). A caller may wait for
+ * photons only when not (photosplat-snap's float checkpoints). */
+bool ps_session_work_pending(ps_session *s);
 
 /* ---- settings ----------------------------------------------------------------- */
 
