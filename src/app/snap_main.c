@@ -928,7 +928,8 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             ps_session_set_budget_share(s->session, plan.share);
         }
         sleep_until(clock + plan.start);
-        await_photons(s, cp < o->checkpoint_count ? fmin(clock + o->checkpoints[cp], fmin(next, end)) : fmin(next, end));
+        double due = fmin(next, end);
+        await_photons(s, cp < o->checkpoint_count ? fmin(clock + o->checkpoints[cp], due) : due);
         /* 8 bits: the checkpoint's frame draws what fits from its start,
          * the photons there then (pace.h). */
         if (!s->layers && plan.shows) {
