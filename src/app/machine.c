@@ -12,12 +12,12 @@
 #endif
 
 #include "core/clock.h"
+#include "core/memory.h"
 #include "photon/photon_map.h"
 #include "photon/tracer.h"
 #include "photon/world.h"
 #include "scene/scene.h"
 
-#define LARGE_PAGE ((size_t)2 * 1024 * 1024)
 #define SMALL_PAGE ((size_t)4096)
 #define BYTES_PER_MIB (1024.0 * 1024.0)
 
@@ -62,11 +62,11 @@ static double read_load(void)
  * the kernel may back each with one. */
 static double first_writes(size_t bytes, bool large)
 {
-    size_t span = bytes + LARGE_PAGE;
+    size_t span = bytes + PS_MEMORY_LARGE_PAGE;
     char *map = mmap(NULL, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (map == MAP_FAILED)
         return -1.0;
-    volatile char *p = (char *)(((uintptr_t)map + LARGE_PAGE - 1) & ~(uintptr_t)(LARGE_PAGE - 1));
+    volatile char *p = (char *)(((uintptr_t)map + PS_MEMORY_LARGE_PAGE - 1) & ~(uintptr_t)(PS_MEMORY_LARGE_PAGE - 1));
     (void)madvise((void *)p, bytes, large ? MADV_HUGEPAGE : MADV_NOHUGEPAGE); /* advice only */
     double t0 = ps_now_seconds();
     for (size_t i = 0; i < bytes; i += SMALL_PAGE)

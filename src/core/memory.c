@@ -28,7 +28,6 @@ void ps_memory_set_drawing_policy(void)
 
 /* Not under ASan: mappings of our own would hide these arrays' bounds from it. */
 #if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(__SANITIZE_ADDRESS__)
-#define LARGE_PAGE ((size_t)2 * 1024 * 1024)
 #define HAVE_LARGE_PAGES 1
 #endif
 
@@ -47,9 +46,9 @@ void ps_memory_reserve_large_heap(size_t bytes)
     (void)mallopt(M_TRIM_THRESHOLD, (int)(bytes + PS_MEMORY_TRIM_THRESHOLD));
     /* A block larger than the heap's free top makes glibc grow the heap by
      * what it lacks and the pad (sbrk); freed, the block joins the top. */
-    size_t top = mallinfo2().keepcost, want = top + LARGE_PAGE;
+    size_t top = mallinfo2().keepcost, want = top + PS_MEMORY_LARGE_PAGE;
     if (want >= PS_MEMORY_HEAP_MAP_THRESHOLD)
-        want = PS_MEMORY_HEAP_MAP_THRESHOLD - LARGE_PAGE; /* the top holds most of it already */
+        want = PS_MEMORY_HEAP_MAP_THRESHOLD - PS_MEMORY_LARGE_PAGE; /* the top holds most of it already */
     (void)mallopt(M_TOP_PAD, (int)bytes);
     char *block = malloc(want);
     if (block) /* used, so that the compiler keeps the malloc and free it sees paired */
@@ -58,9 +57,9 @@ void ps_memory_reserve_large_heap(size_t bytes)
     (void)mallopt(M_TOP_PAD, GLIBC_TOP_PAD);
     /* Only the heap's end just grown (glibc may map a heap elsewhere when
      * sbrk fails: the block is then not below the break). */
-    if (block && end != (char *)-1 && end > block && (size_t)(end - block) <= want + bytes + LARGE_PAGE) {
-        uintptr_t from = ((uintptr_t)block + LARGE_PAGE - 1) & ~(uintptr_t)(LARGE_PAGE - 1);
-        uintptr_t to = (uintptr_t)end & ~(uintptr_t)(LARGE_PAGE - 1);
+    if (block && end != (char *)-1 && end > block && (size_t)(end - block) <= want + bytes + PS_MEMORY_LARGE_PAGE) {
+        uintptr_t from = ((uintptr_t)block + PS_MEMORY_LARGE_PAGE - 1) & ~(uintptr_t)(PS_MEMORY_LARGE_PAGE - 1);
+        uintptr_t to = (uintptr_t)end & ~(uintptr_t)(PS_MEMORY_LARGE_PAGE - 1);
         if (to > from)
             (void)madvise((void *)from, to - from, MADV_HUGEPAGE); /* advice: without it, small pages */
     }
@@ -73,19 +72,22 @@ void ps_memory_reserve_large_heap(size_t bytes)
 
 #ifdef HAVE_LARGE_PAGES
 
-static size_t large_span(size_t bytes) { return (bytes + LARGE_PAGE - 1) / LARGE_PAGE * LARGE_PAGE; }
+static size_t large_span(size_t bytes)
+{
+    return (bytes + PS_MEMORY_LARGE_PAGE - 1) / PS_MEMORY_LARGE_PAGE * PS_MEMORY_LARGE_PAGE;
+}
 
 /* span bytes (whole large pages) at a large page's boundary, advised: mapped
  * one page longer, the ends beside the boundary given back. */
 static void *map_large(size_t span)
 {
-    if (span > SIZE_MAX - LARGE_PAGE)
+    if (span > SIZE_MAX - PS_MEMORY_LARGE_PAGE)
         return NULL;
-    size_t over = span + LARGE_PAGE;
+    size_t over = span + PS_MEMORY_LARGE_PAGE;
     char *m = mmap(NULL, over, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (m == MAP_FAILED)
         return NULL;
-    char *a = (char *)(((uintptr_t)m + LARGE_PAGE - 1) & ~(uintptr_t)(LARGE_PAGE - 1));
+    char *a = (char *)(((uintptr_t)m + PS_MEMORY_LARGE_PAGE - 1) & ~(uintptr_t)(PS_MEMORY_LARGE_PAGE - 1));
     if (a > m)
         munmap(m, (size_t)(a - m));
     if (m + over > a + span)

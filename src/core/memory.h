@@ -88,6 +88,11 @@ void ps_memory_set_drawing_policy(void);
 #define PS_MEMORY_SNAP_HEAP ((size_t)1024 * 1024 * 1024)
 void ps_memory_reserve_large_heap(size_t bytes);
 
+/* The large page the kernel backs advised memory with (x86-64's 2 MiB
+ * transparent huge page): snap's heap and large arrays are aligned to it, and
+ * photosplat-bench times first writes in it (app/machine.h). */
+#define PS_MEMORY_LARGE_PAGE ((size_t)2 * 1024 * 1024)
+
 /* Large arrays that the kernel may back with 2 MiB pages (Linux's
  * transparent huge pages, which it gives to memory advised for them, as
  * here): the first write to each 2 MiB is one page fault instead of 512. A
