@@ -24,14 +24,18 @@
 #define GLOBAL_CAP 10000
 #define EXPOSURE 0.3
 
-static ps_scene *load(void)
+#define AREA_SCENE "data/scenes/cornell-caustic-area.scn"
+
+static ps_scene *load_path(const char *path)
 {
     ps_scene *scene;
     ps_error err;
-    if (ps_scene_load(SCENE, NULL, &scene, &err) != PS_OK)
+    if (ps_scene_load(path, NULL, &scene, &err) != PS_OK)
         fail_msg("scene: %s", err.msg);
     return scene;
 }
+
+static ps_scene *load(void) { return load_path(SCENE); }
 
 static ps_session_settings settings(const ps_scene *scene, bool incremental)
 {
@@ -43,6 +47,14 @@ static ps_session_settings settings(const ps_scene *scene, bool incremental)
     set.exposure = EXPOSURE;
     set.float_buffer = incremental;
     set.incremental = incremental;
+    return set;
+}
+
+/* Incremental, with progressive lights (the window's and snap's --time). */
+static ps_session_settings progressive_settings(const ps_scene *scene)
+{
+    ps_session_settings set = settings(scene, true);
+    set.progressive_lights = true;
     return set;
 }
 
@@ -1127,12 +1139,9 @@ static void still_lookups_prepared_while_waiting(void **state)
 static void area_lights_refine(void **state)
 {
     (void)state;
-    ps_scene *scene;
+    ps_scene *scene = load_path(AREA_SCENE);
     ps_error err;
-    if (ps_scene_load("data/scenes/cornell-caustic-area.scn", NULL, &scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_session_settings set = settings(scene, true);
-    set.progressive_lights = true;
+    ps_session_settings set = progressive_settings(scene);
     ps_session *s = open_session(scene, &set);
     assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
     ps_camera_frame cam = camera(scene);
@@ -1198,12 +1207,9 @@ static void area_lights_refine(void **state)
 static void work_pending_besides_photons(void **state)
 {
     (void)state;
-    ps_scene *scene;
+    ps_scene *scene = load_path(AREA_SCENE);
     ps_error err;
-    if (ps_scene_load("data/scenes/cornell-caustic-area.scn", NULL, &scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_session_settings set = settings(scene, true);
-    set.progressive_lights = true;
+    ps_session_settings set = progressive_settings(scene);
     ps_session *s = open_session(scene, &set);
     ps_session_hold_lights(s, true);
     assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
@@ -1256,10 +1262,8 @@ static void work_pending_besides_photons(void **state)
 static void coarse_shadows_first(void **state)
 {
     (void)state;
-    ps_scene *scene;
+    ps_scene *scene = load_path(SCENE);
     ps_error err;
-    if (ps_scene_load("data/scenes/cornell-caustic.scn", NULL, &scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
     ps_camera_frame cam = camera(scene);
     ps_session_frame f;
     const int sides[3] = {1024, 512, PS_SESSION_COARSE_SHADOW_MIN};
