@@ -111,8 +111,7 @@ awk_true "$first < $first_by" && ok || bad "float checkpoints: the first picture
 # Float checkpoints: a refresh that would find nothing new waits for the
 # tracer's next batch or its time instead (snap_main.c, await_photons). Before,
 # the frame planned at once for a checkpoint drew nothing, ended before it and
-# was planned again: 685-5997 refreshes in runs like these (none in some), now
-# 9-14.
+# was planned again: 685-4961 refreshes in runs like these, now 9-14.
 most=0
 for run in 1 2 3; do
     expect_success "float waits for photons ($run)" "$snap" "$scene" --size 128x128 --splat points --color-depth float \
