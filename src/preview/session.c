@@ -786,6 +786,19 @@ static ps_status bake_step(ps_session *s, int k, const ps_photon_map *m, const p
     return PS_OK;
 }
 
+/* Under the lock: nothing more will arrive for the maps drawn now (the feed
+ * ended, no repair's merge pending, the same generation). */
+static bool feed_over(const ps_session *s)
+{
+    return ps_feed_ended(s->feed) && !ps_feed_merge_pending(s->feed) && ps_feed_generation(s->feed) == s->feed_gen;
+}
+
+/* A view still to draw: an edit, a new or moving camera, lights to rebuild. */
+static bool view_pending(const ps_session *s)
+{
+    return s->edited || s->view_dirty || !s->have_cam || s->lights_pending || s->moving;
+}
+
 /* Whether map k still waits to be baked (ps_session_settled), under the lock. */
 static bool bake_pending(const ps_session *s, int k, const ps_photon_map *m)
 {
@@ -1024,9 +1037,9 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     }
     /* Baking (settings.bake): once nothing more will arrive and a still
      * view shows every photon of the map, its textures are laid. */
-    bool feed_over = ps_feed_ended(s->feed) && !ps_feed_merge_pending(s->feed) && ps_feed_generation(s->feed) == s->feed_gen;
+    bool over = feed_over(s);
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++)
-        if (feed_over && !s->moving && bake_pending(s, k, &maps[k]) && s->drawn[k] >= maps[k].count)
+        if (over && !s->moving && bake_pending(s, k, &maps[k]) && s->drawn[k] >= maps[k].count)
             st = bake_step(s, k, &maps[k], k == PS_MAP_GLOBAL ? global_mats : materials, out, err);
     bool whole = true;
     for (int k = 0; k < PS_MAP_COUNT; k++)
@@ -1236,12 +1249,11 @@ double ps_session_next_refresh(const ps_session *s, double at)
 
 bool ps_session_work_pending(ps_session *s)
 {
-    if (s->edited || s->view_dirty || !s->have_cam || s->lights_pending || s->moving)
+    if (view_pending(s))
         return true;
     /* A bake is laid once the feed is over (ps_session_refresh). */
     ps_feed_lock(s->feed);
-    bool pending = false, over = ps_feed_ended(s->feed) && !ps_feed_merge_pending(s->feed) &&
-                                 ps_feed_generation(s->feed) == s->feed_gen;
+    bool pending = false, over = feed_over(s);
     for (int k = 0; k < PS_MAP_COUNT && over; k++)
         pending = pending || bake_pending(s, k, &ps_feed_maps(s->feed)[k]);
     ps_feed_unlock(s->feed);
@@ -1252,13 +1264,12 @@ bool ps_session_settled(ps_session *s)
 {
     /* A moving camera's picture (or an edit's first) is a level of detail,
      * whatever it drew: the full view is still to come. */
-    if (s->edited || s->view_dirty || !s->have_cam || s->lights_pending || s->moving)
+    if (view_pending(s))
         return false;
     if (s->user_paused || s->counter_stopped)
         return true;
     ps_feed_lock(s->feed);
-    bool over = ps_feed_ended(s->feed) && !ps_feed_merge_pending(s->feed) &&
-                ps_feed_generation(s->feed) == s->feed_gen;
+    bool over = feed_over(s);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         over = over && s->drawn[k] >= ps_feed_maps(s->feed)[k].count && !bake_pending(s, k, &ps_feed_maps(s->feed)[k]);
     ps_feed_unlock(s->feed);
