@@ -745,6 +745,53 @@ static void eye_paths_wait_for_a_cube(void **state)
     }
 }
 
+/* A paths deadline (photosplat-snap's 8-bit checkpoint frames): once a
+ * cube is shown, the owed eye paths are traced only until it, and the layer
+ * stays black while some are still owed, refresh after refresh; without
+ * one, they are traced and the layer is what a session that traced them in
+ * its refresh draws. */
+static void paths_deadline_keeps_the_layer_black(void **state)
+{
+    (void)state;
+    ps_error err;
+    rig r[2];
+    for (int v = 0; v < 2; v++)
+        default_rig(&r[v]);
+    ps_session *s = r[0].session;
+    ps_session_set_specular_wait(s, true);
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_refresh(r[0].spec, r[0].gl, s, &f, 0, &err), PS_OK);
+    assert_true(ps_gl_specular_all_shown(r[0].spec, s));
+    ps_image pic[2];
+    for (int i = 0; i < 2; i++) { /* a deadline already past, two refreshes */
+        if (i > 0)
+            assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
+        assert_true(ps_session_specular_owed(s));
+        ps_gl_specular_set_paths_deadline(r[0].spec, ps_now_seconds() - 1.0);
+        ps_gl_begin_frame(r[0].gl, &r[0].cam, 1.0, false);
+        ps_gl_specular_draw(r[0].spec, r[0].gl, s, 1.0);
+        assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
+        assert_int_equal(lit_channels(&pic[0]), 0);
+        ps_image_destroy(&pic[0]);
+        assert_true(ps_session_specular_owed(s));
+        assert_false(ps_specular_pixel_points(ps_session_specular(s)).ready);
+    }
+    ps_gl_specular_set_paths_deadline(r[0].spec, 0.0);
+    assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
+    ps_gl_begin_frame(r[0].gl, &r[0].cam, 1.0, false);
+    ps_gl_specular_draw(r[0].spec, r[0].gl, s, 1.0);
+    assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
+    assert_false(ps_session_specular_owed(s));
+    assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready);
+    pic[1] = specular_alone(&r[1], false);
+    assert_same_lit_pictures("eye paths traced once the deadline is lifted", pic);
+    for (int v = 0; v < 2; v++) {
+        ps_image_destroy(&pic[v]);
+        rig_free(&r[v]);
+    }
+}
+
 /* The layered path (both programs' float pictures): while every cube is
  * black the layer is neither drawn nor added, and its eye paths wait; once
  * a cube is shown it is, the same floats as the direct drawing's. */
@@ -821,6 +868,7 @@ int main(void)
         cmocka_unit_test(eye_paths_wait_for_a_cube),
         cmocka_unit_test(held_round_guesses_an_untimed_face),
         cmocka_unit_test(layer_waits_for_a_cube),
+        cmocka_unit_test(paths_deadline_keeps_the_layer_black),
         cmocka_unit_test(refined_shadows_keep_the_round),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

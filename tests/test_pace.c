@@ -143,10 +143,12 @@ static void out_of_reach_and_defaults(void **state)
     assert_int_equal(p.target, 0);
     assert_near(p.start, 0.4, 1e-12);
     assert_true(p.faces_deadline <= p.start);
+    assert_near(p.end_by, 0.5 + PS_PACE_MARGIN * 0.6, 1e-12); /* its aim, later than 10 % after */
     ps_pace_model none = {0};
     p = ps_pace_next(&none, 0.05, 0.0, 0.1, cps, 3);
     assert_near(p.start, 0.1, 1e-12);
     assert_false(isfinite(p.faces_deadline));
+    assert_false(isfinite(p.end_by));
     p = ps_pace_next(&m, 0.05, 0.0, 0.1, cps, 0);
     assert_near(p.start, 0.1, 1e-12);
     assert_false(isfinite(p.faces_deadline));
@@ -386,11 +388,15 @@ static void unheld_faces_stay_out_of_the_checkpoints_frame(void **state)
     assert_true(p.hold_faces);
     assert_near(p.start, 0.4, 1e-12);
     assert_near(p.faces_deadline, last_end - 0.05 - 0.05 + 0.005, 1e-12);
-    /* At 0.46 s: the frame, held, its start as planned without them. */
+    assert_false(isfinite(p.end_by)); /* not the checkpoint's frame */
+    /* At 0.46 s: the frame, held, its start as planned without them; what
+     * comes after its splats (snap's owed eye paths) stops at
+     * PS_PACE_PATHS_LATE after the checkpoint. */
     p = ps_pace_next(&m, 0.46, 0.0, 0.46, &cp, 1);
     assert_true(p.shows && p.hold_faces);
     assert_near(p.start, cp + PS_PACE_MARGIN * 0.05 - 0.05, 1e-12);
     assert_near(p.faces_deadline, last_end - 0.05 + 0.005, 1e-12);
+    assert_near(p.end_by, cp * (1.0 + PS_PACE_PATHS_LATE), 1e-12);
     /* A second before: the refresh goes at once, faces and all. Its faces,
      * those it counts on included, end where the frame can still start
      * (ps_gl_specular starts none past it, whatever they were foreseen). */

@@ -69,7 +69,7 @@ static double photons_for(const ps_pace_model *m, double d)
 ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, double due, const double *pending,
                           int count)
 {
-    ps_pace_plan p = {fmax(now, due), HUGE_VAL, -1, HUGE_VAL, false, 1.0, false};
+    ps_pace_plan p = {fmax(now, due), HUGE_VAL, -1, HUGE_VAL, false, 1.0, false, HUGE_VAL};
     if (count <= 0)
         return p;
     p.start = fmax(now, fmin(due, pending[0]));
@@ -110,6 +110,7 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
          * room's 84 faces, 0.3-0.4 s, landed its 0.5 and 1 s checkpoints
          * at 0.86 and 1.32 s). */
         p.shows = p.hold_faces = true;
+        p.end_by = fmax(cp * (1.0 + PS_PACE_PATHS_LATE), aim);
         p.start = now >= ideal ? now : ideal;
         double n = photons + m->rate * (p.start - now);
         double d = fmin(shown_seconds(m, n), cap);

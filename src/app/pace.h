@@ -46,6 +46,15 @@
  * layer stayed black through every checkpoint of a 2 s run. */
 #define PS_PACE_FACES_LATE 0.1
 
+/* What comes last in the checkpoint's frame, after its faces and splats
+ * (photosplat-snap's owed eye paths, ps_gl_specular_set_paths_deadline), may
+ * make it end up to this share of its time after the checkpoint, where that
+ * is later than its aim: the prediction's error is spent by then, and of
+ * bench's 20 % this leaves the rest to the layer those paths feed. (At
+ * PS_PACE_FACES_LATE, the area box's 8-bit 0.5 s checkpoints showed the
+ * mirror black in 5 of 12, where drawn whole they had come at 0.50-0.61 s.) */
+#define PS_PACE_PATHS_LATE 0.15
+
 /* A whole refresh that shows a checkpoint lasts at most this share of the
  * checkpoint's time: aimed to end PS_PACE_MARGIN of its length after the
  * checkpoint, a prediction off by up to that margin then ends it between the
@@ -63,9 +72,13 @@
 #define PS_PACE_SHOWN_BUDGET 0.25
 
 /* A cube face never timed, where a deadline foresees it (a wait, a held
- * first round: ps_gl_specular_set_face_guess), as this share of the last
- * refresh's time without faces. (The bench's first faces took 0.1-0.4x the
- * first frame at 256^2. Let start at once, the first rode in the 0.1 s
+ * first round: ps_gl_specular_set_face_guess), as this share of the first
+ * refresh's time without faces, or of the last one's where that is longer.
+ * (The bench's first faces took 0.1-0.4x the first frame at 256^2, which
+ * holds llvmpipe's first compiles as the first face does; foreseen from the
+ * ring's 8-bit refreshes of 0.007-0.008 s after it, its first face, 0.015-
+ * 0.022 s, rode in the 0.1 s checkpoint's frame and landed it at 0.115-
+ * 0.129 s. Let start at once, the first rode in the 0.1 s
  * checkpoint's frame and made it late; kept out of those frames with the
  * waits' guess the whole last frame, it waited past 0.2 s, and the mirrors
  * were wholly black there in 42-44 of the bench's 48 configurations
@@ -146,6 +159,9 @@ typedef struct ps_pace_plan {
                              * faces_deadline too (ps_gl_specular_hold_first_round): the
                              * checkpoint's frame, and a refresh before it that would
                              * delay it with them */
+    double end_by;          /* shows: when what comes last in it, after its faces and
+                             * splats, stops (snap's owed eye paths): PS_PACE_PATHS_LATE
+                             * after the checkpoint, or its aim if later. Else HUGE_VAL */
 } ps_pace_plan;
 
 /* The next refresh, at `now` with `photons` emitted, due at `due` (tau's

@@ -223,6 +223,8 @@ typedef struct snap_run {
     double shadow_per_light;    /* ... and a virtual light's shadow cube, seconds (0: not timed) */
     bool lights_held;           /* area lights refined in the waits (ps_session_hold_lights) */
     double lit_seconds;         /* the last refresh with new lights, less its cube faces (0: none yet) */
+    double first_seconds;       /* the first refresh's time without cube faces, as the pace
+                                 * learned it (0: not yet): a face never timed is guessed from it */
     bool probed;                /* --time, 8 bits: the last picture's cost learned (probe_redraw) */
     bool drew_nothing;          /* the last refresh drew no splat and no cube face, and took
                                  * under SNAP_AWAIT_POLL */
@@ -746,7 +748,9 @@ static ps_pace_plan plan_refresh(snap_run *s, double clock, double due, int cp, 
      * draws them (held only where the plan says, refine). */
     if (s->layers)
         ps_gl_specular_hold_first_round(s->spec, false);
-    ps_gl_specular_set_face_guess(s->spec, PS_PACE_FACE_GUESS * s->pace.seconds);
+    if (s->first_seconds <= 0.0)
+        s->first_seconds = s->pace.seconds;
+    ps_gl_specular_set_face_guess(s->spec, PS_PACE_FACE_GUESS * fmax(s->pace.seconds, s->first_seconds));
     s->pace.unheld = ps_gl_specular_unheld_seconds(s->spec, s->session);
     /* A refresh draws no fewer photons than the last checkpoint showed (refine's most[]). */
     s->pace.least = s->shown[0] + s->shown[1];
@@ -769,10 +773,13 @@ static ps_status unseen_batch(snap_run *s, ps_error *err)
 {
     const double one[PS_MAP_COUNT] = {0.0, 0.0};
     ps_session_set_whole_most(s->session, one);
-    ps_gl_specular_set_deadline(s->spec, ps_now_seconds());
+    double now = ps_now_seconds();
+    ps_gl_specular_set_deadline(s->spec, now);
+    ps_gl_specular_set_paths_deadline(s->spec, now); /* the waits trace them (ps_gl_specular_idle) */
     ps_session_hold(s->session, true);
     ps_status st = refresh(s, err);
     ps_session_hold(s->session, false);
+    ps_gl_specular_set_paths_deadline(s->spec, 0.0);
     return st;
 }
 
@@ -956,6 +963,16 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         bool hold = !s->layers && cp < o->checkpoint_count;
         if (hold)
             ps_session_hold(s->session, true);
+        /* 8 bits: the eye paths owed while every cube was black, traced in
+         * the checkpoint's frame only until PS_PACE_PATHS_LATE after it
+         * (the layer black while some are left), the rest in the waits
+         * after: all of them, in the frame that first showed a cube, took
+         * the ring's 0.2 s checkpoint to 0.25 s. Kept while the checkpoint
+         * is written, whose layer files draw the specular layer again: as
+         * the picture showed it (reset after, the files' picture less its
+         * specular layer had relMSE 18-34 where it was black). */
+        if (!s->layers && plan.shows)
+            ps_gl_specular_set_paths_deadline(s->spec, clock + plan.end_by);
         st = refresh(s, err);
         if (hold)
             ps_session_hold(s->session, false);
@@ -984,6 +1001,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             if (st != PS_OK)
                 break;
         }
+        ps_gl_specular_set_paths_deadline(s->spec, 0.0);
         next = ps_pace_next_due(next, ps_now_seconds(), o->p.tau);
         /* Every photon traced, or the error counter stopped the tracer:
          * checkpoints still to come get their own frames, on time, and the
@@ -997,6 +1015,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
             break;
     }
     ps_gl_specular_set_deadline(s->spec, 0.0);
+    ps_gl_specular_set_paths_deadline(s->spec, 0.0);
     ps_session_set_whole_most(s->session, NULL);
     ps_session_set_budget_share(s->session, 1.0); /* the last picture catches up at the whole budget */
     st = last_picture(s, st, err);

@@ -75,6 +75,7 @@ struct ps_gl_specular {
     double deadline;
     bool idle; /* ps_gl_specular_idle: faces while they fit, the first round's too */
     double face_guess; /* ps_gl_specular_set_face_guess */
+    double paths_deadline; /* ps_gl_specular_set_paths_deadline (0: none) */
     bool first_held; /* ps_gl_specular_hold_first_round */
     /* Cubes shown since the last edit, layer set or cube set (bit c). The
      * first round shows each once, quick and whatever the budget; new
@@ -100,6 +101,8 @@ struct ps_gl_specular {
 };
 
 void ps_gl_specular_set_deadline(ps_gl_specular *g, double at) { g->deadline = at > 0.0 ? at : 0.0; }
+
+void ps_gl_specular_set_paths_deadline(ps_gl_specular *g, double at) { g->paths_deadline = at > 0.0 ? at : 0.0; }
 
 bool ps_gl_specular_face_fits(double now, double at, double estimate) { return at <= 0.0 || now + estimate <= at; }
 
@@ -842,15 +845,20 @@ static void draw_full(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, doubl
     }
 }
 
-/* Whether a cube shows a picture to look up: until one does, the layer is
- * black and the session leaves its eye paths owed (ps_session_set_specular_wait);
- * once one does, what it left owed is traced before the layer is drawn. */
+/* Whether the layer is drawn: until a cube shows a picture to look up, it
+ * is black and the session leaves its eye paths owed
+ * (ps_session_set_specular_wait); once one does, what it left owed is traced
+ * before the layer is drawn, under ps_gl_specular_set_paths_deadline only
+ * until then, and the layer stays black while some are still owed. */
 static bool eye_paths_for_cubes(ps_gl_specular *g, ps_session *s)
 {
-    if (g->lit)
+    if (g->lit && g->paths_deadline > 0.0)
+        ps_session_trace_specular_until(s, g->paths_deadline);
+    else if (g->lit)
         ps_session_trace_specular(s);
-    ps_session_set_specular_wait(s, !g->lit);
-    return g->lit;
+    bool drawn = g->lit && !ps_session_specular_owed(s);
+    ps_session_set_specular_wait(s, !drawn);
+    return drawn;
 }
 
 void ps_gl_specular_draw(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, double exposure)

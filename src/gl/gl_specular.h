@@ -96,6 +96,15 @@ void ps_gl_specular_set_face_guess(ps_gl_specular *g, double seconds);
  * (ps_gl_specular_hold_first_round), are not foreseen against it but still
  * start only before it. */
 void ps_gl_specular_set_deadline(ps_gl_specular *g, double at);
+/* The eye paths a refresh left owed while every cube was black (the
+ * session's specular_wait: the mirrors' lookups and per-pixel paths, all
+ * traced in the refresh that first shows a cube) are traced only until
+ * `at` (ps_now_seconds' clock; 0, the default: all of them); the layer
+ * stays black in a picture while some are still owed, and the next
+ * refreshes and waits (ps_gl_specular_idle) trace on from where it stopped.
+ * photosplat-snap's 8-bit checkpoint frames: the ring's 0.04 s of them
+ * landed its 0.2 s checkpoint at 0.25 s. */
+void ps_gl_specular_set_paths_deadline(ps_gl_specular *g, double at);
 /* Whether a face predicted to take `estimate` seconds (0: not timed yet,
  * allowed until the deadline) may start at `now` under deadline `at` (0:
  * none). */

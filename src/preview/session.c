@@ -850,6 +850,8 @@ void ps_session_trace_specular(ps_session *s)
     trace_eye_paths(s, &s->owed_view, &s->cam, s->owed_moving);
 }
 
+bool ps_session_specular_owed(const ps_session *s) { return s->specular_owed; }
+
 void ps_session_trace_specular_until(ps_session *s, double deadline)
 {
     /* Lookups a slice at a time, then the per-pixel paths to the deadline:

@@ -395,6 +395,8 @@ void ps_session_trace_specular(ps_session *s);
 /* The same ahead of need, in a wait that ends at `deadline` (on
  * ps_now_seconds' clock): as much of them as fits, the rest still owed. */
 void ps_session_trace_specular_until(ps_session *s, double deadline);
+/* Whether the last refresh's eye paths are still owed (some not traced). */
+bool ps_session_specular_owed(const ps_session *s);
 
 /* While the program would sleep after a moving camera's picture (until
  * ps_session_next_refresh), the work that camera's still view starts with,
