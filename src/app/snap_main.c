@@ -963,15 +963,17 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         bool hold = !s->layers && cp < o->checkpoint_count;
         if (hold)
             ps_session_hold(s->session, true);
-        /* 8 bits: the eye paths owed while every cube was black, traced in
-         * the checkpoint's frame only until PS_PACE_PATHS_LATE after it
-         * (the layer black while some are left), the rest in the waits
-         * after: all of them, in the frame that first showed a cube, took
-         * the ring's 0.2 s checkpoint to 0.25 s. Kept while the checkpoint
-         * is written, whose layer files draw the specular layer again: as
-         * the picture showed it (reset after, the files' picture less its
-         * specular layer had relMSE 18-34 where it was black). */
-        if (!s->layers && plan.shows)
+        /* The eye paths owed while every cube was black, traced in the
+         * checkpoint's frame only until PS_PACE_PATHS_LATE after it (the
+         * layer black while some are left), the rest in the waits and
+         * refreshes after: all of them, in the frame that first showed a
+         * cube, took the ring's 8-bit 0.2 s checkpoint to 0.25 s, and with
+         * the layer's first drawing the design room's float one to 0.25-
+         * 0.29 s. Kept while the checkpoint is written, whose 8-bit layer
+         * files draw the specular layer again: as the picture showed it
+         * (reset after, the files' picture less its specular layer had
+         * relMSE 18-34 where it was black). */
+        if (plan.shows)
             ps_gl_specular_set_paths_deadline(s->spec, clock + plan.end_by);
         st = refresh(s, err);
         if (hold)

@@ -102,8 +102,8 @@ void ps_gl_specular_set_deadline(ps_gl_specular *g, double at);
  * `at` (ps_now_seconds' clock; 0, the default: all of them); the layer
  * stays black in a picture while some are still owed, and the next
  * refreshes and waits (ps_gl_specular_idle) trace on from where it stopped.
- * photosplat-snap's 8-bit checkpoint frames: the ring's 0.04 s of them
- * landed its 0.2 s checkpoint at 0.25 s. */
+ * photosplat-snap's checkpoint frames: the ring's 0.04 s of them landed
+ * its 8-bit 0.2 s checkpoint at 0.25 s. */
 void ps_gl_specular_set_paths_deadline(ps_gl_specular *g, double at);
 /* Whether a face predicted to take `estimate` seconds (0: not timed yet,
  * allowed until the deadline) may start at `now` under deadline `at` (0:
