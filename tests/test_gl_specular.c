@@ -745,50 +745,72 @@ static void eye_paths_wait_for_a_cube(void **state)
     }
 }
 
-/* A paths deadline (photosplat-snap's 8-bit checkpoint frames): once a
- * cube is shown, the owed eye paths are traced only until it, and the layer
- * stays black while some are still owed, refresh after refresh; without
- * one, they are traced and the layer is what a session that traced them in
- * its refresh draws. */
+/* The specular layer of `r`'s last refresh f, drawn directly (`layers`
+ * NULL: snap's 8-bit frames) or as a float layer, into *pic. */
+static void draw_specular(rig *r, ps_gl_layers *layers, const ps_session_frame *f, ps_image *pic)
+{
+    ps_error err;
+    if (!layers) {
+        ps_gl_begin_frame(r->gl, &r->cam, 1.0, false);
+        ps_gl_specular_draw(r->spec, r->gl, r->session, 1.0);
+        assert_int_equal(ps_gl_read(r->gl, pic, &err), PS_OK);
+        return;
+    }
+    const double none[PS_MAP_COUNT] = {0.0, 0.0};
+    ps_gl_layers_view(layers, r->gl, &r->cam, 1.0, false);
+    assert_int_equal(ps_gl_specular_layer(r->spec, layers, r->gl, r->session, f, &err), PS_OK);
+    assert_int_equal(ps_gl_layers_composite(layers, 0.0, none, pic, &err), PS_OK);
+}
+
+/* A paths deadline (photosplat-snap's checkpoint frames, 8-bit and float):
+ * once a cube is shown, the owed eye paths are traced only until it, and the
+ * layer stays black while some are still owed, refresh after refresh;
+ * without one, they are traced and the layer is what a session that traced
+ * them in its refresh draws. */
 static void paths_deadline_keeps_the_layer_black(void **state)
 {
     (void)state;
     ps_error err;
-    rig r[2];
-    for (int v = 0; v < 2; v++)
-        default_rig(&r[v]);
-    ps_session *s = r[0].session;
-    ps_session_set_specular_wait(s, true);
-    ps_session_frame f;
-    assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
-    assert_int_equal(ps_gl_specular_refresh(r[0].spec, r[0].gl, s, &f, 0, &err), PS_OK);
-    assert_true(ps_gl_specular_all_shown(r[0].spec, s));
-    ps_image pic[2];
-    for (int i = 0; i < 2; i++) { /* a deadline already past, two refreshes */
-        if (i > 0)
-            assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
-        assert_true(ps_session_specular_owed(s));
-        ps_gl_specular_set_paths_deadline(r[0].spec, ps_now_seconds() - 1.0);
-        ps_gl_begin_frame(r[0].gl, &r[0].cam, 1.0, false);
-        ps_gl_specular_draw(r[0].spec, r[0].gl, s, 1.0);
-        assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
-        assert_int_equal(lit_channels(&pic[0]), 0);
-        ps_image_destroy(&pic[0]);
-        assert_true(ps_session_specular_owed(s));
-        assert_false(ps_specular_pixel_points(ps_session_specular(s)).ready);
-    }
-    ps_gl_specular_set_paths_deadline(r[0].spec, 0.0);
-    assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
-    ps_gl_begin_frame(r[0].gl, &r[0].cam, 1.0, false);
-    ps_gl_specular_draw(r[0].spec, r[0].gl, s, 1.0);
-    assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
-    assert_false(ps_session_specular_owed(s));
-    assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready);
-    pic[1] = specular_alone(&r[1], false);
-    assert_same_lit_pictures("eye paths traced once the deadline is lifted", pic);
-    for (int v = 0; v < 2; v++) {
-        ps_image_destroy(&pic[v]);
-        rig_free(&r[v]);
+    for (int path = 0; path < 2; path++) {
+        rig r[2];
+        for (int v = 0; v < 2; v++)
+            default_rig(&r[v]);
+        ps_session *s = r[0].session;
+        ps_gl_layers *layers = NULL;
+        if (path == 1)
+            assert_int_equal(ps_gl_layers_create(r[0].w, r[0].h, true, &layers, &err), PS_OK);
+        ps_session_set_specular_wait(s, true);
+        ps_session_frame f;
+        assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(r[0].spec, r[0].gl, s, &f, 0, &err), PS_OK);
+        assert_true(ps_gl_specular_all_shown(r[0].spec, s));
+        ps_image pic[2];
+        for (int i = 0; i < 2; i++) { /* a deadline already past, two refreshes */
+            if (i > 0)
+                assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
+            assert_true(ps_session_specular_owed(s));
+            ps_gl_specular_set_paths_deadline(r[0].spec, ps_now_seconds() - 1.0);
+            draw_specular(&r[0], layers, &f, &pic[0]);
+            assert_int_equal(lit_channels(&pic[0]), 0);
+            ps_image_destroy(&pic[0]);
+            assert_true(ps_session_specular_owed(s));
+            assert_false(ps_specular_pixel_points(ps_session_specular(s)).ready);
+        }
+        ps_gl_specular_set_paths_deadline(r[0].spec, 0.0);
+        assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
+        draw_specular(&r[0], layers, &f, &pic[0]);
+        assert_false(ps_session_specular_owed(s));
+        assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready);
+        pic[1] = specular_alone(&r[1], false);
+        assert_same_lit_pictures(path == 0 ? "eye paths traced once the deadline is lifted"
+                                           : "the same, as a float layer",
+                                 pic);
+        if (layers)
+            ps_gl_layers_destroy(layers);
+        for (int v = 0; v < 2; v++) {
+            ps_image_destroy(&pic[v]);
+            rig_free(&r[v]);
+        }
     }
 }
 
