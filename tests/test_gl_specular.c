@@ -708,6 +708,24 @@ static void idle_draws_the_round_in_a_wait(void **state)
     rig_free(&r);
 }
 
+/* The specular layer of `r`'s last refresh, drawn directly (`layers`
+ * NULL: snap's 8-bit frames; f unused) or as a float layer of refresh f,
+ * into *pic. */
+static void draw_specular(rig *r, ps_gl_layers *layers, const ps_session_frame *f, ps_image *pic)
+{
+    ps_error err;
+    if (!layers) {
+        ps_gl_begin_frame(r->gl, &r->cam, 1.0, false);
+        ps_gl_specular_draw(r->spec, r->gl, r->session, 1.0);
+        assert_int_equal(ps_gl_read(r->gl, pic, &err), PS_OK);
+        return;
+    }
+    const double none[PS_MAP_COUNT] = {0.0, 0.0};
+    ps_gl_layers_view(layers, r->gl, &r->cam, 1.0, false);
+    assert_int_equal(ps_gl_specular_layer(r->spec, layers, r->gl, r->session, f, &err), PS_OK);
+    assert_int_equal(ps_gl_layers_composite(layers, 0.0, none, pic, &err), PS_OK);
+}
+
 /* Both programs' sessions leave the specular layer's eye paths owed while
  * no cube is shown (ps_session_set_specular_wait): the layer is black then
  * and traces nothing; once a cube is shown it traces them and draws the
@@ -725,17 +743,13 @@ static void eye_paths_wait_for_a_cube(void **state)
     assert_int_equal(ps_session_refresh(s, &r[0].cam, &f, &err), PS_OK);
     assert_true(f.specular);
     ps_image pic[2];
-    ps_gl_begin_frame(r[0].gl, &r[0].cam, 1.0, false);
-    ps_gl_specular_draw(r[0].spec, r[0].gl, s, 1.0);
-    assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
+    draw_specular(&r[0], NULL, &f, &pic[0]);
     assert_int_equal(lit_channels(&pic[0]), 0);
     ps_image_destroy(&pic[0]);
     assert_false(ps_specular_pixel_points(ps_session_specular(s)).ready);
     /* Every face rendered, the cubes shown: traced, and drawn. */
     assert_int_equal(ps_gl_specular_refresh(r[0].spec, r[0].gl, s, &f, 0, &err), PS_OK);
-    ps_gl_begin_frame(r[0].gl, &r[0].cam, 1.0, false);
-    ps_gl_specular_draw(r[0].spec, r[0].gl, s, 1.0);
-    assert_int_equal(ps_gl_read(r[0].gl, &pic[0], &err), PS_OK);
+    draw_specular(&r[0], NULL, &f, &pic[0]);
     assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready);
     pic[1] = specular_alone(&r[1], false);
     assert_same_lit_pictures("eye paths owed until a cube is shown", pic);
@@ -743,23 +757,6 @@ static void eye_paths_wait_for_a_cube(void **state)
         ps_image_destroy(&pic[v]);
         rig_free(&r[v]);
     }
-}
-
-/* The specular layer of `r`'s last refresh f, drawn directly (`layers`
- * NULL: snap's 8-bit frames) or as a float layer, into *pic. */
-static void draw_specular(rig *r, ps_gl_layers *layers, const ps_session_frame *f, ps_image *pic)
-{
-    ps_error err;
-    if (!layers) {
-        ps_gl_begin_frame(r->gl, &r->cam, 1.0, false);
-        ps_gl_specular_draw(r->spec, r->gl, r->session, 1.0);
-        assert_int_equal(ps_gl_read(r->gl, pic, &err), PS_OK);
-        return;
-    }
-    const double none[PS_MAP_COUNT] = {0.0, 0.0};
-    ps_gl_layers_view(layers, r->gl, &r->cam, 1.0, false);
-    assert_int_equal(ps_gl_specular_layer(r->spec, layers, r->gl, r->session, f, &err), PS_OK);
-    assert_int_equal(ps_gl_layers_composite(layers, 0.0, none, pic, &err), PS_OK);
 }
 
 /* A paths deadline (photosplat-snap's checkpoint frames, 8-bit and float):
@@ -827,7 +824,6 @@ static void layer_waits_for_a_cube(void **state)
     ps_session_set_specular_wait(s, true);
     ps_gl_layers *l;
     assert_int_equal(ps_gl_layers_create(r.w, r.h, true, &l, &err), PS_OK);
-    const double none[PS_MAP_COUNT] = {0.0, 0.0};
     ps_image pic[2];
     for (int v = 0; v < 2; v++) {
         ps_session_frame f;
@@ -835,9 +831,7 @@ static void layer_waits_for_a_cube(void **state)
         assert_true(f.specular);
         if (v == 1) /* every face, the cubes shown */
             assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 0, &err), PS_OK);
-        ps_gl_layers_view(l, r.gl, &r.cam, 1.0, false);
-        assert_int_equal(ps_gl_specular_layer(r.spec, l, r.gl, s, &f, &err), PS_OK);
-        assert_int_equal(ps_gl_layers_composite(l, 0.0, none, &pic[v], &err), PS_OK);
+        draw_specular(&r, l, &f, &pic[v]);
         assert_true(ps_specular_pixel_points(ps_session_specular(s)).ready == (v == 1));
         if (v == 0) {
             assert_int_equal(lit_channels(&pic[v]), 0);
@@ -846,9 +840,7 @@ static void layer_waits_for_a_cube(void **state)
     }
     /* The same floats as drawn directly. */
     ps_image drawn[2] = {pic[1]};
-    ps_gl_begin_frame(r.gl, &r.cam, 1.0, false);
-    ps_gl_specular_draw(r.spec, r.gl, s, 1.0);
-    assert_int_equal(ps_gl_read(r.gl, &drawn[1], &err), PS_OK);
+    draw_specular(&r, NULL, NULL, &drawn[1]); /* directly: no frame needed */
     assert_same_lit_pictures("the layered path once a cube is shown", drawn);
     for (int v = 0; v < 2; v++)
         ps_image_destroy(&drawn[v]);
