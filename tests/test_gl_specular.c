@@ -848,6 +848,45 @@ static void layer_waits_for_a_cube(void **state)
     rig_free(&r);
 }
 
+/* Cube maps are made as faces are rendered into them: none for a first
+ * picture, whose faces wait (black maps of every cube's own, shown and
+ * back, took the design room's first frame 6-25 ms); a cube's shown map
+ * once it is whole, its back map again for the next round. Cubes never
+ * shown draw black (layer_waits_for_a_cube), and a round drawn again shows
+ * the same picture. */
+static void cube_maps_made_as_faces_are_rendered(void **state)
+{
+    (void)state;
+    ps_error err;
+    rig r;
+    default_rig(&r);
+    ps_session *s = r.session;
+    int cubes = ps_specular_cube_count(ps_session_specular(s));
+    assert_true(cubes >= 2); /* the mirror and the glass sphere */
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+    assert_true(f.specular && f.new_view);
+    assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 3, &err), PS_OK);
+    assert_int_equal(ps_gl_specular_faces_rendered(r.spec), 0);
+    assert_int_equal(ps_gl_specular_maps(r.spec), 0);
+    ps_image pic[2];
+    for (int round = 0; round < 2; round++) {
+        if (round == 1)
+            ps_gl_specular_redraw_all(r.spec);
+        assert_int_equal(ps_session_refresh(s, &r.cam, &f, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, s, &f, 0, &err), PS_OK);
+        assert_int_equal(ps_gl_specular_faces_rendered(r.spec), (unsigned)(6 * cubes * (round + 1)));
+        assert_int_equal(ps_gl_specular_maps(r.spec), cubes * (round + 1));
+        assert_true(ps_gl_specular_all_shown(r.spec, s));
+        draw_specular(&r, NULL, NULL, &pic[round]);
+        assert_true(lit_channels(&pic[round]) > 0);
+    }
+    assert_same_lit_pictures("a cube's second round", pic);
+    for (int k = 0; k < 2; k++)
+        ps_image_destroy(&pic[k]);
+    rig_free(&r);
+}
+
 /* A face foreseen from its fill (ps_gl_specular_face_foreseen): longer as
  * (fill now / fill then)^PS_GL_SPECULAR_FILL_GROWTH, never shorter, and as
  * it took when its fill is not known. */
@@ -873,6 +912,7 @@ int main(void)
         cmocka_unit_test(lit_triangles_draw_the_same),
         cmocka_unit_test(deadline_holds_faces),
         cmocka_unit_test(faces_foreseen_from_their_fill),
+        cmocka_unit_test(cube_maps_made_as_faces_are_rendered),
         cmocka_unit_test(a_settled_round_ends_whole),
         cmocka_unit_test(redraw_all_after_a_wait),
         cmocka_unit_test(refined_lights_keep_the_cubes),

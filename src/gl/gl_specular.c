@@ -30,8 +30,11 @@ struct ps_gl_specular {
      * from one centre since the last change (back_faces, a bit a face). A
      * map is never shown with faces from two places or two scenes: after
      * an edit the old one shows (its lookups looking from the old centre,
-     * ps_specular_set_lookup_centre) until the new one is whole. */
+     * ps_specular_set_lookup_centre) until the new one is whole. A cube
+     * never shown shows `black`; its back map is made when its first face
+     * is rendered into it (0 until then). */
     GLuint cube[PS_SPECULAR_MAX_CUBES], back[PS_SPECULAR_MAX_CUBES];
+    GLuint black; /* a 1x1 black cube map, shared */
     unsigned back_faces[PS_SPECULAR_MAX_CUBES];
     ps_vec3 back_centre[PS_SPECULAR_MAX_CUBES];
     int cube_count;
@@ -170,6 +173,40 @@ void ps_gl_specular_hold_first_round(ps_gl_specular *g, bool held) { g->first_he
 
 void ps_gl_specular_set_face_guess(ps_gl_specular *g, double seconds) { g->face_guess = seconds > 0.0 ? seconds : 0.0; }
 
+/* A cube map of side `size`, its texels as `texels` (RGBA floats, the same
+ * for every face) or left undefined (NULL) for one whose six faces are all
+ * rendered before it is shown. */
+static GLuint new_cube_texture(int size, const float *texels)
+{
+    GLuint tex;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, tex);
+    for (int f = 0; f < 6; f++)
+        glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_RGBA16F, size, size, 0, GL_RGBA, GL_FLOAT, texels);
+    ps_gl_cube_linear_clamped();
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    return tex;
+}
+
+/* Cube c's back map, made when a face is first rendered into it. */
+static GLuint back_map(ps_gl_specular *g, int c)
+{
+    if (!g->back[c])
+        g->back[c] = new_cube_texture(g->size, NULL);
+    return g->back[c];
+}
+
+static void delete_cubes(ps_gl_specular *g)
+{
+    for (int c = 0; c < g->cube_count; c++) {
+        if (g->cube[c] != g->black)
+            glDeleteTextures(1, &g->cube[c]);
+        if (g->back[c])
+            glDeleteTextures(1, &g->back[c]);
+        g->cube[c] = g->back[c] = 0;
+    }
+}
+
 ps_status ps_gl_specular_create(int cube_size, ps_gl_specular **out, ps_error *err)
 {
     *out = NULL;
@@ -196,10 +233,9 @@ void ps_gl_specular_destroy(ps_gl_specular *g)
 {
     if (!g)
         return;
-    if (g->cube_count) {
-        glDeleteTextures(g->cube_count, g->cube);
-        glDeleteTextures(g->cube_count, g->back);
-    }
+    delete_cubes(g);
+    if (g->black)
+        glDeleteTextures(1, &g->black);
     glDeleteFramebuffers(1, &g->fbo);
     glDeleteRenderbuffers(1, &g->depth_stencil);
     if (g->layer_tex)
@@ -216,6 +252,14 @@ void ps_gl_specular_destroy(ps_gl_specular *g)
 
 unsigned ps_gl_specular_faces_rendered(const ps_gl_specular *g) { return g->faces_rendered; }
 
+int ps_gl_specular_maps(const ps_gl_specular *g)
+{
+    int n = 0;
+    for (int c = 0; c < g->cube_count; c++)
+        n += (g->cube[c] != g->black) + (g->back[c] != 0);
+    return n;
+}
+
 void ps_gl_specular_redraw_all(ps_gl_specular *g)
 {
     /* A settled round from here, its back maps begun afresh. */
@@ -223,28 +267,15 @@ void ps_gl_specular_redraw_all(ps_gl_specular *g)
     memset(g->back_faces, 0, sizeof g->back_faces);
 }
 
-static void new_cube_textures(ps_gl_specular *g, int n, GLuint *tex, const float *black)
-{
-    glGenTextures(n, tex);
-    for (int c = 0; c < n; c++) {
-        glBindTexture(GL_TEXTURE_CUBE_MAP, tex[c]);
-        for (int f = 0; f < 6; f++)
-            glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_RGBA16F, g->size, g->size, 0, GL_RGBA, GL_FLOAT,
-                         black);
-        ps_gl_cube_linear_clamped();
-    }
-    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
-}
-
-/* Cube textures (shown and back) for n cubes, black until rendered. */
+/* n cubes, each showing the shared black map until its back map is whole.
+ * Maps of their own only as faces are rendered: black ones made here for
+ * every cube, shown and back, took the design room's first frame (eight
+ * cubes, 12 MiB) 6-25 ms, before any face was rendered. */
 static void ensure_cubes(ps_gl_specular *g, int n)
 {
     if (n == g->cube_count)
         return;
-    if (g->cube_count) {
-        glDeleteTextures(g->cube_count, g->cube);
-        glDeleteTextures(g->cube_count, g->back);
-    }
+    delete_cubes(g);
     g->cube_count = n;
     g->cursor = 0;
     memset(g->face_time, 0, sizeof g->face_time); /* other cubes: other faces */
@@ -256,10 +287,12 @@ static void ensure_cubes(ps_gl_specular *g, int n)
     memset(g->back_faces, 0, sizeof g->back_faces);
     if (n == 0)
         return;
-    float *black = calloc(4 * (size_t)g->size * (size_t)g->size, sizeof *black);
-    new_cube_textures(g, n, g->cube, black);
-    new_cube_textures(g, n, g->back, black);
-    free(black);
+    if (!g->black) {
+        const float texel[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        g->black = new_cube_texture(1, texel);
+    }
+    for (int c = 0; c < n; c++)
+        g->cube[c] = g->black;
 }
 
 /* Whether a back map holds some faces of a round but not all six. */
@@ -279,7 +312,7 @@ static void show_back(ps_gl_specular *g, ps_session *s, int c)
 {
     GLuint t = g->cube[c];
     g->cube[c] = g->back[c];
-    g->back[c] = t;
+    g->back[c] = t != g->black ? t : 0;
     g->back_faces[c] = 0;
     g->shown |= 1u << c;
     g->lit = true;
@@ -297,9 +330,14 @@ void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value)
     for (size_t i = 0; i < n; i++)
         texels[4 * i] = texels[4 * i + 1] = texels[4 * i + 2] = value, texels[4 * i + 3] = 1.0f;
     for (int c = 0; c < g->cube_count; c++) {
-        glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[c]);
-        for (int f = 0; f < 6; f++)
-            glTexSubImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, 0, 0, g->size, g->size, GL_RGBA, GL_FLOAT, texels);
+        if (g->cube[c] == g->black)
+            g->cube[c] = new_cube_texture(g->size, texels);
+        else {
+            glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[c]);
+            for (int f = 0; f < 6; f++)
+                glTexSubImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, 0, 0, g->size, g->size, GL_RGBA, GL_FLOAT,
+                                texels);
+        }
         g->back_faces[c] = 0;
     }
     glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
@@ -341,7 +379,7 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
     g->back_centre[c] = cam.eye;
     g->back_faces[c] |= 1u << f;
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, g->back[c], 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, back_map(g, c), 0);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, g->depth_stencil);
     r->skip_specular = true;
     bool hide = r->in.hide_emitters;

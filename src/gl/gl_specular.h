@@ -187,6 +187,10 @@ void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value);
 
 /* What ran: cube faces rendered so far. */
 unsigned ps_gl_specular_faces_rendered(const ps_gl_specular *g);
+/* Cube maps of their own held now, shown and back (a cube never shown
+ * shows one black map that all share, and has a back map only once a face
+ * was rendered into it). */
+int ps_gl_specular_maps(const ps_gl_specular *g);
 /* The next refresh draws every face of every cube again, from the photons
  * there, whatever earlier refreshes and waits drew: a last picture whose
  * cube maps depend on the photons alone (photosplat-snap's). A face drawn
