@@ -456,7 +456,8 @@ static void stencil_clips_haze(void **state)
 /* Area lights are seen as the reference renderer sees them: a disc light
  * from below shows its radiance P / (pi * pi R^2) in every pixel (times the
  * exposure), black with the direct layer off; from above, its back, nothing:
- * the floor under it shows through. */
+ * the floor under it shows through; a quad light flush with a ceiling
+ * shows. */
 static void area_light_seen(void **state)
 {
     (void)state;
@@ -488,6 +489,28 @@ static void area_light_seen(void **state)
     double floor = 0.5 * le * 0.09 / 1.09;
     printf("disc light from above: floor %.4f, analytic %.4f\n", ps_image_at(&img, 4, 4)[0], floor);
     assert_near(ps_image_at(&img, 4, 4)[0], floor, 0.03 * floor);
+    ps_image_destroy(&img);
+    preview_free(&p);
+    /* A quad light in the plane of the ceiling it hangs from, seen from
+     * below at a slant: every pixel of it shows its radiance, L = P / (pi A).
+     * Emitters are drawn without the prepass's polygon offset, which pushes
+     * the ceiling's depth behind theirs. Given that offset to share the
+     * prepass's llvmpipe set-up function (one compile less in the area box's
+     * first frame), with GL_LEQUAL, they lost the tie in all 256 pixels. */
+    const char *flush = "camera eye 0.3 0.2 0.1 target 0 1 0 up 0 0 -1 fov 8\n"
+                        "material white diffuse albedo 0.5 0.5 0.5\n"
+                        "quad corner -50 1 -50 edge1 100 0 0 edge2 0 0 100 material white\n"
+                        "light quad corner -0.5 1 -0.5 edge1 1 0 0 edge2 0 0 1 power 100 100 100\n";
+    const double lq = 100.0 / PS_PI; /* P / (pi A), A = 1 */
+    preview_make(&p, flush, 16, 16, PS_KERNEL_BOX);
+    ps_gl_begin_frame(p.gl, &p.cam, 0.01, true);
+    img = read_back(&p);
+    size_t off = 0;
+    for (int y = 0; y < p.h; y++)
+        for (int x = 0; x < p.w; x++)
+            off += fabs(ps_image_at(&img, x, y)[0] - lq * 0.01) > 1e-5 * lq * 0.01;
+    printf("quad light flush with the ceiling: %zu of %d pixels not its radiance\n", off, p.w * p.h);
+    assert_int_equal(off, 0);
     ps_image_destroy(&img);
     preview_free(&p);
 }
