@@ -330,17 +330,11 @@ void ps_gl_specular_fill(ps_gl_specular *g, ps_session *s, float value)
     for (size_t i = 0; i < n; i++)
         texels[4 * i] = texels[4 * i + 1] = texels[4 * i + 2] = value, texels[4 * i + 3] = 1.0f;
     for (int c = 0; c < g->cube_count; c++) {
-        if (g->cube[c] == g->black)
-            g->cube[c] = new_cube_texture(g->size, texels);
-        else {
-            glBindTexture(GL_TEXTURE_CUBE_MAP, g->cube[c]);
-            for (int f = 0; f < 6; f++)
-                glTexSubImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, 0, 0, g->size, g->size, GL_RGBA, GL_FLOAT,
-                                texels);
-        }
+        if (g->cube[c] != g->black)
+            glDeleteTextures(1, &g->cube[c]);
+        g->cube[c] = new_cube_texture(g->size, texels);
         g->back_faces[c] = 0;
     }
-    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
     free(texels);
     /* The glossy levels blurred from those faces, as a refresh would. */
     ps_error err;
