@@ -9,7 +9,12 @@
  *  - the work beside the round runs once;
  *  - with --global-layer maps, the illumination maps gather the round's
  *    photons beside the work too, before the first refresh, and its
- *    picture is still the same floats as a plain start's. */
+ *    picture is still the same floats as a plain start's;
+ *  - 8 bits (ps_gl_draw_view_ahead): the view drawn beside the round into
+ *    the colour buffer, the first frame draws only its splats over it, the
+ *    same bytes as a frame drawn whole; for another camera or exposure, after
+ *    another view begun in between, or after new materials, the frame draws
+ *    its own view again, the bytes again the same. */
 #include "test.h"
 
 #include <GL/osmesa.h>
@@ -189,12 +194,146 @@ static void maps_gathered_beside_the_round(void **state)
     ps_image_destroy(&splats.img);
 }
 
+/* ---- 8 bits: the view drawn into the colour buffer --------------------------- */
+
+typedef struct ahead8_job {
+    ps_gl_renderer *gl;
+    ps_camera_frame cam;
+    double exposure;
+    bool direct;
+    int calls;
+} ahead8_job;
+
+static void view_ahead8(void *ctx)
+{
+    ahead8_job *j = ctx;
+    j->calls++;
+    ps_gl_draw_view_ahead(j->gl, &j->cam, j->exposure, j->direct);
+}
+
+/* What happens between the view drawn ahead and the first frame. */
+typedef enum between { BETWEEN_NOTHING, BETWEEN_OTHER_VIEW, BETWEEN_MATERIALS } between;
+
+typedef struct first8 {
+    ps_image img;
+    uint64_t views;
+    uint64_t emitted[PS_MAP_COUNT];
+    int calls;
+    bool drawn_ahead; /* the frame drew over the view drawn ahead (ps_gl_stats) */
+} first8;
+
+/* The first 8-bit frame (photosplat-snap's: no layers, the whole frame
+ * redrawn), the session started plainly or with the view drawn beside its
+ * round (ahead) for the camera's eye moved eye_dx, at exposure_factor times
+ * the frame's exposure, and `b` done in between. */
+static first8 first_8bit(bool ahead, double eye_dx, double exposure_factor, between b)
+{
+    gl_rig g;
+    ps_session_settings set = gl_rig_load(&g, ROOM, "ahead8.scn");
+    set.float_buffer = false;
+    set.incremental = false;
+    set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
+    gl_rig_untraced(&g, &set, SIDE);
+    ps_gl_scene gs = ps_gl_scene_of(g.s);
+    ps_gl_options go = {true, false, 0, false, false};
+    ps_gl_renderer *gl;
+    ps_error err;
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g.s), &go, &gl, &err), PS_OK);
+    first8 out = {0};
+    if (ahead) {
+        ahead8_job job = {gl, g.cam, 1.0, false, 0};
+        job.cam.eye.x += eye_dx;
+        ps_session_direct_view(g.s, &job.exposure, &job.direct);
+        job.exposure *= exposure_factor;
+        assert_int_equal(ps_session_start_beside(g.s, true, view_ahead8, &job, &err), PS_OK);
+        out.calls = job.calls;
+    } else {
+        assert_int_equal(ps_session_start(g.s, true, &err), PS_OK);
+    }
+    if (b == BETWEEN_OTHER_VIEW) {
+        ps_camera_frame other = g.cam;
+        other.eye.y += 0.2;
+        ps_gl_begin_frame(gl, &other, 0.5, true);
+    } else if (b == BETWEEN_MATERIALS) {
+        ps_gl_renderer_set_materials(gl, ps_session_materials(g.s), false);
+    }
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(g.s, &g.cam, &f, &err), PS_OK);
+    assert_true(f.new_view && !f.moving);
+    ps_gl_draw_frame(gl, &g.cam, &f);
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        out.emitted[k] = f.emitted[k];
+        assert_true(f.emitted[k] > 0 && f.splats > 0);
+    }
+    assert_int_equal(ps_gl_read(gl, &out.img, &err), PS_OK);
+    out.views = ps_gl_get_stats(gl).views;
+    out.drawn_ahead = ps_gl_get_stats(gl).drawn_ahead_last;
+    ps_gl_renderer_destroy(gl);
+    gl_rig_close(&g);
+    return out;
+}
+
+static void same_8bit(const first8 *a, const first8 *b)
+{
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        assert_int_equal(a->emitted[k], b->emitted[k]);
+    size_t n = 3 * (size_t)a->img.width * (size_t)a->img.height;
+    assert_int_equal(a->img.width, b->img.width);
+    assert_true(gl_rig_image_mean(&a->img) > 0.0);
+    assert_memory_equal(a->img.rgb, b->img.rgb, n * sizeof *a->img.rgb);
+}
+
+static void view_drawn_ahead_into_8_bits(void **state)
+{
+    (void)state;
+    first8 plain = first_8bit(false, 0.0, 1.0, BETWEEN_NOTHING);
+    first8 ahead = first_8bit(true, 0.0, 1.0, BETWEEN_NOTHING);
+    printf("8 bits: first frame of %llu caustic and %llu global photons, views drawn %llu plain, %llu ahead\n",
+           (unsigned long long)ahead.emitted[PS_MAP_CAUSTIC], (unsigned long long)ahead.emitted[PS_MAP_GLOBAL],
+           (unsigned long long)plain.views, (unsigned long long)ahead.views);
+    assert_int_equal(ahead.calls, 1);
+    assert_int_equal(plain.views, 1);
+    assert_int_equal(ahead.views, 1); /* the frame drew only its splats over it */
+    assert_true(ahead.drawn_ahead);
+    assert_false(plain.drawn_ahead);
+    same_8bit(&ahead, &plain);
+    ps_image_destroy(&plain.img);
+    ps_image_destroy(&ahead.img);
+}
+
+static void view_8bit_drawn_again_when_not_the_frames(void **state)
+{
+    (void)state;
+    first8 plain = first_8bit(false, 0.0, 1.0, BETWEEN_NOTHING);
+    const struct {
+        double eye_dx, exposure_factor;
+        between b;
+        uint64_t views;
+    } cases[] = {
+        {0.05, 1.0, BETWEEN_NOTHING, 2},    /* another camera */
+        {0.0, 2.0, BETWEEN_NOTHING, 2},     /* another exposure */
+        {0.0, 1.0, BETWEEN_OTHER_VIEW, 3},  /* a view begun in between (a cube face's) */
+        {0.0, 1.0, BETWEEN_MATERIALS, 2},   /* new materials (an edit) */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        first8 a = first_8bit(true, cases[i].eye_dx, cases[i].exposure_factor, cases[i].b);
+        assert_int_equal(a.calls, 1);
+        assert_int_equal(a.views, cases[i].views);
+        assert_false(a.drawn_ahead);
+        same_8bit(&a, &plain);
+        ps_image_destroy(&a.img);
+    }
+    ps_image_destroy(&plain.img);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(view_drawn_beside_the_round),
         cmocka_unit_test(another_view_drawn_again),
         cmocka_unit_test(maps_gathered_beside_the_round),
+        cmocka_unit_test(view_drawn_ahead_into_8_bits),
+        cmocka_unit_test(view_8bit_drawn_again_when_not_the_frames),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

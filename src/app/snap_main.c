@@ -223,6 +223,8 @@ typedef struct snap_run {
     double shadow_per_light;    /* ... and a virtual light's shadow cube, seconds (0: not timed) */
     bool lights_held;           /* area lights refined in the waits (ps_session_hold_lights) */
     double lit_seconds;         /* the last refresh with new lights, less its cube faces (0: none yet) */
+    double view_ahead_seconds;  /* 8 bits: the first view, drawn beside the first round (view_ahead), */
+    double view_ahead_shadows;  /* ... and of that, its shadow maps */
     double first_seconds;       /* the first refresh's time without cube faces, as the pace
                                  * learned it (0: not yet): a face never timed is guessed from it */
     bool probed;                /* --time, 8 bits: the last picture's cost learned (probe_redraw) */
@@ -291,7 +293,13 @@ static ps_status refresh(snap_run *s, ps_error *err)
     s->drew_nothing = s->frame.splats == 0 && ps_gl_specular_faces_rendered(s->spec) == faces_before &&
                       t1 - t_refresh < SNAP_AWAIT_POLL;
     gst = ps_gl_get_stats(s->gl);
-    shadows += gst.shadow_seconds_last;
+    /* 8 bits: the first refresh's view, when drawn before it (view_ahead)
+     * and not again, counted here as the refresh's own, as every later
+     * refresh draws its view: its shadow maps as the shadow maps, the rest
+     * as lit passes. */
+    bool first = s->frames == 0 && !s->layers && gst.drawn_ahead_last;
+    double ahead = first ? s->view_ahead_seconds : 0.0, ahead_shadows = first ? s->view_ahead_shadows : 0.0;
+    shadows += gst.shadow_seconds_last + ahead_shadows;
     if (shadows > 0.0 && gst.virtual_lights > 0)
         s->shadow_per_light = shadows / gst.virtual_lights;
     ps_latency_add(&s->lat, PS_LAT_SHADOWS, gst.shadow_seconds_last);
@@ -320,7 +328,7 @@ static ps_status refresh(snap_run *s, ps_error *err)
      * was foreseen with those photons four times over: 64^2, --time 10,
      * ended at 5.5 s). */
     if (s->frame.lights_changed || s->frames == 1)
-        s->lit_seconds = t1 - t_refresh - faces_seconds - (s->layers ? 0.0 : build_seconds + splat_seconds);
+        s->lit_seconds = t1 - t_refresh - faces_seconds - (s->layers ? 0.0 : build_seconds + splat_seconds) + ahead;
     if (!s->layers || s->pace.seconds <= 0.0 || !(s->frame.new_view || s->frame.lights_changed))
     {
         /* Incremental: the next draws up to its budget's share of tau of
@@ -339,7 +347,7 @@ static ps_status refresh(snap_run *s, ps_error *err)
          * foreseen at 0.025 s, took 0.032-0.036 s (0.011 s of it their
          * gathering) and came at 0.12 s. */
         if (s->frames == 1)
-            plain += after.ahead_seconds;
+            plain += after.ahead_seconds + ahead - ahead_shadows;
         ps_pace_learn(&s->pace, fmax(plain, 1e-6), (double)(s->frame.emitted[0] + s->frame.emitted[1]),
                       build_seconds + splat_seconds, !s->layers);
         s->pace.lead = t0 - t_refresh;
@@ -785,7 +793,8 @@ static ps_status unseen_batch(snap_run *s, ps_error *err)
 
 /* The first picture's view, drawn while its photons are traced
  * (ps_session_start_beside): its shadow maps, prepass and lit passes, and
- * llvmpipe's first compiles of them. */
+ * llvmpipe's first compiles of them; into the float layers, or into the
+ * 8-bit buffer, where the first refresh draws its splats over it. */
 typedef struct view_ahead_job {
     snap_run *s;
     double exposure; /* the direct layer as the first refresh asks for it */
@@ -795,7 +804,19 @@ typedef struct view_ahead_job {
 static void view_ahead(void *ctx)
 {
     view_ahead_job *j = ctx;
-    ps_gl_layers_view_ahead(j->s->layers, j->s->gl, &j->s->cam, j->exposure, j->direct);
+    snap_run *s = j->s;
+    if (s->layers) {
+        ps_gl_layers_view_ahead(s->layers, s->gl, &s->cam, j->exposure, j->direct);
+        return;
+    }
+    /* Finished here, so that its time is its own: the first refresh counts
+     * it as its view's (refresh). */
+    double t0 = ps_now_seconds();
+    ps_gl_clear_shadow_timing(s->gl);
+    ps_gl_draw_view_ahead(s->gl, &s->cam, j->exposure, j->direct);
+    ps_gl_finish();
+    s->view_ahead_seconds = ps_now_seconds() - t0;
+    s->view_ahead_shadows = ps_gl_get_stats(s->gl).shadow_seconds_last;
 }
 
 /* Progressive: trace in the background, refresh every tau. As in the window,
@@ -811,16 +832,16 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
      * 8 bits trace meanwhile, on every core (session.h), for the first frame
      * that shows a checkpoint. (The default box's first float picture: 0.35-
      * 0.36 s; 0.43-0.50 s sharing the cores and waiting for the first
-     * checkpoint or tau.) Float layers keep a view: the first one is drawn
-     * while the first round is traced (view_ahead). An 8-bit frame draws
-     * its view again whole: drawn beside the round as well (llvmpipe's
-     * first compiles and the shadow maps done there), the default box's
-     * and the design room's first 8-bit checkpoints came 5-7 ms later
-     * (medians of eight runs). */
+     * checkpoint or tau.) The first view is drawn while the first round is
+     * traced (view_ahead): into the float layers, which keep it, or into the
+     * 8-bit buffer, whose first frame then draws only its splats over it.
+     * (Drawn beside the round as well but the frame drawing its view again,
+     * the default box's and the design room's first 8-bit checkpoints came
+     * 5-7 ms later, medians of eight runs; see docs/preview.md for the
+     * figures of the view kept.) */
     view_ahead_job ahead = {s, 1.0, false};
     ps_session_direct_view(s->session, &ahead.exposure, &ahead.direct);
-    ps_status st = s->layers ? ps_session_start_beside(s->session, true, view_ahead, &ahead, err)
-                             : ps_session_start(s->session, false, err);
+    ps_status st = ps_session_start_beside(s->session, s->layers != NULL, view_ahead, &ahead, err);
     double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
     pace_rate rate = {0.0, 0.0};
     int cp = 0;

@@ -77,6 +77,15 @@ struct ps_gl_renderer {
     uint32_t only_object;
     bool skip_baked;
     bool direct_bake_off; /* this frame draws the lit passes whatever is laid (cube faces) */
+    /* ps_gl_draw_view_ahead: the still view in the framebuffer, for
+     * ahead_cam with this exposure and direct flag, at ahead_epoch and
+     * ahead_bakes; dropped by the next view begun. */
+    bool ahead;
+    ps_camera_frame ahead_cam;
+    double ahead_exposure;
+    bool ahead_direct;
+    uint64_t ahead_epoch;
+    unsigned ahead_bakes;
 };
 
 /* Textures (gl_albedo.c). The lit passes and the splats use the materials'

@@ -106,6 +106,15 @@ void ps_gl_draw_frame(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_se
  * (photosplat-snap's pace, app/pace.h). */
 void ps_gl_draw_frame_timed(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f,
                             double *splat_seconds);
+/* The still view of cam (ps_gl_begin_frame: shadow maps, depth, direct
+ * light, emitters) drawn now into the current framebuffer, for the next
+ * ps_gl_draw_frame*: photosplat-snap's 8-bit buffer draws it while its first
+ * round is traced (ps_session_start_beside), as ps_gl_layers_view_ahead the
+ * float layers'. That frame, if it is a still one of the same camera,
+ * exposure and direct flag with the same lights and shadows, draws only its
+ * splats over it; any other view begun first (a cube face), or new inputs,
+ * drop it. Nothing else may draw into the framebuffer in between. */
+void ps_gl_draw_view_ahead(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct);
 
 /* Adds a batch of splats (preview/splat.h) to the frame, depth tested against
  * the scene, additively. point_size: the points' side in pixels; sprites take
@@ -203,6 +212,7 @@ typedef struct ps_gl_stats {
     double shadow_seconds_last;
     unsigned direct_bakes;   /* times the direct light's textures were laid (bake_direct) */
     bool direct_baked_last;  /* the last view's direct layer drew them */
+    bool drawn_ahead_last;   /* the last ps_gl_draw_frame* drew over the view drawn ahead */
     uint64_t views;          /* views begun (ps_gl_begin_frame*: clear, prepass, direct light), all told */
 } ps_gl_stats;
 void ps_gl_clear_shadow_timing(ps_gl_renderer *r);
