@@ -240,6 +240,8 @@ static first8 first_8bit(bool ahead, double eye_dx, double exposure_factor, betw
     ps_error err;
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g.s), &go, &gl, &err), PS_OK);
     first8 out = {0};
+    /* Held both ways (snap's 8 bits are not): the frame shows the first
+     * round's photons, the same ones whichever way it started. */
     if (ahead) {
         ahead8_job job = {gl, g.cam, 1.0, false, 0};
         job.cam.eye.x += eye_dx;
