@@ -41,6 +41,8 @@ static const char *const ROOM = "camera eye 0 1 3 target 0 0.5 0 fov 45\n"
                                 "light point position 0 1.5 0.3 power 50 50 50\n"
                                 "photons caustic 40000 global 10000\n";
 
+/* The view drawn beside the round: into the float layers, or (layers NULL)
+ * into the 8-bit colour buffer. */
 typedef struct ahead_job {
     ps_gl_layers *layers;
     ps_gl_renderer *gl;
@@ -54,7 +56,31 @@ static void view_ahead(void *ctx)
 {
     ahead_job *j = ctx;
     j->calls++;
-    ps_gl_layers_view_ahead(j->layers, j->gl, &j->cam, j->exposure, j->direct);
+    if (j->layers)
+        ps_gl_layers_view_ahead(j->layers, j->gl, &j->cam, j->exposure, j->direct);
+    else
+        ps_gl_draw_view_ahead(j->gl, &j->cam, j->exposure, j->direct);
+}
+
+/* The session started held (the first picture shows the first round's
+ * photons, whichever way it started; snap's 8 bits are not held), plainly or
+ * with the view drawn beside the round (into the layers l, or with l NULL
+ * into the colour buffer) for the camera's eye moved eye_dx, at
+ * exposure_factor times the first refresh's exposure: the calls of the work
+ * beside the round. */
+static int start(gl_rig *g, ps_gl_layers *l, ps_gl_renderer *gl, bool ahead, double eye_dx, double exposure_factor)
+{
+    ps_error err;
+    if (!ahead) {
+        assert_int_equal(ps_session_start(g->s, true, &err), PS_OK);
+        return 0;
+    }
+    ahead_job job = {l, gl, g->cam, 1.0, false, 0};
+    job.cam.eye.x += eye_dx;
+    ps_session_direct_view(g->s, &job.exposure, &job.direct);
+    job.exposure *= exposure_factor;
+    assert_int_equal(ps_session_start_beside(g->s, true, view_ahead, &job, &err), PS_OK);
+    return job.calls;
 }
 
 typedef struct first_picture {
@@ -86,16 +112,7 @@ static first_picture first_of(bool ahead, double eye_dx, double exposure_factor,
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g.s), &go, &gl, &err), PS_OK);
     assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &l, &err), PS_OK);
     first_picture out = {0};
-    if (ahead) {
-        ahead_job job = {l, gl, g.cam, 1.0, false, 0};
-        job.cam.eye.x += eye_dx;
-        ps_session_direct_view(g.s, &job.exposure, &job.direct);
-        job.exposure *= exposure_factor;
-        assert_int_equal(ps_session_start_beside(g.s, true, view_ahead, &job, &err), PS_OK);
-        out.calls = job.calls;
-    } else {
-        assert_int_equal(ps_session_start(g.s, true, &err), PS_OK);
-    }
+    out.calls = start(&g, l, gl, ahead, eye_dx, exposure_factor);
     const ps_illummap *imap = ps_session_illummap(g.s);
     out.gathered = imap ? ps_illummap_count(imap) : 0;
     ps_session_counts counts;
@@ -196,21 +213,6 @@ static void maps_gathered_beside_the_round(void **state)
 
 /* ---- 8 bits: the view drawn into the colour buffer --------------------------- */
 
-typedef struct ahead8_job {
-    ps_gl_renderer *gl;
-    ps_camera_frame cam;
-    double exposure;
-    bool direct;
-    int calls;
-} ahead8_job;
-
-static void view_ahead8(void *ctx)
-{
-    ahead8_job *j = ctx;
-    j->calls++;
-    ps_gl_draw_view_ahead(j->gl, &j->cam, j->exposure, j->direct);
-}
-
 /* What happens between the view drawn ahead and the first frame. */
 typedef enum between { BETWEEN_NOTHING, BETWEEN_OTHER_VIEW, BETWEEN_MATERIALS } between;
 
@@ -240,18 +242,7 @@ static first8 first_8bit(bool ahead, double eye_dx, double exposure_factor, betw
     ps_error err;
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g.s), &go, &gl, &err), PS_OK);
     first8 out = {0};
-    /* Held both ways (snap's 8 bits are not): the frame shows the first
-     * round's photons, the same ones whichever way it started. */
-    if (ahead) {
-        ahead8_job job = {gl, g.cam, 1.0, false, 0};
-        job.cam.eye.x += eye_dx;
-        ps_session_direct_view(g.s, &job.exposure, &job.direct);
-        job.exposure *= exposure_factor;
-        assert_int_equal(ps_session_start_beside(g.s, true, view_ahead8, &job, &err), PS_OK);
-        out.calls = job.calls;
-    } else {
-        assert_int_equal(ps_session_start(g.s, true, &err), PS_OK);
-    }
+    out.calls = start(&g, NULL, gl, ahead, eye_dx, exposure_factor);
     if (b == BETWEEN_OTHER_VIEW) {
         ps_camera_frame other = g.cam;
         other.eye.y += 0.2;
