@@ -27,6 +27,27 @@ typedef struct ps_gl_direct_bake {
     bool shadows;
 } ps_gl_direct_bake;
 
+/* A still view drawn ahead, while the first round is traced (into the
+ * colour buffer, ps_gl_draw_view_ahead, or the float layers,
+ * ps_gl_layers_view_ahead): for cam, with this exposure and direct flag, by
+ * renderer at its lit epoch (lights and shadows) with `bakes` direct
+ * textures laid (a new laying draws them). held until used or dropped. */
+typedef struct ps_gl_ahead {
+    bool held;
+    ps_camera_frame cam;
+    double exposure;
+    bool direct;
+    const ps_gl_renderer *renderer;
+    uint64_t epoch;
+    unsigned bakes;
+} ps_gl_ahead;
+/* Holds the view r has just drawn for cam (after the drawing: its shadow maps count the epoch up). */
+void ps_gl_ahead_hold(ps_gl_ahead *a, const ps_gl_renderer *r, const ps_camera_frame *cam, double exposure,
+                      bool direct);
+/* Whether a held view is the still view of cam that f asks r for. */
+bool ps_gl_ahead_is(const ps_gl_ahead *a, const ps_gl_renderer *r, const ps_camera_frame *cam,
+                    const ps_session_frame *f);
+
 struct ps_gl_renderer {
     ps_gl_scene in;
     /* The mesh this frame's lit passes draw: in.mesh, or in.moving for a
@@ -77,15 +98,9 @@ struct ps_gl_renderer {
     uint32_t only_object;
     bool skip_baked;
     bool direct_bake_off; /* this frame draws the lit passes whatever is laid (cube faces) */
-    /* ps_gl_draw_view_ahead: the still view in the framebuffer, for
-     * ahead_cam with this exposure and direct flag, at ahead_epoch and
-     * ahead_bakes; dropped by the next view begun. */
-    bool ahead;
-    ps_camera_frame ahead_cam;
-    double ahead_exposure;
-    bool ahead_direct;
-    uint64_t ahead_epoch;
-    unsigned ahead_bakes;
+    /* ps_gl_draw_view_ahead: the still view in the framebuffer; dropped by
+     * the next view begun. */
+    ps_gl_ahead ahead;
 };
 
 /* Textures (gl_albedo.c). The lit passes and the splats use the materials'

@@ -44,18 +44,10 @@ struct ps_gl_layers {
     GLuint extra_tex; /* the specular layer (gl_specular.c), times extra_gain */
     double extra_gain;
     ps_gl_bake bake[PS_MAP_COUNT]; /* each map's baked textures (preview/bake.h) */
-    /* ps_gl_layers_view_ahead: the still view drawn for ahead_cam, with this
-     * exposure and direct flag, by ahead_renderer at ahead_epoch (its lights
-     * and shadows); the next ps_gl_layers_draw's new view, when it is that
-     * one, is not drawn again. Any other view, relight or splat drawn into
-     * the layers drops it. */
-    bool ahead;
-    ps_camera_frame ahead_cam;
-    double ahead_exposure;
-    bool ahead_direct;
-    const ps_gl_renderer *ahead_renderer;
-    uint64_t ahead_epoch;
-    unsigned ahead_bakes; /* ... and its direct light's textures laid so far (a new laying draws them) */
+    /* ps_gl_layers_view_ahead: the still view drawn ahead; the next
+     * ps_gl_layers_draw's new view, when it is that one, is not drawn again.
+     * Any other view, relight or splat drawn into the layers drops it. */
+    ps_gl_ahead ahead;
 };
 
 GLuint ps_gl_layers_depth_stencil(const ps_gl_layers *l) { return l->depth_stencil; }
@@ -198,7 +190,7 @@ static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *
 
 void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
 {
-    l->ahead = false;
+    l->ahead.held = false;
     new_view(l, r, cam, exposure, direct, r->opt.shadows, false);
 }
 
@@ -206,30 +198,14 @@ void ps_gl_layers_view_ahead(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera
                              bool direct)
 {
     new_view(l, r, cam, exposure, direct, r->opt.shadows, false);
-    /* After the drawing: its shadow maps count the epoch up. */
-    l->ahead = true;
-    l->ahead_cam = *cam;
-    l->ahead_exposure = exposure;
-    l->ahead_direct = direct;
-    l->ahead_renderer = r;
-    l->ahead_epoch = r->lit_epoch;
-    l->ahead_bakes = r->stats.direct_bakes;
-}
-
-/* Whether a still view of cam, as f asks for it, is the one drawn ahead. */
-static bool drawn_ahead(const ps_gl_layers *l, const ps_gl_renderer *r, const ps_camera_frame *cam,
-                        const ps_session_frame *f)
-{
-    return l->ahead && !f->moving && l->ahead_renderer == r && l->ahead_epoch == r->lit_epoch &&
-           l->ahead_bakes == r->stats.direct_bakes && l->ahead_exposure == f->direct_exposure &&
-           l->ahead_direct == f->direct && ps_camera_frame_equal(&l->ahead_cam, cam);
+    ps_gl_ahead_hold(&l->ahead, r, cam, exposure, direct);
 }
 
 void ps_gl_layers_relight(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
 {
     /* Its pass redraws the shared depth prepass too, the same depths, so the
      * map layers' splats stay right. */
-    l->ahead = false;
+    l->ahead.held = false;
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_DIRECT_TEX]);
@@ -306,7 +282,7 @@ static void shrink_maps(ps_gl_layers *l, const ps_session_frame *f)
 void ps_gl_layers_add(ps_gl_layers *l, ps_gl_renderer *r, int map, const ps_splat_batch *b, ps_splat_mode mode,
                       double radius, double point_size)
 {
-    l->ahead = false; /* the map no longer as a new view leaves it */
+    l->ahead.held = false; /* the map no longer as a new view leaves it */
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     bool shrunk = l->map_w[map] < l->view_w || l->map_h[map] < l->view_h;
@@ -390,13 +366,13 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
          * edit may be what they show. The moving camera's passes light the
          * moving mesh (a quarter of the fine one's vertices on flat faces). */
         bool moving = f->moving && !f->edit_lod;
-        if (!drawn_ahead(l, r, cam, f))
+        if (!ps_gl_ahead_is(&l->ahead, r, cam, f))
             new_view(l, r, cam, f->direct_exposure, f->direct, r->opt.shadows && !moving, moving);
         shrink_maps(l, f);
     } else if (f->lights_changed) {
         ps_gl_layers_relight(l, r, cam, f->direct_exposure, f->direct);
     }
-    l->ahead = false;
+    l->ahead.held = false;
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         const ps_session_layer *m = &f->map[k];
         if (m->bake_reset)

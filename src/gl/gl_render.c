@@ -230,7 +230,7 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
 void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
                                bool shadows, bool moving)
 {
-    r->ahead = false; /* the framebuffer's view is this one from here on */
+    r->ahead.held = false; /* the framebuffer's view is this one from here on */
     r->lit = moving && r->in.moving ? r->in.moving : r->in.mesh;
     r->stats.views++;
     r->stats.light_passes = 0;
@@ -306,25 +306,24 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
     ps_gl_draw_emitters(r, exposure, direct);
 }
 
+void ps_gl_ahead_hold(ps_gl_ahead *a, const ps_gl_renderer *r, const ps_camera_frame *cam, double exposure,
+                      bool direct)
+{
+    *a = (ps_gl_ahead){true, *cam, exposure, direct, r, r->lit_epoch, r->stats.direct_bakes};
+}
+
+bool ps_gl_ahead_is(const ps_gl_ahead *a, const ps_gl_renderer *r, const ps_camera_frame *cam,
+                    const ps_session_frame *f)
+{
+    return a->held && !f->moving && a->renderer == r && a->epoch == r->lit_epoch &&
+           a->bakes == r->stats.direct_bakes && a->exposure == f->direct_exposure && a->direct == f->direct &&
+           ps_camera_frame_equal(&a->cam, cam);
+}
+
 void ps_gl_draw_view_ahead(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
 {
     ps_gl_begin_frame(r, cam, exposure, direct);
-    /* After the drawing: its shadow maps count the epoch up. */
-    r->ahead = true;
-    r->ahead_cam = *cam;
-    r->ahead_exposure = exposure;
-    r->ahead_direct = direct;
-    r->ahead_epoch = r->lit_epoch;
-    r->ahead_bakes = r->stats.direct_bakes;
-}
-
-/* Whether the framebuffer holds the still view of cam that f asks for, drawn
- * ahead (as gl_layers.c's drawn_ahead for the layers). */
-static bool drawn_ahead(const ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f)
-{
-    return r->ahead && !f->moving && r->ahead_epoch == r->lit_epoch && r->ahead_bakes == r->stats.direct_bakes &&
-           r->ahead_exposure == f->direct_exposure && r->ahead_direct == f->direct &&
-           ps_camera_frame_equal(&r->ahead_cam, cam);
+    ps_gl_ahead_hold(&r->ahead, r, cam, exposure, direct);
 }
 
 void ps_gl_draw_frame(ps_gl_renderer *r, const ps_camera_frame *cam, const ps_session_frame *f)
@@ -338,9 +337,9 @@ void ps_gl_draw_frame_timed(ps_gl_renderer *r, const ps_camera_frame *cam, const
     /* The view drawn ahead is used once: the splats go over it, and every
      * pass after it loads the camera's matrices itself (r->proj, r->view);
      * the viewport is set again in case a pass that restores its own moved it. */
-    r->stats.drawn_ahead_last = drawn_ahead(r, cam, f);
+    r->stats.drawn_ahead_last = ps_gl_ahead_is(&r->ahead, r, cam, f);
     if (r->stats.drawn_ahead_last) {
-        r->ahead = false;
+        r->ahead.held = false;
         glViewport(0, 0, cam->width, cam->height);
     } else {
         ps_gl_begin_frame(r, cam, f->direct_exposure, f->direct);
