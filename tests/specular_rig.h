@@ -58,7 +58,7 @@ static void rig_make_as(rig *r, ps_scene *scene, int w, int h, bool refining)
     assert_non_null(r->ctx);
     r->buffer = malloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
     assert_true(OSMesaMakeCurrent(r->ctx, r->buffer, GL_FLOAT, w, h));
-    ps_gl_options go = {true, true, 0, false, false};
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
     ps_gl_scene gs = ps_gl_scene_of(r->session);
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(r->session), &go, &r->gl, &err), PS_OK);
     assert_int_equal(ps_gl_specular_create(0, &r->spec, &err), PS_OK);

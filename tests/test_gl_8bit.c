@@ -59,7 +59,7 @@ static void rig_open(rig8 *r, ps_splat_mode mode, uint64_t photons, bool float_b
     assert_non_null(r->ctx);
     r->buffer = malloc(4 * sizeof(float) * SIDE * SIDE);
     assert_true(OSMesaMakeCurrent(r->ctx, r->buffer, float_buffer ? GL_FLOAT : GL_UNSIGNED_BYTE, SIDE, SIDE));
-    ps_gl_options go = {false, float_buffer, 0, false, false};
+    ps_gl_options go = {false, float_buffer, 0, false, false, OSMesaGetProcAddress};
     ps_gl_scene gs = ps_gl_scene_of(r->session);
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(r->session), &go, &r->gl, &err), PS_OK);
     r->cam = ps_camera_frame_make(ps_scene_camera(r->scene), SIDE, SIDE);

@@ -105,7 +105,7 @@ static first_picture first_of(bool ahead, double eye_dx, double exposure_factor,
     set.global_layer = global;
     gl_rig_untraced(&g, &set, SIDE);
     ps_gl_scene gs = ps_gl_scene_of(g.s);
-    ps_gl_options go = {true, true, 0, false, false};
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
     ps_gl_renderer *gl;
     ps_gl_layers *l;
     ps_error err;
@@ -237,7 +237,7 @@ static first8 first_8bit(bool ahead, double eye_dx, double exposure_factor, betw
     set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
     gl_rig_untraced(&g, &set, SIDE);
     ps_gl_scene gs = ps_gl_scene_of(g.s);
-    ps_gl_options go = {true, false, 0, false, false};
+    ps_gl_options go = {true, false, 0, false, false, OSMesaGetProcAddress};
     ps_gl_renderer *gl;
     ps_error err;
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g.s), &go, &gl, &err), PS_OK);

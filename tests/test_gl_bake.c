@@ -74,7 +74,7 @@ static void rig_open(rig *g, const char *text)
     set.layers = PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
     gl_rig_start(&g->base, &set, SIDE);
     ps_gl_scene gs = ps_gl_scene_of(g->base.s);
-    ps_gl_options go = {true, true, 0, false, false};
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
     ps_error err;
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g->base.s), &go, &g->gl, &err), PS_OK);
     assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &g->layers, &err), PS_OK);

@@ -38,7 +38,7 @@ static float *preview_lux(const char *text, ps_scene **scene_out, ps_camera_fram
     uint8_t *buffer = malloc(4 * SIDE * SIDE);
     assert_true(OSMesaMakeCurrent(ctx, buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
     assert_int_equal(ps_session_set_illuminance(s, true, &err), PS_OK);
-    ps_gl_options go = {true, false, 0, false, false};
+    ps_gl_options go = {true, false, 0, false, false, OSMesaGetProcAddress};
     ps_gl_scene gs = ps_gl_scene_of(s);
     assert_true(gs.hide_emitters);
     ps_gl_renderer *gl;

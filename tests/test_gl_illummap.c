@@ -59,7 +59,7 @@ static ps_image draw_shown(bool layers, int threads, bool move, double *lo, doub
     assert_non_null(ctx);
     uint8_t *buffer = malloc(4 * SIDE * SIDE);
     assert_true(OSMesaMakeCurrent(ctx, buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
-    ps_gl_options go = {true, false, 0, false, false};
+    ps_gl_options go = {true, false, 0, false, false, OSMesaGetProcAddress};
     ps_gl_scene gs = ps_gl_scene_of(s);
     ps_gl_renderer *gl;
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);

@@ -66,7 +66,7 @@ static void rig_close(rig *g) { gl_rig_close(g); }
 
 static ps_gl_renderer *renderer(const ps_gl_scene *gs, ps_session *s)
 {
-    ps_gl_options go = {true, true, 0, false, false};
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
     ps_gl_renderer *gl;
     ps_error err;
     assert_int_equal(ps_gl_renderer_create(gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);

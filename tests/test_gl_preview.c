@@ -59,7 +59,7 @@ static void preview_make(preview *out, const char *text, int w, int h, ps_kernel
     assert_non_null(p.ctx);
     p.buffer = malloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
     assert_true(OSMesaMakeCurrent(p.ctx, p.buffer, GL_FLOAT, w, h));
-    ps_gl_options go = {true, true, 0, false, false};
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
     *pp = p;
     assert_int_equal(ps_preview_lights_build(pp->scene, NULL, &pp->coarse, PS_GL_SHADOW_SIZE, PS_PREVIEW_AREA_SIDE, &pp->lights, &err), PS_OK);
     size_t nmat;

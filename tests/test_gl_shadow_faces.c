@@ -18,7 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gl/gl_internal.h" /* ps_gl_begin_frame_shadows: a moving frame */
+#include "core/clock.h"
+#include "gl/gl_internal.h" /* ps_gl_begin_frame_shadows: a moving frame; the shadow query */
 #include "gl/gl_render.h"
 #include "preview/lights.h"
 #include "preview/mesh.h"
@@ -141,7 +142,7 @@ static void edit_renders(edit_kind e, unsigned expect_faces, bool picture_change
     ps_error err;
     gl_rig g = gl_rig_open(scene_text);
     ps_scene *s = g.s;
-    ps_gl_options go = {true, true, 0, false, false};
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
 
     inputs before;
     inputs_make(s, &before);
@@ -248,7 +249,7 @@ static void culled_faces_draw_the_same(void **state)
         /* Culled by tiles, every object whole, culled by whole ranges (the
          * mesh's tiles dropped: what a mesh without them draws). */
         for (int v = 0; v < 3; v++) {
-            ps_gl_options go = {true, true, 0, v == 1, false};
+            ps_gl_options go = {true, true, 0, v == 1, false, OSMesaGetProcAddress};
             if (v == 2)
                 ps_mesh_tiling_free(&in.mesh.tiles);
             ps_gl_renderer *r;
@@ -295,7 +296,7 @@ static void resized_shadows_render_every_face(void **state)
     (void)state;
     ps_error err;
     gl_rig g = gl_rig_open(scene_text);
-    ps_gl_options go = {true, true, 0, false, false};
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
     inputs coarse, full;
     inputs_make_sized(g.s, 32, &coarse);
     inputs_make(g.s, &full);
@@ -322,6 +323,53 @@ static void resized_shadows_render_every_face(void **state)
     ps_gl_renderer_destroy(r);
     inputs_free(&coarse);
     inputs_free(&full);
+    gl_rig_close(&g);
+}
+
+/* The shadow maps' seconds, from their start to GL's end of them: by a
+ * timestamp query where the platform gives one (ps_gl_options.gl_proc),
+ * which the passes after them do not wait for, else by waiting. Either way
+ * more than nothing and no more than the frame that made them, and the same
+ * picture; a time dropped (ps_gl_clear_shadow_timing) while its query is
+ * still pending stays dropped. */
+static void shadow_maps_timed_to_their_end(void **state)
+{
+    (void)state;
+    ps_error err;
+    gl_rig g = gl_rig_open(scene_text);
+    inputs in;
+    inputs_make(g.s, &in);
+    ps_gl_scene gs = gl_scene(g.s, &in);
+    ps_image pic[2];
+    for (int v = 0; v < 2; v++) {
+        ps_gl_options go = {true, true, 0, false, false, v == 0 ? OSMesaGetProcAddress : NULL};
+        ps_gl_renderer *r;
+        assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &r, &err), PS_OK);
+        assert_true((r->query_counter != NULL) == (v == 0)); /* llvmpipe has GL 3.3's timer queries */
+        ps_gl_clear_shadow_timing(r);
+        double t0 = ps_now_seconds();
+        pic[v] = draw(r, g.s);
+        double frame = ps_now_seconds() - t0;
+        ps_gl_stats st = ps_gl_get_stats(r);
+        printf("shadow maps %s: %.2f ms of a %.2f ms frame\n", v == 0 ? "by a timestamp" : "waited for",
+               1e3 * st.shadow_seconds_last, 1e3 * frame);
+        assert_int_equal(st.shadow_faces_last, 6);
+        assert_true(st.shadow_seconds_last > 0.0);
+        assert_true(st.shadow_seconds_last <= frame);
+        /* Made again, the time dropped before it is read: none. */
+        assert_int_equal(ps_gl_renderer_set_scene(r, &gs, &err), PS_OK);
+        ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(g.s), W, H);
+        ps_gl_begin_frame(r, &cam, 1.0, true);
+        ps_gl_clear_shadow_timing(r);
+        ps_gl_finish();
+        assert_false(r->shadow_query_pending);
+        assert_true(ps_gl_get_stats(r).shadow_seconds_last == 0.0);
+        ps_gl_renderer_destroy(r);
+    }
+    assert_true(same_pixels(&pic[0], &pic[1]));
+    ps_image_destroy(&pic[0]);
+    ps_image_destroy(&pic[1]);
+    inputs_free(&in);
     gl_rig_close(&g);
 }
 
@@ -369,7 +417,7 @@ static void baked_against_lit(const char *text, const char *what, ps_vec3 other_
     inputs in;
     inputs_make(g.s, &in);
     ps_gl_scene gs = gl_scene(g.s, &in);
-    ps_gl_options lit_o = {true, true, 0, false, false}, baked_o = {true, true, 0, false, true};
+    ps_gl_options lit_o = {true, true, 0, false, false, OSMesaGetProcAddress}, baked_o = {true, true, 0, false, true, OSMesaGetProcAddress};
     ps_gl_renderer *lit, *baked;
     assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &lit_o, &lit, &err), PS_OK);
     assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &baked_o, &baked, &err), PS_OK);
@@ -474,6 +522,7 @@ int main(void)
         cmocka_unit_test(moved_light_renders_its_cube),
         cmocka_unit_test(culled_faces_draw_the_same),
         cmocka_unit_test(resized_shadows_render_every_face),
+        cmocka_unit_test(shadow_maps_timed_to_their_end),
         cmocka_unit_test(direct_light_baked_on_quads),
         cmocka_unit_test(direct_light_baked_on_a_back_side),
     };

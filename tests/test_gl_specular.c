@@ -341,7 +341,7 @@ static void lit_triangles_draw_the_same(void **state)
     assert_int_equal(ps_gl_specular_refresh(r.spec, r.gl, r.session, &f, 0, &err), PS_OK);
     /* The per-pixel points dropped: the lookups' terms are drawn. */
     ps_specular_invalidate(ps_session_specular(r.session));
-    ps_gl_options go = {true, true, 0, true, false};
+    ps_gl_options go = {true, true, 0, true, false, OSMesaGetProcAddress};
     ps_gl_scene gs = ps_gl_scene_of(r.session);
     ps_gl_renderer *whole;
     assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(r.session), &go, &whole, &err), PS_OK);

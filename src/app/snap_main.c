@@ -1381,7 +1381,7 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
     /* Never the direct light's textures: snap's pictures are compared with
      * the reference's, and with them a picture would depend on when they
      * were laid. */
-    ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0, false, false};
+    ps_gl_options gopt = {o->p.shadows != 0, o->p.color_depth != 0, 0, false, false, ps_platform_gl_proc};
     if (st == PS_OK) {
         ps_gl_scene gs = ps_gl_scene_of(s.session);
         st = ps_gl_renderer_create(&gs, ps_session_kernel(s.session), &gopt, &s.gl, err);

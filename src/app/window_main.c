@@ -293,7 +293,7 @@ static ps_status open_session(app *a, ps_error *err)
     set.progressive_lights = true; /* the first picture (and the first after an edit) sooner */
     set.repair = !a->o.no_repair;
     ps_status st = ps_session_create(a->scene, &set, &a->session, err);
-    ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE, false, a->o.p.bake};
+    ps_gl_options go = {a->o.p.shadows != 0, true, WIN_SHADOW_SIZE, false, a->o.p.bake, ps_platform_gl_proc};
     if (st == PS_OK) {
         ps_gl_scene gs = ps_gl_scene_of(a->session);
         st = ps_gl_renderer_create(&gs, ps_session_kernel(a->session), &go, &a->gl, err);

@@ -65,6 +65,14 @@ struct ps_gl_renderer {
     struct ps_gl_shadow_key *shadow_keys; /* shadow_lights of them */
     struct ps_gl_object_sig *object_sigs;
     size_t object_sig_count;
+    /* The shadow maps timed without waiting for them (ps_gl_make_shadow_maps):
+     * GL's time at their start, and a timestamp query at their end, read by
+     * ps_gl_settle_shadow_timing. NULL entry points: timed by glFinish. */
+    PFNGLQUERYCOUNTERPROC query_counter;
+    PFNGLGETQUERYOBJECTUI64VPROC query_result;
+    GLuint shadow_query;
+    bool shadow_query_pending;
+    GLint64 shadow_gl_start; /* ns, GL's clock */
     GLuint fbo, kernel_tex, spot_tex;
     GLuint *profile_tex; /* the IES lights' cube maps, as lights->profiles */
     size_t profile_count;
@@ -165,6 +173,12 @@ ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err); /* new lights: s
 void ps_gl_lights_free(ps_gl_renderer *r);
 void ps_gl_make_spot_texture(ps_gl_renderer *r);
 void ps_gl_make_shadow_maps(ps_gl_renderer *r);
+/* The timestamp query's answer added to the shadow maps' seconds, if one is
+ * pending: waits for GL to reach the maps' end if it has not. */
+void ps_gl_settle_shadow_timing(ps_gl_renderer *r);
+/* Where GL has timer queries and the platform gives them: the entry points
+ * and the query (ps_gl_options.gl_proc). */
+void ps_gl_timer_init(ps_gl_renderer *r);
 /* Each GL light's pass added to the frame, times exposure, then emissive
  * faces; shadows: through the shadow cubes (else one pass a light). */
 void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows);

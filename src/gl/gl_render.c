@@ -436,13 +436,18 @@ ps_status ps_gl_renderer_create(const ps_gl_scene *in, const ps_kernel_texture *
         return st;
     }
     glGenFramebuffers(1, &r->fbo);
+    ps_gl_timer_init(r);
     ps_gl_upload_kernel(r, kernel);
     ps_gl_make_spot_texture(r);
     *out = r;
     return PS_OK;
 }
 
-ps_gl_stats ps_gl_get_stats(const ps_gl_renderer *r) { return r->stats; }
+ps_gl_stats ps_gl_get_stats(ps_gl_renderer *r)
+{
+    ps_gl_settle_shadow_timing(r);
+    return r->stats;
+}
 
 void ps_gl_renderer_destroy(ps_gl_renderer *r)
 {
@@ -454,6 +459,8 @@ void ps_gl_renderer_destroy(ps_gl_renderer *r)
     free(r->range_bounds);
     if (r->fbo)
         glDeleteFramebuffers(1, &r->fbo);
+    if (r->shadow_query)
+        glDeleteQueries(1, &r->shadow_query);
     if (r->kernel_tex)
         glDeleteTextures(1, &r->kernel_tex);
     free(r);

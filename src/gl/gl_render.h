@@ -44,6 +44,12 @@
 
 typedef struct ps_gl_renderer ps_gl_renderer;
 
+/* A GL entry point by name, from the program's platform
+ * (ps_platform_gl_proc), for those its GL library need not export: OSMesa
+ * exports no glQueryCounter. NULL where there is none. */
+typedef void (*ps_gl_proc)(void);
+typedef ps_gl_proc ps_gl_proc_lookup(const char *name);
+
 typedef struct ps_gl_options {
     bool shadows;      /* default true */
     bool float_buffer; /* the colour buffer keeps floats: no clamping anywhere */
@@ -60,6 +66,10 @@ typedef struct ps_gl_options {
                              * (preview/bake.h, ps_gl_direct_bake_lay), which every view,
                              * moving ones too, draws until the lights, the geometry or
                              * the materials change (default false) */
+    ps_gl_proc_lookup *gl_proc; /* the platform's lookup: with GL 3.3 or ARB_timer_query, the
+                                 * shadow maps are timed by a GL timestamp at their end, and
+                                 * the passes after them need not wait for them; NULL: by
+                                 * waiting for them (glFinish) */
 } ps_gl_options;
 
 /* What the renderer draws, prepared GL-free; everything pointed to must
@@ -204,7 +214,9 @@ ps_status ps_gl_layers_composite(ps_gl_layers *l, double direct_gain, const doub
 /* What ran: shadow maps made so far and lighting passes in the last frame;
  * the faces the last shadow-map pass rendered (only those whose depths can
  * have changed, gl_lights.c) and its seconds (0 when no pass ran since the
- * caller last reset them with ps_gl_clear_shadow_timing). */
+ * caller last reset them with ps_gl_clear_shadow_timing): from its start to
+ * GL's end of it, which ps_gl_get_stats waits for if GL has not reached it
+ * (timed by a timestamp, ps_gl_options.gl_proc). */
 typedef struct ps_gl_stats {
     unsigned shadow_maps, light_passes, virtual_lights;
     uint64_t light_vertices; /* vertices the lit passes of the last frame drew */
@@ -216,7 +228,7 @@ typedef struct ps_gl_stats {
     uint64_t views;          /* views begun (ps_gl_begin_frame*: clear, prepass, direct light), all told */
 } ps_gl_stats;
 void ps_gl_clear_shadow_timing(ps_gl_renderer *r);
-ps_gl_stats ps_gl_get_stats(const ps_gl_renderer *r);
+ps_gl_stats ps_gl_get_stats(ps_gl_renderer *r);
 
 /* With bake_direct: the direct light of diffuse quads laid into their
  * textures (preview/bake.h), a quad side at a time for about max_seconds

@@ -36,5 +36,10 @@ void ps_platform_present(ps_platform *p);
 ps_status ps_platform_read(ps_platform *p, ps_image *out, ps_error *err);
 /* The window (a GLFWwindow *, for input callbacks), or NULL headless. */
 void *ps_platform_window(ps_platform *p);
+/* A GL entry point of the current context by name, or NULL: for those the
+ * GL library need not export (OSMesa exports no glQueryCounter), as
+ * ps_gl_options.gl_proc. */
+typedef void (*ps_platform_proc)(void);
+ps_platform_proc ps_platform_gl_proc(const char *name);
 
 #endif

@@ -52,6 +52,8 @@ void ps_platform_close(ps_platform *p)
 
 void ps_platform_make_current(ps_platform *p) { glfwMakeContextCurrent(p->win); }
 
+ps_platform_proc ps_platform_gl_proc(const char *name) { return (ps_platform_proc)glfwGetProcAddress(name); }
+
 void ps_platform_size(const ps_platform *p, int *width, int *height)
 {
     *width = p->width;

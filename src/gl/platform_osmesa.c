@@ -55,6 +55,8 @@ void ps_platform_close(ps_platform *p)
     free(p);
 }
 
+ps_platform_proc ps_platform_gl_proc(const char *name) { return (ps_platform_proc)OSMesaGetProcAddress(name); }
+
 void ps_platform_make_current(ps_platform *p) { OSMesaMakeCurrent(p->ctx, p->buffer, p->type, p->width, p->height); }
 
 void ps_platform_size(const ps_platform *p, int *width, int *height)
