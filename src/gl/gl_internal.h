@@ -153,21 +153,6 @@ void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil)
  * a scene's objects lie outside; GL clips only after it has lit them. */
 void ps_gl_draw_mesh_within(ps_gl_renderer *r, const double (*planes)[4], int plane_count);
 
-/* The depth passes' push-back, in glPolygonOffset's (factor, units): the
- * shadow maps' against self-shadowing (acne), and the eye's depth prepass's,
- * so that later passes of the same surface pass GL_LEQUAL even where a clip
- * plane re-rasterises it. One pair for both: llvmpipe compiles a
- * triangle-setup function for each polygon offset it meets (the offset is in
- * its key, and no disk cache keeps these), 3-5 ms of every first picture.
- * The shadow maps had (2, 4). At (1, 1) (the steepest slope over a texel,
- * which covers the half texel each way a nearest lookup can be off) the
- * direct layer against the reference stayed or got better: the ring's relMSE 0.041 to 0.028 (the larger offset leaked
- * light at its foot), the default box 0.0039 to 0.0038, the area box the
- * same. The prepass at (2, 4) let a wall's splats through at its edges
- * (test_gl_moving's shrunk layer: pixels 0.17-1.79x, against 0.67-1.21x). */
-#define PS_GL_DEPTH_OFFSET_FACTOR 1.0f
-#define PS_GL_DEPTH_OFFSET_UNITS 1.0f
-
 /* Lights (gl_lights.c). */
 ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err); /* new lights: shadow slots, maps remade */
 void ps_gl_lights_free(ps_gl_renderer *r);

@@ -16,6 +16,10 @@
  * of E off R (not R/Q) moves the test by that error's own 1/distance law. */
 #define SHADOW_TEXGEN_ULPS 32.0
 #define FLOAT_ULP 1.1920928955078125e-07 /* 2^-23 */
+/* Shadow maps are pushed back against self-shadowing (acne), in
+ * glPolygonOffset's (factor, units). */
+#define SHADOW_OFFSET_FACTOR 2.0f
+#define SHADOW_OFFSET_UNITS 4.0f
 /* A spot light's cone, drawn per pixel: a disc texture projected from the
  * light (thesis departure: GL's GL_SPOT_CUTOFF is applied per vertex, so the
  * cone's edge followed the mesh in steps a mesh edge wide, and photosplat-bench
@@ -374,7 +378,7 @@ void ps_gl_make_shadow_maps(ps_gl_renderer *r)
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(PS_GL_DEPTH_OFFSET_FACTOR, PS_GL_DEPTH_OFFSET_UNITS);
+    glPolygonOffset(SHADOW_OFFSET_FACTOR, SHADOW_OFFSET_UNITS);
     for (size_t i = 0; i < r->shadow_lights; i++) {
         const ps_preview_light *v = &lights_of(r)->lights[i];
         GLuint *shadow = r->shadow[i];

@@ -12,6 +12,10 @@
 /* The camera's near plane: never nearer than this fraction of its far plane,
  * which keeps 24-bit depth fine enough for the depth prepass and the splats. */
 #define CAMERA_DEPTH_RATIO 4096.0
+/* The depth prepass is pushed back so that later passes of the same surface
+ * pass GL_LEQUAL even where a clip plane re-rasterises it (glPolygonOffset's
+ * factor and units). */
+#define PREPASS_OFFSET 1.0f
 /* Blinn's (n.h)^s is about Phong's cos^e(alpha) when s = 4e; GL caps s at 128. */
 #define BLINN_PER_PHONG 4.0
 #define GL_MAX_SHININESS 128.0
@@ -268,14 +272,14 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
     glMatrixMode(GL_MODELVIEW);
     glLoadMatrixd(r->view);
 
-    /* Depth first, pushed back a little (see PS_GL_DEPTH_OFFSET_FACTOR). */
+    /* Depth first, pushed back a little (see PREPASS_OFFSET). */
     glDisable(GL_BLEND);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(PS_GL_DEPTH_OFFSET_FACTOR, PS_GL_DEPTH_OFFSET_UNITS);
+    glPolygonOffset(PREPASS_OFFSET, PREPASS_OFFSET);
     /* Each visible pixel keeps its object's stencil value, for clipping splats. */
     glEnable(GL_STENCIL_TEST);
     glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
