@@ -92,6 +92,23 @@ done
 cmp -s "$cli_tmp/lp1.png" "$cli_tmp/lp2.png" && cmp -s "$cli_tmp/lp1.png" "$cli_tmp/lp3.png" && ok ||
     bad "the picture depends on LP_NUM_THREADS"
 
+# ... and whether llvmpipe optimises its programs: snap leaves its passes out
+# (GALLIVM_PERF=nopt, platform_osmesa.c) unless the user set GALLIVM_PERF,
+# here empty: Mesa's defaults. Every layer of the design room (its specular
+# layer too), 8 bits and float, triangles and sprites (their own programs).
+for args in "--splat triangles --color-depth 8" "--splat sprites --color-depth float"; do
+    for opt in default passes; do
+        if [ $opt = default ]; then e=(env -u GALLIVM_PERF); else e=(env GALLIVM_PERF=); fi
+        expect_success "llvmpipe $opt, $args" "${e[@]}" "$snap" data/scenes/design-room.scn "${small[@]}" $args \
+            --hdr "$cli_tmp/opt-$opt.pfm" --hdr-layers "$cli_tmp/opt-$opt"
+    done
+    for f in opt-default.pfm opt-default-direct.pfm opt-default-caustic.pfm opt-default-global.pfm \
+        opt-default-specular.pfm; do
+        cmp -s "$cli_tmp/$f" "$cli_tmp/${f/default/passes}" && ok ||
+            bad "$f ($args) differs with llvmpipe's optimisation passes"
+    done
+done
+
 # Progressive mode: several refreshes, photons up to the cap at most.
 expect_success "progressive" "$snap" "$scene" --size 32x32 --time 0.6 --tau 0.1 --caustic-photons 400000 \
     --global-photons 100000 -o "$cli_tmp/p.png" --stats "$cli_tmp/p.json"

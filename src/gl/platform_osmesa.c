@@ -17,9 +17,20 @@ struct ps_platform {
     int width, height;
 };
 
+/* llvmpipe compiles a program for each new GL state on first use (the
+ * fragment and vertex programs, often from Mesa's disk cache, and a triangle
+ * set-up function, never cached), and most of a first picture is those
+ * compiles (docs/preview.md). Mesa's GALLIVM_PERF=nopt leaves out its LLVM IR
+ * optimisation passes: the same pictures, byte for byte, compiled sooner, at
+ * some cost in fill rate. Set before the context is made (Mesa reads it
+ * once), and never over the user's own GALLIVM_PERF. */
+#define LLVMPIPE_PERF_ENV "GALLIVM_PERF"
+#define LLVMPIPE_PERF_FAST_COMPILES "nopt"
+
 ps_status ps_platform_open(const ps_platform_config *c, ps_platform **out, ps_error *err)
 {
     *out = NULL;
+    (void)setenv(LLVMPIPE_PERF_ENV, LLVMPIPE_PERF_FAST_COMPILES, 0);
     ps_platform *p = calloc(1, sizeof *p);
     if (!p)
         return ps_error_set(err, PS_ERR_NOMEM, "out of memory for an OSMesa context");
