@@ -373,6 +373,32 @@ static void shadow_maps_timed_to_their_end(void **state)
     gl_rig_close(&g);
 }
 
+/* The colour clamps are off from the renderer's creation, before the first
+ * shadow maps: llvmpipe keys its vertex and fragment programs on them, and
+ * the maps drawn under GL's defaults (vertex colours clamped) loaded a
+ * program of their own in every first picture. */
+static void colour_unclamped_before_the_first_maps(void **state)
+{
+    (void)state;
+    ps_error err;
+    gl_rig g = gl_rig_open(scene_text);
+    inputs in;
+    inputs_make(g.s, &in);
+    ps_gl_scene gs = gl_scene(g.s, &in);
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
+    ps_gl_renderer *r;
+    assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &r, &err), PS_OK);
+    const GLenum clamps[] = {GL_CLAMP_VERTEX_COLOR, GL_CLAMP_FRAGMENT_COLOR, GL_CLAMP_READ_COLOR};
+    for (size_t i = 0; i < sizeof clamps / sizeof clamps[0]; i++) {
+        GLint v = -1;
+        glGetIntegerv(clamps[i], &v);
+        assert_int_equal(v, GL_FALSE);
+    }
+    ps_gl_renderer_destroy(r);
+    inputs_free(&in);
+    gl_rig_close(&g);
+}
+
 /* ps_gl_options.bake_direct: the direct layer of diffuse quads drawn from
  * textures laid once (gl_direct_bake.c) against the lit passes themselves
  * (a renderer without them), at the laying view and at another: relative
@@ -523,6 +549,7 @@ int main(void)
         cmocka_unit_test(culled_faces_draw_the_same),
         cmocka_unit_test(resized_shadows_render_every_face),
         cmocka_unit_test(shadow_maps_timed_to_their_end),
+        cmocka_unit_test(colour_unclamped_before_the_first_maps),
         cmocka_unit_test(direct_light_baked_on_quads),
         cmocka_unit_test(direct_light_baked_on_a_back_side),
     };

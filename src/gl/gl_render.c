@@ -440,6 +440,13 @@ ps_status ps_gl_renderer_create(const ps_gl_scene *in, const ps_kernel_texture *
         return st;
     }
     glGenFramebuffers(1, &r->fbo);
+    /* The colour clamps as every frame sets them (ps_gl_begin_frame_shadows),
+     * before the first shadow maps: llvmpipe keys its programs on them, and
+     * those maps, drawn under GL's defaults, loaded a program of their own
+     * in every first picture. */
+    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
     ps_gl_timer_init(r);
     ps_gl_upload_kernel(r, kernel);
     ps_gl_make_spot_texture(r);
