@@ -331,7 +331,10 @@ static void resized_shadows_render_every_face(void **state)
  * which the passes after them do not wait for, else by waiting. Either way
  * more than nothing and no more than the frame that made them, and the same
  * picture; a time dropped (ps_gl_clear_shadow_timing) while its query is
- * still pending stays dropped. */
+ * still pending stays dropped. And the first maps draw with the colour
+ * clamps off, as every pass after them: llvmpipe keys its programs on the
+ * clamps, and maps drawn under GL's defaults (vertex colours clamped) loaded
+ * a program of their own in every first picture. */
 static void shadow_maps_timed_to_their_end(void **state)
 {
     (void)state;
@@ -346,6 +349,12 @@ static void shadow_maps_timed_to_their_end(void **state)
         ps_gl_renderer *r;
         assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &r, &err), PS_OK);
         assert_true((r->query_counter != NULL) == (v == 0)); /* llvmpipe has GL 3.3's timer queries */
+        const GLenum clamps[] = {GL_CLAMP_VERTEX_COLOR, GL_CLAMP_FRAGMENT_COLOR, GL_CLAMP_READ_COLOR};
+        for (size_t i = 0; i < sizeof clamps / sizeof clamps[0]; i++) {
+            GLint c = -1;
+            glGetIntegerv(clamps[i], &c);
+            assert_int_equal(c, GL_FALSE);
+        }
         ps_gl_clear_shadow_timing(r);
         double t0 = ps_now_seconds();
         pic[v] = draw(r, g.s);
@@ -369,32 +378,6 @@ static void shadow_maps_timed_to_their_end(void **state)
     assert_true(same_pixels(&pic[0], &pic[1]));
     ps_image_destroy(&pic[0]);
     ps_image_destroy(&pic[1]);
-    inputs_free(&in);
-    gl_rig_close(&g);
-}
-
-/* The colour clamps are off from the renderer's creation, before the first
- * shadow maps: llvmpipe keys its vertex and fragment programs on them, and
- * the maps drawn under GL's defaults (vertex colours clamped) loaded a
- * program of their own in every first picture. */
-static void colour_unclamped_before_the_first_maps(void **state)
-{
-    (void)state;
-    ps_error err;
-    gl_rig g = gl_rig_open(scene_text);
-    inputs in;
-    inputs_make(g.s, &in);
-    ps_gl_scene gs = gl_scene(g.s, &in);
-    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
-    ps_gl_renderer *r;
-    assert_int_equal(ps_gl_renderer_create(&gs, &g.kernel, &go, &r, &err), PS_OK);
-    const GLenum clamps[] = {GL_CLAMP_VERTEX_COLOR, GL_CLAMP_FRAGMENT_COLOR, GL_CLAMP_READ_COLOR};
-    for (size_t i = 0; i < sizeof clamps / sizeof clamps[0]; i++) {
-        GLint v = -1;
-        glGetIntegerv(clamps[i], &v);
-        assert_int_equal(v, GL_FALSE);
-    }
-    ps_gl_renderer_destroy(r);
     inputs_free(&in);
     gl_rig_close(&g);
 }
@@ -549,7 +532,6 @@ int main(void)
         cmocka_unit_test(culled_faces_draw_the_same),
         cmocka_unit_test(resized_shadows_render_every_face),
         cmocka_unit_test(shadow_maps_timed_to_their_end),
-        cmocka_unit_test(colour_unclamped_before_the_first_maps),
         cmocka_unit_test(direct_light_baked_on_quads),
         cmocka_unit_test(direct_light_baked_on_a_back_side),
     };
