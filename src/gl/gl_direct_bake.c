@@ -195,8 +195,7 @@ bool ps_gl_direct_bake_lay(ps_gl_renderer *r, double exposure, double max_second
     glDisable(GL_SCISSOR_TEST);
     glDepthMask(GL_FALSE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
-    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    ps_gl_unclamp_colour();
     glClearColor(0, 0, 0, 0);
     /* A target at least, then as many as the time allows (each finished:
      * the time is the lay's, not queued for the next frame). */

@@ -153,6 +153,11 @@ void ps_gl_draw_mesh(const ps_gl_renderer *r, bool with_materials, bool stencil)
  * a scene's objects lie outside; GL clips only after it has lit them. */
 void ps_gl_draw_mesh_within(ps_gl_renderer *r, const double (*planes)[4], int plane_count);
 
+/* GL's colour clamps off, vertex, fragment and read: radiance is kept as it
+ * is on the way, and only an 8-bit buffer's store clamps it. Context state;
+ * the renderer sets it when made and every pass that relies on it again. */
+void ps_gl_unclamp_colour(void);
+
 /* Lights (gl_lights.c). */
 ps_status ps_gl_lights_reset(ps_gl_renderer *r, ps_error *err); /* new lights: shadow slots, maps remade */
 void ps_gl_lights_free(ps_gl_renderer *r);

@@ -409,9 +409,7 @@ static void composite(ps_gl_layers *l, int target, int target_w, int target_h, d
     if (corner)
         glDisable(GL_SCISSOR_TEST);
     /* Gains above 1 (N/n early on) must not clamp on the way. */
-    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
-    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
-    glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
+    ps_gl_unclamp_colour();
     glMatrixMode(GL_PROJECTION);
     glLoadIdentity();
     glMatrixMode(GL_MODELVIEW);

@@ -249,9 +249,7 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
      * modulated (shadows, spot discs, IES tables) as it is, and only an 8-bit
      * buffer's store clamps it, once, as a display would; float targets (the
      * window's layers, the illuminance pass) keep it all. */
-    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
-    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
-    glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
+    ps_gl_unclamp_colour();
     glClearColor(0, 0, 0, 0);
     glClearDepth(1.0);
     /* glClear obeys the write masks, which the last frame's splats left off. */
@@ -444,9 +442,7 @@ ps_status ps_gl_renderer_create(const ps_gl_scene *in, const ps_kernel_texture *
      * before the first shadow maps: llvmpipe keys its programs on them, and
      * those maps, drawn under GL's defaults, loaded a program of their own
      * in every first picture. */
-    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
-    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
-    glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
+    ps_gl_unclamp_colour();
     ps_gl_timer_init(r);
     ps_gl_upload_kernel(r, kernel);
     ps_gl_make_spot_texture(r);
@@ -475,6 +471,13 @@ void ps_gl_renderer_destroy(ps_gl_renderer *r)
     if (r->kernel_tex)
         glDeleteTextures(1, &r->kernel_tex);
     free(r);
+}
+
+void ps_gl_unclamp_colour(void)
+{
+    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    glClampColor(GL_CLAMP_READ_COLOR, GL_FALSE);
 }
 
 void ps_gl_begin_additive_pass(const ps_gl_renderer *r)

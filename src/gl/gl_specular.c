@@ -732,8 +732,7 @@ static void draw_terms(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s, doub
     size_t n = ranges[nr - 1].offset + mesh->ranges[ranges[nr - 1].range].count;
     ps_gl_begin_additive_pass(r);
     glBlendFunc(GL_ONE, GL_ONE);
-    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
-    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    ps_gl_unclamp_colour();
     glActiveTexture(GL_TEXTURE0);
     glEnable(GL_TEXTURE_CUBE_MAP);
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
@@ -827,8 +826,7 @@ static void draw_points(ps_gl_specular *g, ps_gl_renderer *r, const ps_specular_
     glDepthMask(GL_FALSE);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
-    glClampColor(GL_CLAMP_VERTEX_COLOR, GL_FALSE);
-    glClampColor(GL_CLAMP_FRAGMENT_COLOR, GL_FALSE);
+    ps_gl_unclamp_colour();
     glPointSize(1.0f);
     glActiveTexture(GL_TEXTURE0);
     glEnable(GL_TEXTURE_CUBE_MAP);
