@@ -10,6 +10,11 @@
  *  - with --global-layer maps, the illumination maps gather the round's
  *    photons beside the work too, before the first refresh, and its
  *    picture is still the same floats as a plain start's;
+ *  - the direct layer's lit passes are left by the view (ps_gl_defer_lit)
+ *    and drawn by the refresh after its splats: the direct layer the same
+ *    floats as the passes drawn at once, an emitter in a wall's plane
+ *    included; drawn first by a view begun elsewhere in between, dropped
+ *    (and the view drawn again) after new materials, the picture the same;
  *  - 8 bits (ps_gl_draw_view_ahead): the view drawn beside the round into
  *    the colour buffer, the first frame draws only its splats over it, the
  *    same bytes as a frame drawn whole; for another camera or exposure, after
@@ -211,10 +216,134 @@ static void maps_gathered_beside_the_round(void **state)
     ps_image_destroy(&splats.img);
 }
 
+/* ---- The direct layer's lit passes after the splats (ps_gl_defer_lit) ---------- */
+
+/* What happens between the view drawn ahead and the first picture: nothing,
+ * a view of another camera begun (8 bits: into the colour buffer), the same
+ * camera's view begun into another target (the layers: the colour buffer,
+ * as a cube face is drawn before the layers' splats), new materials. */
+typedef enum between { BETWEEN_NOTHING, BETWEEN_OTHER_VIEW, BETWEEN_OTHER_TARGET, BETWEEN_MATERIALS } between;
+
+/* ROOM with a quad light in the back wall's plane, facing the camera: the
+ * wall's lit passes pass the depth test on some of its pixels (the same
+ * plane, rounded either way), which the view drew over with the emitter's
+ * colour. */
+static const char *const ROOM_LAMP = "camera eye 0 1 3 target 0 0.5 0 fov 45\n"
+                                     "material white diffuse albedo 0.75 0.75 0.75\n"
+                                     "material glass dielectric ior 1.5\n"
+                                     "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
+                                     "quad corner -1 0 -1 edge1 2 0 0 edge2 0 2 0 material white\n"
+                                     "sphere center 0 0.4 0 radius 0.3 material glass\n"
+                                     "light point position 0 1.5 0.3 power 50 50 50\n"
+                                     "light quad corner -0.2 0.75 -1 edge1 0.4 0 0 edge2 0 0.4 0 power 5 5 5\n"
+                                     "photons caustic 40000 global 10000\n";
+
+typedef struct deferred_picture {
+    ps_image whole, direct; /* the first refresh's composite, and its direct layer alone */
+    ps_image direct_now;    /* the direct layer drawn again at once (ps_gl_layers_relight) */
+    unsigned passes_ahead;  /* lit passes drawn when the view beside the round was done */
+    unsigned passes;        /* ... and when the first refresh was */
+    uint64_t views;
+} deferred_picture;
+
+/* The first float picture of ROOM_LAMP, its view drawn beside the round
+ * (ahead) or by the refresh, with `b` done between the two. */
+static deferred_picture deferred_first(bool ahead, between b)
+{
+    gl_rig g;
+    ps_session_settings set = gl_rig_load(&g, ROOM_LAMP, "deferred.scn");
+    set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
+    gl_rig_untraced(&g, &set, SIDE);
+    ps_gl_scene gs = ps_gl_scene_of(g.s);
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
+    ps_gl_renderer *gl;
+    ps_gl_layers *l;
+    ps_error err;
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g.s), &go, &gl, &err), PS_OK);
+    assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &l, &err), PS_OK);
+    deferred_picture out;
+    memset(&out, 0, sizeof out);
+    start(&g, l, gl, ahead, 0.0, 1.0);
+    out.passes_ahead = ps_gl_get_stats(gl).light_passes;
+    if (b == BETWEEN_OTHER_TARGET) {
+        /* The same camera (the layers' splats take the last view's
+         * matrices: a cube face puts the view's back, gl_specular.c). */
+        double exposure;
+        bool direct;
+        ps_session_direct_view(g.s, &exposure, &direct);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        ps_gl_begin_frame(gl, &g.cam, exposure, direct);
+    } else if (b == BETWEEN_MATERIALS) {
+        ps_gl_renderer_set_materials(gl, ps_session_materials(g.s), false);
+    }
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(g.s, &g.cam, &f, &err), PS_OK);
+    ps_gl_layers_draw(l, gl, &g.cam, &f);
+    out.passes = ps_gl_get_stats(gl).light_passes;
+    out.views = ps_gl_get_stats(gl).views;
+    double gains[PS_MAP_COUNT], none[PS_MAP_COUNT] = {0.0, 0.0};
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        gains[k] = f.map[k].gain;
+    assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, gains, &out.whole, &err), PS_OK);
+    assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, none, &out.direct, &err), PS_OK);
+    ps_gl_layers_relight(l, gl, &g.cam, f.direct_exposure, f.direct);
+    assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, none, &out.direct_now, &err), PS_OK);
+    ps_gl_layers_destroy(l);
+    ps_gl_renderer_destroy(gl);
+    gl_rig_close(&g);
+    return out;
+}
+
+static void same_image(const ps_image *a, const ps_image *b)
+{
+    assert_int_equal(a->width, b->width);
+    assert_int_equal(a->height, b->height);
+    assert_true(gl_rig_image_mean(a) > 0.0);
+    assert_memory_equal(a->rgb, b->rgb, 3 * (size_t)a->width * (size_t)a->height * sizeof *a->rgb);
+}
+
+static void deferred_destroy(deferred_picture *p)
+{
+    ps_image_destroy(&p->whole);
+    ps_image_destroy(&p->direct);
+    ps_image_destroy(&p->direct_now);
+}
+
+static void lit_passes_drawn_after_the_splats(void **state)
+{
+    (void)state;
+    deferred_picture plain = deferred_first(false, BETWEEN_NOTHING);
+    deferred_picture ahead = deferred_first(true, BETWEEN_NOTHING);
+    printf("lit passes: %u when the view beside the round was drawn, %u after the first refresh\n",
+           ahead.passes_ahead, ahead.passes);
+    /* The view beside the round left them; the refresh drew them, after its splats. */
+    assert_int_equal(ahead.passes_ahead, 0);
+    assert_true(ahead.passes > 0);
+    assert_int_equal(ahead.views, 1);
+    /* The direct layer as the same passes drawn at once give it, the
+     * emitter's colour over the wall it lies in included. */
+    same_image(&ahead.direct, &ahead.direct_now);
+    same_image(&plain.direct, &plain.direct_now);
+    same_image(&ahead.whole, &plain.whole);
+    /* A view begun elsewhere before the refresh draws the passes left first,
+     * as the view drawn ahead saw them: the same picture. */
+    deferred_picture other = deferred_first(true, BETWEEN_OTHER_TARGET);
+    assert_int_equal(other.views, 2);
+    same_image(&other.whole, &plain.whole);
+    same_image(&other.direct, &plain.direct);
+    /* New materials before it: the passes left are dropped, and the refresh
+     * draws its view again. */
+    deferred_picture materials = deferred_first(true, BETWEEN_MATERIALS);
+    assert_int_equal(materials.views, 2);
+    same_image(&materials.whole, &plain.whole);
+    deferred_destroy(&plain);
+    deferred_destroy(&ahead);
+    deferred_destroy(&other);
+    deferred_destroy(&materials);
+}
+
 /* ---- 8 bits: the view drawn into the colour buffer --------------------------- */
 
-/* What happens between the view drawn ahead and the first frame. */
-typedef enum between { BETWEEN_NOTHING, BETWEEN_OTHER_VIEW, BETWEEN_MATERIALS } between;
 
 typedef struct first8 {
     ps_image img;
@@ -325,6 +454,7 @@ int main(void)
         cmocka_unit_test(view_drawn_beside_the_round),
         cmocka_unit_test(another_view_drawn_again),
         cmocka_unit_test(maps_gathered_beside_the_round),
+        cmocka_unit_test(lit_passes_drawn_after_the_splats),
         cmocka_unit_test(view_drawn_ahead_into_8_bits),
         cmocka_unit_test(view_8bit_drawn_again_when_not_the_frames),
     };

@@ -48,6 +48,22 @@ void ps_gl_ahead_hold(ps_gl_ahead *a, const ps_gl_renderer *r, const ps_camera_f
 bool ps_gl_ahead_is(const ps_gl_ahead *a, const ps_gl_renderer *r, const ps_camera_frame *cam,
                     const ps_session_frame *f);
 
+/* A view's lit passes left for later (ps_gl_defer_lit): what they need of
+ * the view, its target, size, matrices and mesh, kept until they are drawn
+ * (ps_gl_draw_deferred_lit). */
+typedef struct ps_gl_deferred_lit {
+    bool requested; /* the next view begun leaves its lit passes */
+    bool pending;   /* a view's lit passes not drawn yet */
+    GLint fbo;      /* the view's target (the framebuffer bound when it began) */
+    int width, height;
+    double proj[16], view[16], eye_extent;
+    const ps_preview_mesh *lit;
+    ps_vec3 eye;
+    double exposure;
+    bool shadows, baked;
+    uint64_t epoch; /* lit_epoch at the view: another, and the passes are dropped */
+} ps_gl_deferred_lit;
+
 struct ps_gl_renderer {
     ps_gl_scene in;
     /* The mesh this frame's lit passes draw: in.mesh, or in.moving for a
@@ -109,6 +125,7 @@ struct ps_gl_renderer {
     /* ps_gl_draw_view_ahead: the still view in the framebuffer; dropped by
      * the next view begun. */
     ps_gl_ahead ahead;
+    ps_gl_deferred_lit deferred;
 };
 
 /* Textures (gl_albedo.c). The lit passes and the splats use the materials'
@@ -181,6 +198,28 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
 /* Area lights as the eye sees them, in their radiance times exposure, or
  * black when the direct layer is off. */
 void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct);
+/* Their colour again, where ps_gl_draw_emitters drew them (GL_EQUAL against
+ * the depth they wrote, which nothing after them writes): over passes
+ * drawn after them that they would have covered. */
+void ps_gl_draw_emitters_colour(const ps_gl_renderer *r, double exposure, bool direct);
+
+/* The next view begun (ps_gl_begin_frame_shadows) draws its shadow maps,
+ * depth prepass and emitters, and leaves its lit passes to
+ * ps_gl_draw_deferred_lit, for a caller whose view has a target of its own
+ * (the float layers' direct layer): llvmpipe rasterises what is drawn
+ * meanwhile (the splats, into the other layers) while the lit passes are
+ * issued, and the direct layer is the same. */
+void ps_gl_defer_lit(ps_gl_renderer *r);
+/* A view's lit passes left by ps_gl_defer_lit, drawn into its target, and
+ * the emitters' colour over them (ps_gl_draw_emitters_colour: the view drew
+ * them after its lit passes). Nothing when none are left, or when the
+ * lights or shadows have changed since (lit_epoch): that view is stale and
+ * is drawn again before it is shown (ps_gl_ahead_is; ps_gl_layers_draw
+ * draws its own in one call). The framebuffer bound is kept; the matrices
+ * and the viewport are the view's after. ps_gl_begin_frame_shadows draws
+ * them first when it begins a view into another target, and drops them
+ * when into theirs (the new view clears it). */
+void ps_gl_draw_deferred_lit(ps_gl_renderer *r);
 
 /* Layers (gl_layers.c): the depth-stencil buffer every layer shares, and
  * one more texture (the specular layer, gl_specular.c) added to the

@@ -709,21 +709,11 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows)
  * are not in the shadow maps, as photons and shadow rays pass through them. */
 #define DISC_SEGMENTS 64
 
-void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct)
+/* The emitters' shapes, in their radiance times exposure (black without
+ * the direct layer), under the caller's depth and stencil state. */
+static void draw_emitter_shapes(const ps_gl_renderer *r, double exposure, bool direct)
 {
-    if (r->in.hide_emitters)
-        return;
     const ps_preview_lights *lights = lights_of(r);
-    glDisable(GL_BLEND);
-    glDisable(GL_LIGHTING);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glEnable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
-    /* Their pixels belong to no object: splats are not clipped into them. */
-    glEnable(GL_STENCIL_TEST);
-    glStencilFunc(GL_ALWAYS, 0, 0xff);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
     for (size_t l = 0; l < lights->emitter_count; l++) {
         const ps_preview_emitter *L = &lights->emitters[l];
         double k = direct ? exposure : 0.0;
@@ -757,7 +747,40 @@ void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct)
             glEnd();
         }
     }
+}
+
+void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct)
+{
+    if (r->in.hide_emitters)
+        return;
+    glDisable(GL_BLEND);
+    glDisable(GL_LIGHTING);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    /* Their pixels belong to no object: splats are not clipped into them. */
+    glEnable(GL_STENCIL_TEST);
+    glStencilFunc(GL_ALWAYS, 0, 0xff);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+    draw_emitter_shapes(r, exposure, direct);
     glDisable(GL_STENCIL_TEST);
     glDisable(GL_CULL_FACE);
+}
+
+void ps_gl_draw_emitters_colour(const ps_gl_renderer *r, double exposure, bool direct)
+{
+    if (r->in.hide_emitters || lights_of(r)->emitter_count == 0)
+        return;
+    glDisable(GL_BLEND);
+    glDisable(GL_LIGHTING);
+    /* Their own depth, to the bit: the same shapes and matrices. */
+    glDepthFunc(GL_EQUAL);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    draw_emitter_shapes(r, exposure, direct);
+    glDisable(GL_CULL_FACE);
+    glDepthFunc(GL_LEQUAL);
 }
 

@@ -230,6 +230,17 @@ void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exp
 void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
                                bool shadows, bool moving)
 {
+    /* A view whose lit passes wait (ps_gl_defer_lit): drawn now where this
+     * view has another target (a cube face before the layers' splats),
+     * dropped where it has theirs, which this view clears. */
+    if (r->deferred.pending) {
+        GLint fbo = 0;
+        glGetIntegerv(GL_FRAMEBUFFER_BINDING, &fbo);
+        if (fbo == r->deferred.fbo)
+            r->deferred.pending = false;
+        else
+            ps_gl_draw_deferred_lit(r);
+    }
     r->ahead.held = false; /* the framebuffer's view is this one from here on */
     r->lit = moving && r->in.moving ? r->in.moving : r->in.mesh;
     r->stats.views++;
@@ -286,7 +297,28 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
     glDisable(GL_STENCIL_TEST);
     glDisable(GL_POLYGON_OFFSET_FILL);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    if (direct) {
+    bool defer = direct && r->deferred.requested;
+    r->deferred.requested = false;
+    if (defer) {
+        /* The lit passes later (ps_gl_draw_deferred_lit); the emitters now,
+         * whose depth hides the splats behind them. */
+        ps_gl_deferred_lit *d = &r->deferred;
+        d->pending = true;
+        GLint fbo = 0;
+        glGetIntegerv(GL_FRAMEBUFFER_BINDING, &fbo);
+        d->fbo = fbo;
+        d->width = cam->width;
+        d->height = cam->height;
+        memcpy(d->proj, r->proj, sizeof d->proj);
+        memcpy(d->view, r->view, sizeof d->view);
+        d->eye_extent = r->eye_extent;
+        d->lit = r->lit;
+        d->eye = cam->eye;
+        d->exposure = exposure;
+        d->shadows = shadows;
+        d->baked = baked;
+        d->epoch = r->lit_epoch;
+    } else if (direct) {
         /* Each light adds its pass on top. */
         glDepthMask(GL_FALSE);
         glDepthFunc(GL_LEQUAL);
@@ -302,6 +334,59 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
         glDisable(GL_BLEND);
     }
     ps_gl_draw_emitters(r, exposure, direct);
+}
+
+void ps_gl_defer_lit(ps_gl_renderer *r) { r->deferred.requested = true; }
+
+void ps_gl_draw_deferred_lit(ps_gl_renderer *r)
+{
+    ps_gl_deferred_lit *d = &r->deferred;
+    if (!d->pending)
+        return;
+    d->pending = false;
+    if (d->epoch != r->lit_epoch)
+        return;
+    GLint old_fbo = 0, old_box[4] = {0, 0, 0, 0};
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glGetIntegerv(GL_SCISSOR_BOX, old_box);
+    GLboolean old_scissor = glIsEnabled(GL_SCISSOR_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)d->fbo);
+    glViewport(0, 0, d->width, d->height);
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(d->proj);
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(d->view);
+    /* The state the view's own passes had after its prepass
+     * (ps_gl_begin_frame_shadows), whatever was drawn since; the scissor
+     * too, which a level of detail's view had on its corner (gl_layers.c). */
+    glScissor(0, 0, d->width, d->height);
+    glEnable(GL_SCISSOR_TEST);
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_LEQUAL);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    const ps_preview_mesh *lit = r->lit;
+    double extent = r->eye_extent;
+    r->lit = d->lit;
+    r->eye_extent = d->eye_extent;
+    if (d->baked)
+        ps_gl_direct_bake_draw(r, d->eye);
+    r->skip_baked = d->baked;
+    ps_gl_draw_direct(r, d->exposure, d->shadows);
+    r->skip_baked = false;
+    r->lit = lit;
+    r->eye_extent = extent;
+    glDisable(GL_BLEND);
+    ps_gl_draw_emitters_colour(r, d->exposure, true);
+    glScissor(old_box[0], old_box[1], old_box[2], old_box[3]);
+    if (!old_scissor)
+        glDisable(GL_SCISSOR_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
 }
 
 void ps_gl_ahead_hold(ps_gl_ahead *a, const ps_gl_renderer *r, const ps_camera_frame *cam, double exposure,
