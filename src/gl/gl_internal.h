@@ -61,6 +61,7 @@ typedef struct ps_gl_deferred_lit {
     ps_vec3 eye;
     double exposure;
     bool shadows, baked;
+    bool skip_specular, hide_emitters; /* as the view had them (a cube face sets both its own way) */
     uint64_t epoch; /* lit_epoch at the view: another, and the passes are dropped */
 } ps_gl_deferred_lit;
 

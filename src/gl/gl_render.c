@@ -317,6 +317,8 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
         d->exposure = exposure;
         d->shadows = shadows;
         d->baked = baked;
+        d->skip_specular = r->skip_specular;
+        d->hide_emitters = r->in.hide_emitters;
         d->epoch = r->lit_epoch;
     } else if (direct) {
         /* Each light adds its pass on top. */
@@ -370,19 +372,26 @@ void ps_gl_draw_deferred_lit(ps_gl_renderer *r)
     glDepthFunc(GL_LEQUAL);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
+    /* The view's own settings, where a cube face begun since (which draws
+     * these first) has its own. */
     const ps_preview_mesh *lit = r->lit;
     double extent = r->eye_extent;
+    bool skip_specular = r->skip_specular, hide_emitters = r->in.hide_emitters;
     r->lit = d->lit;
     r->eye_extent = d->eye_extent;
+    r->skip_specular = d->skip_specular;
+    r->in.hide_emitters = d->hide_emitters;
     if (d->baked)
         ps_gl_direct_bake_draw(r, d->eye);
     r->skip_baked = d->baked;
     ps_gl_draw_direct(r, d->exposure, d->shadows);
     r->skip_baked = false;
-    r->lit = lit;
-    r->eye_extent = extent;
     glDisable(GL_BLEND);
     ps_gl_draw_emitters_colour(r, d->exposure, true);
+    r->lit = lit;
+    r->eye_extent = extent;
+    r->skip_specular = skip_specular;
+    r->in.hide_emitters = hide_emitters;
     glScissor(old_box[0], old_box[1], old_box[2], old_box[3]);
     if (!old_scissor)
         glDisable(GL_SCISSOR_TEST);
