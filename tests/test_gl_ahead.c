@@ -37,14 +37,16 @@
 
 /* A box's floor under a point light, a glass sphere focusing a caustic on
  * it: both maps in the first round, shadows in the view. */
-static const char *const ROOM = "camera eye 0 1 3 target 0 0.5 0 fov 45\n"
-                                "material white diffuse albedo 0.75 0.75 0.75\n"
-                                "material glass dielectric ior 1.5\n"
-                                "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
-                                "quad corner -1 0 -1 edge1 2 0 0 edge2 0 2 0 material white\n"
-                                "sphere center 0 0.4 0 radius 0.3 material glass\n"
-                                "light point position 0 1.5 0.3 power 50 50 50\n"
-                                "photons caustic 40000 global 10000\n";
+#define ROOM_OBJECTS                                                                                     \
+    "camera eye 0 1 3 target 0 0.5 0 fov 45\n"                                                          \
+    "material white diffuse albedo 0.75 0.75 0.75\n"                                                    \
+    "material glass dielectric ior 1.5\n"                                                               \
+    "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"                                      \
+    "quad corner -1 0 -1 edge1 2 0 0 edge2 0 2 0 material white\n"                                      \
+    "sphere center 0 0.4 0 radius 0.3 material glass\n"                                                 \
+    "light point position 0 1.5 0.3 power 50 50 50\n"
+#define ROOM_PHOTONS "photons caustic 40000 global 10000\n"
+static const char *const ROOM = ROOM_OBJECTS ROOM_PHOTONS;
 
 /* The view drawn beside the round: into the float layers, or (layers NULL)
  * into the 8-bit colour buffer. */
@@ -98,47 +100,65 @@ typedef struct first_picture {
     double ahead_seconds; /* the session's count of them (ps_session_counts) */
 } first_picture;
 
+/* A scene untraced at SIDE with every layer in float, its renderer and
+ * its layers, as photosplat-snap's --time draws them. */
+typedef struct float_rig {
+    gl_rig g;
+    ps_gl_renderer *gl;
+    ps_gl_layers *l;
+} float_rig;
+
+static void float_rig_open(float_rig *r, const char *text, const char *name, ps_global_layer global)
+{
+    ps_session_settings set = gl_rig_load(&r->g, text, name);
+    set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
+    set.global_layer = global;
+    gl_rig_untraced(&r->g, &set, SIDE);
+    ps_gl_scene gs = ps_gl_scene_of(r->g.s);
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
+    ps_error err;
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(r->g.s), &go, &r->gl, &err), PS_OK);
+    assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &r->l, &err), PS_OK);
+}
+
+static void float_rig_close(float_rig *r)
+{
+    ps_gl_layers_destroy(r->l);
+    ps_gl_renderer_destroy(r->gl);
+    gl_rig_close(&r->g);
+}
+
 /* The first refresh's composite, the session started the plain way, or
  * with the view drawn beside its round (ahead) for the scene's camera, its
  * eye moved eye_dx along x, at the refresh's exposure times exposure_factor;
  * the global layer as splats or as illumination maps. */
 static first_picture first_of(bool ahead, double eye_dx, double exposure_factor, ps_global_layer global)
 {
-    gl_rig g;
-    ps_session_settings set = gl_rig_load(&g, ROOM, "ahead.scn");
-    set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
-    set.global_layer = global;
-    gl_rig_untraced(&g, &set, SIDE);
-    ps_gl_scene gs = ps_gl_scene_of(g.s);
-    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
-    ps_gl_renderer *gl;
-    ps_gl_layers *l;
+    float_rig r;
+    float_rig_open(&r, ROOM, "ahead.scn", global);
+    gl_rig *g = &r.g;
     ps_error err;
-    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g.s), &go, &gl, &err), PS_OK);
-    assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &l, &err), PS_OK);
     first_picture out = {0};
-    out.calls = start(&g, l, gl, ahead, eye_dx, exposure_factor);
-    const ps_illummap *imap = ps_session_illummap(g.s);
+    out.calls = start(g, r.l, r.gl, ahead, eye_dx, exposure_factor);
+    const ps_illummap *imap = ps_session_illummap(g->s);
     out.gathered = imap ? ps_illummap_count(imap) : 0;
     ps_session_counts counts;
-    ps_session_get_counts(g.s, &counts);
+    ps_session_get_counts(g->s, &counts);
     out.ahead_seconds = counts.ahead_seconds;
     ps_session_frame f;
-    assert_int_equal(ps_session_refresh(g.s, &g.cam, &f, &err), PS_OK);
+    assert_int_equal(ps_session_refresh(g->s, &g->cam, &f, &err), PS_OK);
     assert_true(f.new_view && !f.moving);
     out.shown = imap ? ps_illummap_count(imap) : 0;
-    ps_gl_layers_draw(l, gl, &g.cam, &f);
+    ps_gl_layers_draw(r.l, r.gl, &g->cam, &f);
     double gains[PS_MAP_COUNT];
     for (int k = 0; k < PS_MAP_COUNT; k++) {
         gains[k] = f.map[k].gain;
         out.emitted[k] = f.emitted[k];
         assert_true(f.emitted[k] > 0);
     }
-    assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, gains, &out.img, &err), PS_OK);
-    out.views = ps_gl_get_stats(gl).views;
-    ps_gl_layers_destroy(l);
-    ps_gl_renderer_destroy(gl);
-    gl_rig_close(&g);
+    assert_int_equal(ps_gl_layers_composite(r.l, f.direct_gain, gains, &out.img, &err), PS_OK);
+    out.views = ps_gl_get_stats(r.gl).views;
+    float_rig_close(&r);
     return out;
 }
 
@@ -228,15 +248,8 @@ typedef enum between { BETWEEN_NOTHING, BETWEEN_OTHER_VIEW, BETWEEN_OTHER_TARGET
  * wall's lit passes pass the depth test on some of its pixels (the same
  * plane, rounded either way), which the view drew over with the emitter's
  * colour. */
-static const char *const ROOM_LAMP = "camera eye 0 1 3 target 0 0.5 0 fov 45\n"
-                                     "material white diffuse albedo 0.75 0.75 0.75\n"
-                                     "material glass dielectric ior 1.5\n"
-                                     "quad corner -1 0 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
-                                     "quad corner -1 0 -1 edge1 2 0 0 edge2 0 2 0 material white\n"
-                                     "sphere center 0 0.4 0 radius 0.3 material glass\n"
-                                     "light point position 0 1.5 0.3 power 50 50 50\n"
-                                     "light quad corner -0.2 0.75 -1 edge1 0.4 0 0 edge2 0 0.4 0 power 5 5 5\n"
-                                     "photons caustic 40000 global 10000\n";
+static const char *const ROOM_LAMP =
+    ROOM_OBJECTS "light quad corner -0.2 0.75 -1 edge1 0.4 0 0 edge2 0 0.4 0 power 5 5 5\n" ROOM_PHOTONS;
 
 typedef struct deferred_picture {
     ps_image whole, direct; /* the first refresh's composite, and its direct layer alone */
@@ -250,47 +263,38 @@ typedef struct deferred_picture {
  * (ahead) or by the refresh, with `b` done between the two. */
 static deferred_picture deferred_first(bool ahead, between b)
 {
-    gl_rig g;
-    ps_session_settings set = gl_rig_load(&g, ROOM_LAMP, "deferred.scn");
-    set.layers = PS_LAYER_DIRECT | PS_LAYER_CAUSTIC | PS_LAYER_GLOBAL;
-    gl_rig_untraced(&g, &set, SIDE);
-    ps_gl_scene gs = ps_gl_scene_of(g.s);
-    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
-    ps_gl_renderer *gl;
-    ps_gl_layers *l;
+    float_rig r;
+    float_rig_open(&r, ROOM_LAMP, "deferred.scn", PS_GLOBAL_SPLATS);
+    gl_rig *g = &r.g;
     ps_error err;
-    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(g.s), &go, &gl, &err), PS_OK);
-    assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &l, &err), PS_OK);
     deferred_picture out;
     memset(&out, 0, sizeof out);
-    start(&g, l, gl, ahead, 0.0, 1.0);
-    out.passes_ahead = ps_gl_get_stats(gl).light_passes;
+    start(g, r.l, r.gl, ahead, 0.0, 1.0);
+    out.passes_ahead = ps_gl_get_stats(r.gl).light_passes;
     if (b == BETWEEN_OTHER_TARGET) {
         /* The same camera (the layers' splats take the last view's
          * matrices: a cube face puts the view's back, gl_specular.c). */
         double exposure;
         bool direct;
-        ps_session_direct_view(g.s, &exposure, &direct);
+        ps_session_direct_view(g->s, &exposure, &direct);
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        ps_gl_begin_frame(gl, &g.cam, exposure, direct);
+        ps_gl_begin_frame(r.gl, &g->cam, exposure, direct);
     } else if (b == BETWEEN_MATERIALS) {
-        ps_gl_renderer_set_materials(gl, ps_session_materials(g.s), false);
+        ps_gl_renderer_set_materials(r.gl, ps_session_materials(g->s), false);
     }
     ps_session_frame f;
-    assert_int_equal(ps_session_refresh(g.s, &g.cam, &f, &err), PS_OK);
-    ps_gl_layers_draw(l, gl, &g.cam, &f);
-    out.passes = ps_gl_get_stats(gl).light_passes;
-    out.views = ps_gl_get_stats(gl).views;
+    assert_int_equal(ps_session_refresh(g->s, &g->cam, &f, &err), PS_OK);
+    ps_gl_layers_draw(r.l, r.gl, &g->cam, &f);
+    out.passes = ps_gl_get_stats(r.gl).light_passes;
+    out.views = ps_gl_get_stats(r.gl).views;
     double gains[PS_MAP_COUNT], none[PS_MAP_COUNT] = {0.0, 0.0};
     for (int k = 0; k < PS_MAP_COUNT; k++)
         gains[k] = f.map[k].gain;
-    assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, gains, &out.whole, &err), PS_OK);
-    assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, none, &out.direct, &err), PS_OK);
-    ps_gl_layers_relight(l, gl, &g.cam, f.direct_exposure, f.direct);
-    assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, none, &out.direct_now, &err), PS_OK);
-    ps_gl_layers_destroy(l);
-    ps_gl_renderer_destroy(gl);
-    gl_rig_close(&g);
+    assert_int_equal(ps_gl_layers_composite(r.l, f.direct_gain, gains, &out.whole, &err), PS_OK);
+    assert_int_equal(ps_gl_layers_composite(r.l, f.direct_gain, none, &out.direct, &err), PS_OK);
+    ps_gl_layers_relight(r.l, r.gl, &g->cam, f.direct_exposure, f.direct);
+    assert_int_equal(ps_gl_layers_composite(r.l, f.direct_gain, none, &out.direct_now, &err), PS_OK);
+    float_rig_close(&r);
     return out;
 }
 
