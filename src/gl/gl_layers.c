@@ -198,6 +198,7 @@ void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
 {
     l->ahead.held = false;
     new_view(l, r, cam, exposure, direct, r->opt.shadows, false);
+    ps_gl_draw_deferred_lit(r); /* no splats to draw beside them here */
 }
 
 void ps_gl_layers_view_ahead(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure,

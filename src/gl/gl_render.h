@@ -173,7 +173,8 @@ void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
  * its frame's new view is this still one (the same camera, exposure, direct
  * flag and renderer, its lights, shadow maps and direct light's textures
  * unchanged), does not draw it again; any other view, relight or splat
- * added in between drops it. */
+ * added in between drops it. Its lit passes come with that
+ * ps_gl_layers_draw, after its splats (as every new view's there). */
 void ps_gl_layers_view_ahead(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure,
                              bool direct);
 /* The direct layer alone drawn again for the same view (new lights, or the
