@@ -10,7 +10,7 @@
  *  - with --global-layer maps, the illumination maps gather the round's
  *    photons beside the work too, before the first refresh, and its
  *    picture is still the same floats as a plain start's;
- *  - the direct layer's lit passes are left by the view (ps_gl_defer_lit)
+ *  - the direct layer's lit passes are left by the view (defer_lit)
  *    and drawn by the refresh after its splats: the direct layer the same
  *    floats as the passes drawn at once, an emitter in a wall's plane
  *    included; drawn first by a view begun elsewhere in between, dropped
@@ -236,7 +236,7 @@ static void maps_gathered_beside_the_round(void **state)
     ps_image_destroy(&splats.img);
 }
 
-/* ---- The direct layer's lit passes after the splats (ps_gl_defer_lit) ---------- */
+/* ---- The direct layer's lit passes after the splats (defer_lit) ---------------- */
 
 /* What happens between the view drawn ahead and the first picture: nothing,
  * a view of another camera begun (8 bits: into the colour buffer), the same

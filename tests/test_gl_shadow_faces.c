@@ -412,7 +412,7 @@ static double rel_mse(const ps_image *a, const ps_image *b, double *mean_a, doub
 
 static ps_image draw_at(ps_gl_renderer *r, const ps_camera_frame *cam, bool moving)
 {
-    ps_gl_begin_frame_shadows(r, cam, 1.0, true, !moving, moving);
+    ps_gl_begin_frame_shadows(r, cam, 1.0, true, !moving, moving, false);
     ps_image img;
     ps_error err;
     assert_int_equal(ps_gl_read(r, &img, &err), PS_OK);

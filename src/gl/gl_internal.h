@@ -48,11 +48,10 @@ void ps_gl_ahead_hold(ps_gl_ahead *a, const ps_gl_renderer *r, const ps_camera_f
 bool ps_gl_ahead_is(const ps_gl_ahead *a, const ps_gl_renderer *r, const ps_camera_frame *cam,
                     const ps_session_frame *f);
 
-/* A view's lit passes left for later (ps_gl_defer_lit): what they need of
+/* A view's lit passes left for later (defer_lit): what they need of
  * the view, its target, size, matrices and mesh, kept until they are drawn
  * (ps_gl_draw_deferred_lit). */
 typedef struct ps_gl_deferred_lit {
-    bool requested; /* the next view begun leaves its lit passes */
     bool pending;   /* a view's lit passes not drawn yet */
     GLint fbo;      /* the view's target (the framebuffer bound when it began) */
     int width, height;
@@ -193,9 +192,14 @@ void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows);
 /* ps_gl_begin_frame with the shadows said here instead of by the options
  * (the window's moving camera draws without them), and moving: the lit
  * passes (and the texture factor) on the scene's moving mesh (in.moving),
- * a moving camera's level of detail. */
+ * a moving camera's level of detail. defer_lit: the view draws its shadow
+ * maps, depth prepass and emitters, and leaves its lit passes to
+ * ps_gl_draw_deferred_lit, for a caller whose view has a target of its own
+ * (the float layers' direct layer): llvmpipe rasterises what is drawn
+ * meanwhile (the splats, into the other layers) while the lit passes are
+ * issued, and the direct layer is the same. */
 void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
-                               bool shadows, bool moving);
+                               bool shadows, bool moving, bool defer_lit);
 /* Area lights as the eye sees them, in their radiance times exposure, or
  * black when the direct layer is off. */
 void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct);
@@ -204,14 +208,7 @@ void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct);
  * drawn after them that they would have covered. */
 void ps_gl_draw_emitters_colour(const ps_gl_renderer *r, double exposure, bool direct);
 
-/* The next view begun (ps_gl_begin_frame_shadows) draws its shadow maps,
- * depth prepass and emitters, and leaves its lit passes to
- * ps_gl_draw_deferred_lit, for a caller whose view has a target of its own
- * (the float layers' direct layer): llvmpipe rasterises what is drawn
- * meanwhile (the splats, into the other layers) while the lit passes are
- * issued, and the direct layer is the same. */
-void ps_gl_defer_lit(ps_gl_renderer *r);
-/* A view's lit passes left by ps_gl_defer_lit, drawn into its target, and
+/* A view's lit passes left (ps_gl_begin_frame_shadows' defer_lit), drawn into its target, and
  * the emitters' colour over them (ps_gl_draw_emitters_colour: the view drew
  * them after its lit passes). Nothing when none are left, or when the
  * lights or shadows have changed since (lit_epoch): that view is stale and

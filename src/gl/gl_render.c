@@ -224,13 +224,32 @@ static void make_range_bounds(ps_gl_renderer *r)
 
 void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
 {
-    ps_gl_begin_frame_shadows(r, cam, exposure, direct, r->opt.shadows, false);
+    ps_gl_begin_frame_shadows(r, cam, exposure, direct, r->opt.shadows, false, false);
+}
+
+/* The lit passes after the prepass (ps_gl_begin_frame_shadows), or those a
+ * view left (ps_gl_draw_deferred_lit): each light added, with shadows, over
+ * the direct light's textures where they are laid. */
+static void draw_lit(ps_gl_renderer *r, ps_vec3 eye, double exposure, bool shadows, bool baked)
+{
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_LEQUAL);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    if (baked)
+        ps_gl_direct_bake_draw(r, eye);
+    /* With shadows where the textures have them: a moving frame's
+     * other objects keep its level of detail (none). */
+    r->skip_baked = baked;
+    ps_gl_draw_direct(r, exposure, shadows);
+    r->skip_baked = false;
+    glDisable(GL_BLEND);
 }
 
 void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
-                               bool shadows, bool moving)
+                               bool shadows, bool moving, bool defer_lit)
 {
-    /* A view whose lit passes wait (ps_gl_defer_lit): drawn now where this
+    /* A view whose lit passes wait (defer_lit): drawn now where this
      * view has another target (a cube face before the layers' splats),
      * dropped where it has theirs, which this view clears. */
     if (r->deferred.pending) {
@@ -297,9 +316,7 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
     glDisable(GL_STENCIL_TEST);
     glDisable(GL_POLYGON_OFFSET_FILL);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    bool defer = direct && r->deferred.requested;
-    r->deferred.requested = false;
-    if (defer) {
+    if (direct && defer_lit) {
         /* The lit passes later (ps_gl_draw_deferred_lit); the emitters now,
          * whose depth hides the splats behind them. */
         ps_gl_deferred_lit *d = &r->deferred;
@@ -321,24 +338,10 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
         d->hide_emitters = r->in.hide_emitters;
         d->epoch = r->lit_epoch;
     } else if (direct) {
-        /* Each light adds its pass on top. */
-        glDepthMask(GL_FALSE);
-        glDepthFunc(GL_LEQUAL);
-        glEnable(GL_BLEND);
-        glBlendFunc(GL_ONE, GL_ONE);
-        if (baked)
-            ps_gl_direct_bake_draw(r, cam->eye);
-        /* With shadows where the textures have them: a moving frame's
-         * other objects keep its level of detail (none). */
-        r->skip_baked = baked;
-        ps_gl_draw_direct(r, exposure, shadows);
-        r->skip_baked = false;
-        glDisable(GL_BLEND);
+        draw_lit(r, cam->eye, exposure, shadows, baked); /* each light adds its pass on top */
     }
     ps_gl_draw_emitters(r, exposure, direct);
 }
-
-void ps_gl_defer_lit(ps_gl_renderer *r) { r->deferred.requested = true; }
 
 void ps_gl_draw_deferred_lit(ps_gl_renderer *r)
 {
@@ -368,10 +371,6 @@ void ps_gl_draw_deferred_lit(ps_gl_renderer *r)
     glDisable(GL_CULL_FACE);
     glEnable(GL_DEPTH_TEST);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDepthMask(GL_FALSE);
-    glDepthFunc(GL_LEQUAL);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
     /* The view's own settings, where a cube face begun since (which draws
      * these first) has its own. */
     const ps_preview_mesh *lit = r->lit;
@@ -381,12 +380,7 @@ void ps_gl_draw_deferred_lit(ps_gl_renderer *r)
     r->eye_extent = d->eye_extent;
     r->skip_specular = d->skip_specular;
     r->in.hide_emitters = d->hide_emitters;
-    if (d->baked)
-        ps_gl_direct_bake_draw(r, d->eye);
-    r->skip_baked = d->baked;
-    ps_gl_draw_direct(r, d->exposure, d->shadows);
-    r->skip_baked = false;
-    glDisable(GL_BLEND);
+    draw_lit(r, d->eye, d->exposure, d->shadows, d->baked);
     ps_gl_draw_emitters_colour(r, d->exposure, true);
     r->lit = lit;
     r->eye_extent = extent;

@@ -389,7 +389,7 @@ static ps_status render_face(ps_gl_specular *g, ps_gl_renderer *r, ps_session *s
      * a face drawn before they are laid and one after would differ by their
      * sampling, and the faces of one round come over many refreshes. */
     r->direct_bake_off = true;
-    ps_gl_begin_frame_shadows(r, &cam, 1.0, fr->direct, shadows, false);
+    ps_gl_begin_frame_shadows(r, &cam, 1.0, fr->direct, shadows, false, false);
     r->direct_bake_off = false;
     ps_status st = PS_OK;
     for (int k = 0; k < PS_MAP_COUNT && st == PS_OK; k++) {
