@@ -217,7 +217,7 @@ static int first_picture_run(bench_gl *g, double t[STAGE_COUNT], double warm[3],
     if (ps_kernel_texture_make(PS_KERNEL_CONE, PS_KERNEL_TEXTURE_SIZE, &g->kernel, err) != PS_OK)
         goto done;
     STAGE();
-    ps_gl_options gopt = {true, false, 0, false, false};
+    ps_gl_options gopt = {true, false, 0, false, false, NULL};
     mopt.max_edge = HUGE_VAL;
     if (ps_preview_mesh_build(g->scene, &mopt, &g->coarse, err) != PS_OK)
         goto done;
