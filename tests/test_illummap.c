@@ -156,7 +156,8 @@ static void box_flux_is_the_photons(void **state)
 }
 
 /* The same photons in any batches and on any number of threads give the
- * same bytes; another radius
+ * same bytes (f sums each photon as it is gathered, on one thread; g's
+ * larger batches go through three workers' lists); another radius
  * rebuilds from photon 0 to the same bytes as a map built at that radius. */
 static void batches_do_not_matter(void **state)
 {

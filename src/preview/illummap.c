@@ -445,6 +445,23 @@ static void *gather_range(void *arg)
     return NULL;
 }
 
+/* One photon's shares (of worker g's lists) added to the sums. */
+static void add_shares(ps_illummap *m, const gather *g, const photon_shares *sh, ps_rgb power)
+{
+    if (sh->lost) {
+        m->lost = ps_rgb_add(m->lost, power);
+        return;
+    }
+    for (size_t j = sh->first; j < sh->first + sh->count; j++) {
+        uint32_t s = g->sample[j] & 0x7fffffffu;
+        double *e = m->sum + SUMS * s + ((g->sample[j] & 0x80000000u) ? 3 : 0);
+        double w = g->weight[j];
+        e[0] += power.r * w;
+        e[1] += power.g * w;
+        e[2] += power.b * w;
+    }
+}
+
 /* Photons [begin, end) added: their shares gathered on the workers, each a
  * contiguous range, then summed here in photon order, so that the sums are
  * the same bytes for any number of threads. */
@@ -455,8 +472,24 @@ static ps_status add_photons(ps_illummap *m, const ps_photon *photons, const uin
     int threads = m->threads;
     if ((size_t)threads > n / PS_ILLUM_MIN_PHOTONS_A_THREAD)
         threads = (int)(n / PS_ILLUM_MIN_PHOTONS_A_THREAD);
-    if (threads < 1)
-        threads = 1;
+    if (threads <= 1) {
+        /* On one thread each photon is summed as soon as it is gathered, so
+         * its lists hold one photon's shares and stay in cache, where a
+         * chunk's would be megabytes written once: the default box's first
+         * gathering (3 972 photons, 85 877 shares) took 0.009-0.016 s with
+         * fresh lists against 0.003 s with lists already written
+         * (docs/preview.md). The same sums in the same order: the same bytes. */
+        gather *g = &m->workers[0];
+        g->m = m;
+        photon_shares sh;
+        for (size_t i = begin; i < end; i++) {
+            g->count = 0;
+            if (!gather_photon(g, &photons[i], objects[i], &sh))
+                return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the illumination maps' estimate");
+            add_shares(m, g, &sh, ps_photon_power(&photons[i]));
+        }
+        return PS_OK;
+    }
     pthread_t tid[PS_ILLUM_MAX_THREADS];
     bool started[PS_ILLUM_MAX_THREADS] = {false};
     for (int t = 0; t < threads; t++) {
@@ -481,22 +514,8 @@ static ps_status add_photons(ps_illummap *m, const ps_photon *photons, const uin
             return ps_error_set(err, PS_ERR_NOMEM, "out of memory for the illumination maps' estimate");
     for (int t = 0; t < threads; t++) {
         const gather *g = &m->workers[t];
-        for (size_t i = g->begin; i < g->end; i++) {
-            const photon_shares *sh = &g->shares[i - g->begin];
-            ps_rgb power = ps_photon_power(&photons[i]);
-            if (sh->lost) {
-                m->lost = ps_rgb_add(m->lost, power);
-                continue;
-            }
-            for (size_t j = sh->first; j < sh->first + sh->count; j++) {
-                uint32_t s = g->sample[j] & 0x7fffffffu;
-                double *e = m->sum + SUMS * s + ((g->sample[j] & 0x80000000u) ? 3 : 0);
-                double w = g->weight[j];
-                e[0] += power.r * w;
-                e[1] += power.g * w;
-                e[2] += power.b * w;
-            }
-        }
+        for (size_t i = g->begin; i < g->end; i++)
+            add_shares(m, g, &g->shares[i - g->begin], ps_photon_power(&photons[i]));
     }
     return PS_OK;
 }

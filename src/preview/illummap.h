@@ -90,7 +90,8 @@ const char *ps_global_layer_name(ps_global_layer g);
 /* The gather runs on every core in contiguous ranges of a chunk of photons
  * (at least PS_ILLUM_MIN_PHOTONS_A_THREAD each), and the shares it found are
  * summed in photon order on the calling thread: the same bytes for any
- * number of cores. */
+ * number of cores. On one thread each photon's shares are summed as soon as
+ * they are found, in the same order. */
 #define PS_ILLUM_CHUNK 16384
 #define PS_ILLUM_MIN_PHOTONS_A_THREAD 1024
 #define PS_ILLUM_MAX_THREADS 64
