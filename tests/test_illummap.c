@@ -193,6 +193,71 @@ static void batches_do_not_matter(void **state)
     close_fixture(&g);
 }
 
+/* The spans GL draws (ps_illummap_spans) are the surfaces the maps colour:
+ * every vertex outside them is black on both sides, the glass between two
+ * walls splits them, and the view's colours inside them are a side's. */
+static void spans_are_the_coloured_surfaces(void **state)
+{
+    (void)state;
+    static const char *const SPLIT = "camera eye 0 0 0.9 target 0 0 0 fov 60\n"
+                                     "material white diffuse albedo 0.6 0.5 0.4\n"
+                                     "material glass dielectric ior 1.5\n"
+                                     "material mirror mirror reflectance 0.9 0.9 0.9\n"
+                                     "quad corner -1 -1 -1 edge1 2 0 0 edge2 0 2 0 material white\n"
+                                     "sphere center 0 0 -0.5 radius 0.3 material glass\n"
+                                     "quad corner -1 -1 -1 edge1 0 0 2 edge2 2 0 0 material white\n"
+                                     "quad corner 1 -1 -1 edge1 0 0 2 edge2 0 2 0 material mirror\n"
+                                     "light point position 0 0.5 0 power 30 40 50\n";
+    const char *const scenes[] = {BOX, SPLIT};
+    const size_t want_spans[] = {1, 2};
+    for (int sc = 0; sc < 2; sc++) {
+        fixture f;
+        open_fixture_at(&f, scenes[sc], 20000);
+        update(&f, f.photons.count, 0.15);
+        size_t nmat;
+        const ps_material *mats = ps_scene_materials(f.r.scene, &nmat);
+        const float *front, *back;
+        ps_illummap_colors(f.map, mats, 1.0, &front, &back);
+        const float *view = ps_illummap_view_colors(f.map, ps_v3(0.0, 0.0, 0.9));
+        const ps_illum_span *sp;
+        size_t n = ps_illummap_spans(f.map, &sp);
+        assert_int_equal(n, want_spans[sc]);
+        size_t nv = f.mesh.vertex_count, in = 0, lit = 0;
+        bool *spanned = calloc(nv, sizeof *spanned);
+        assert_non_null(spanned);
+        for (size_t i = 0; i < n; i++) {
+            assert_true(sp[i].count > 0 && sp[i].count % 3 == 0 && sp[i].first + sp[i].count <= nv);
+            if (i > 0) /* in order, apart: neighbours would have been joined */
+                assert_true(sp[i].first > sp[i - 1].first + sp[i - 1].count);
+            for (size_t v = sp[i].first; v < sp[i].first + sp[i].count; v++) {
+                spanned[v] = true;
+                in++;
+                bool is_front = !memcmp(view + 4 * v, front + 4 * v, 4 * sizeof *view);
+                assert_true(is_front || !memcmp(view + 4 * v, back + 4 * v, 4 * sizeof *view));
+                lit += front[4 * v + 1] > 0.0f || back[4 * v + 1] > 0.0f;
+            }
+        }
+        /* Every range of a diffuse or glossy surface spanned, the rest not. */
+        size_t want_in = 0;
+        for (size_t r = 0; r < f.mesh.range_count; r++) {
+            const ps_mesh_range *rg = &f.mesh.ranges[r];
+            bool coloured = mats[rg->material].type == PS_MAT_DIFFUSE || mats[rg->material].type == PS_MAT_GLOSSY;
+            want_in += coloured ? rg->count : 0;
+            for (size_t v = rg->first; v < rg->first + rg->count; v++)
+                assert_true(spanned[v] == coloured);
+        }
+        assert_int_equal(in, want_in);
+        assert_true(in < nv);
+        assert_true(lit > in / 2);
+        for (size_t v = 0; v < nv; v++)
+            if (!spanned[v])
+                for (int c = 0; c < 3; c++)
+                    assert_true(front[4 * v + c] == 0.0f && back[4 * v + c] == 0.0f);
+        free(spanned);
+        close_fixture(&f);
+    }
+}
+
 /* Colours: E albedo / pi times the scale, black on the glass. */
 static void colours_are_radiance(void **state)
 {
@@ -428,7 +493,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(furnace_is_uniform),   cmocka_unit_test(box_flux_is_the_photons),
-        cmocka_unit_test(batches_do_not_matter), cmocka_unit_test(colours_are_radiance),
+        cmocka_unit_test(batches_do_not_matter), cmocka_unit_test(spans_are_the_coloured_surfaces),
+        cmocka_unit_test(colours_are_radiance),
         cmocka_unit_test(radius_levels),        cmocka_unit_test(refuses_over_budget),
         cmocka_unit_test(session_fills_the_maps), cmocka_unit_test(maps_take_the_budget_share),
     };

@@ -425,7 +425,7 @@ static ps_status write_layers(snap_run *s, const char *prefix, ps_error *err)
         } else {
             ps_gl_begin_frame(s->gl, &s->cam, f->direct_exposure, layer < 0 && f->direct);
             if (layer == PS_MAP_GLOBAL && !specular)
-                ps_gl_draw_illummap(s->gl, f->imap_colors);
+                ps_gl_draw_illummap(s->gl, f);
             if (layer >= 0 && !specular)
                 ps_gl_draw_splats(s->gl, f->map[layer].batch, f->splat, f->map[layer].radius, f->point_size);
             if (specular && f->specular)

@@ -2,15 +2,16 @@
  * drawn in fixed function: the fine mesh with the maps' colours per vertex
  * (irradiance times albedo / pi times the gain, made GL-free by
  * ps_illummap_colors), Gouraud-interpolated, no lighting, added to what is
- * there where the depth prepass says the surface shows. Two-sided surfaces
+ * there where the depth prepass says the surface shows; only the surfaces
+ * the maps hold (ps_illummap_spans). Two-sided surfaces
  * carry a value a side; the colours given are already the side each
  * triangle shows this view (ps_illummap_view_colors), so one pass draws both. */
 #include "gl/gl_internal.h"
 
-void ps_gl_draw_illummap(ps_gl_renderer *r, const float *colors)
+void ps_gl_draw_illummap(ps_gl_renderer *r, const ps_session_frame *f)
 {
     const ps_preview_mesh *m = r->in.mesh;
-    if (!colors || m->vertex_count == 0)
+    if (!f->imap_colors || f->imap_span_count == 0)
         return;
     ps_gl_begin_additive_pass(r);
     glDisable(GL_TEXTURE_2D);
@@ -20,8 +21,11 @@ void ps_gl_draw_illummap(ps_gl_renderer *r, const float *colors)
     glEnableClientState(GL_VERTEX_ARRAY);
     glEnableClientState(GL_COLOR_ARRAY);
     glVertexPointer(3, GL_FLOAT, 0, m->positions);
-    glColorPointer(4, GL_FLOAT, 0, colors);
-    glDrawArrays(GL_TRIANGLES, 0, (GLsizei)m->vertex_count);
+    glColorPointer(4, GL_FLOAT, 0, f->imap_colors);
+    /* Only the surfaces in the maps: mirrors and glass would add black, and
+     * took 41 % of the default box's pass. */
+    for (size_t i = 0; i < f->imap_span_count; i++)
+        glDrawArrays(GL_TRIANGLES, (GLint)f->imap_spans[i].first, (GLsizei)f->imap_spans[i].count);
     glDisableClientState(GL_COLOR_ARRAY);
     glDisableClientState(GL_VERTEX_ARRAY);
     glDisable(GL_BLEND);

@@ -147,7 +147,7 @@ static void draw_imap(ps_gl_layers *l, ps_gl_renderer *r, const ps_session_frame
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_IMAP_TEX]);
     glViewport(0, 0, l->view_w, l->view_h);
-    ps_gl_draw_illummap(r, f->imap_colors);
+    ps_gl_draw_illummap(r, f);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
     l->imap_drawn = true;
 }

@@ -63,6 +63,8 @@ struct ps_illummap {
     double *area;
     double *sum;
     uint32_t *vsample; /* fine-mesh vertex -> sample, or NO_SAMPLE (no diffuse reflection) */
+    ps_illum_span *spans; /* the vertices with samples (ps_illummap_spans) */
+    size_t span_count;
     float *front, *back, *view;
     /* The grid: cubic cells of side `radius`, hashed into `buckets` (a power
      * of two) lists; first[b]..first[b + 1] index items, which copy what the
@@ -150,9 +152,17 @@ static ps_status weld(ps_illummap *m, double step, ps_error *err)
     for (size_t i = 0; i < tsize; i++)
         table[i] = NO_SAMPLE;
     size_t n = 0;
+    m->span_count = 0;
     for (size_t r = 0; r < mesh->range_count; r++) {
         const ps_mesh_range *rg = &mesh->ranges[r];
         bool diffuse = rg->material < m->material_count && reflects_diffusely(&m->scene_materials[rg->material]);
+        if (diffuse && rg->count > 0) {
+            ps_illum_span *last = m->span_count ? &m->spans[m->span_count - 1] : NULL;
+            if (last && last->first + last->count == rg->first)
+                last->count += rg->count;
+            else
+                m->spans[m->span_count++] = (ps_illum_span){rg->first, rg->count};
+        }
         for (size_t v = rg->first; v < rg->first + rg->count; v++) {
             m->vsample[v] = NO_SAMPLE;
             if (!diffuse)
@@ -225,7 +235,10 @@ ps_status ps_illummap_create(const ps_scene *scene, const ps_preview_mesh *mesh,
     m->front = calloc(4 * n1, sizeof *m->front);
     m->back = calloc(4 * n1, sizeof *m->back);
     m->view = calloc(4 * n1, sizeof *m->view);
-    st = m->pos && m->nrm && m->obj && m->area && m->vsample && m->front && m->back && m->view ? PS_OK : PS_ERR_NOMEM;
+    m->spans = malloc((mesh->range_count ? mesh->range_count : 1) * sizeof *m->spans);
+    st = m->pos && m->nrm && m->obj && m->area && m->vsample && m->front && m->back && m->view && m->spans
+             ? PS_OK
+             : PS_ERR_NOMEM;
     if (st != PS_OK)
         ps_error_set(err, st, "%s: out of memory for the illumination maps", ps_scene_path(scene));
     double diag = ps_v3_len(ps_aabb_diag(ps_scene_bounds(scene)));
@@ -289,6 +302,7 @@ void ps_illummap_destroy(ps_illummap *m)
     free(m->front);
     free(m->back);
     free(m->view);
+    free(m->spans);
     free(m->first);
     free(m->items);
     free(m->lobe_ph);
@@ -610,14 +624,24 @@ void ps_illummap_colors(ps_illummap *m, const ps_material *materials, double sca
 const float *ps_illummap_view_colors(ps_illummap *m, ps_vec3 eye)
 {
     const ps_preview_mesh *mesh = m->mesh;
-    for (size_t v = 0; v + 2 < mesh->vertex_count; v += 3) {
-        const float *p = mesh->positions + 3 * v;
-        ps_vec3 p0 = ps_v3(p[0], p[1], p[2]), p1 = ps_v3(p[3], p[4], p[5]), p2 = ps_v3(p[6], p[7], p[8]);
-        ps_vec3 n = ps_v3_cross(ps_v3_sub(p1, p0), ps_v3_sub(p2, p0));
-        const float *src = ps_v3_dot(ps_v3_sub(eye, p0), n) > 0.0 ? m->front : m->back;
-        memcpy(m->view + 4 * v, src + 4 * v, 12 * sizeof *src);
+    for (size_t i = 0; i < m->span_count; i++) {
+        const ps_illum_span *sp = &m->spans[i];
+        /* Ranges are whole triangles, so a span is too. */
+        for (size_t v = sp->first; v + 2 < sp->first + sp->count; v += 3) {
+            const float *p = mesh->positions + 3 * v;
+            ps_vec3 p0 = ps_v3(p[0], p[1], p[2]), p1 = ps_v3(p[3], p[4], p[5]), p2 = ps_v3(p[6], p[7], p[8]);
+            ps_vec3 n = ps_v3_cross(ps_v3_sub(p1, p0), ps_v3_sub(p2, p0));
+            const float *src = ps_v3_dot(ps_v3_sub(eye, p0), n) > 0.0 ? m->front : m->back;
+            memcpy(m->view + 4 * v, src + 4 * v, 12 * sizeof *src);
+        }
     }
     return m->view;
+}
+
+size_t ps_illummap_spans(const ps_illummap *m, const ps_illum_span **spans)
+{
+    *spans = m->spans;
+    return m->span_count;
 }
 
 size_t ps_illummap_lobe(const ps_illummap *m, const ps_photon **photons, const uint16_t **materials,

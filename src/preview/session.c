@@ -701,6 +701,7 @@ static ps_status imap_refresh(ps_session *s, const ps_photon_map *m, const ps_ca
     if (out->imap_redraw)
         s->imap_view = ps_illummap_view_colors(s->imap, cam->eye);
     out->imap_colors = s->imap_view;
+    out->imap_span_count = ps_illummap_spans(s->imap, &out->imap_spans);
     return st;
 }
 

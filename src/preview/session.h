@@ -335,6 +335,8 @@ typedef struct ps_session_frame {
      * incremental layers, exposure N / n in whole ones); NULL when not shown.
      * map[PS_MAP_GLOBAL]'s batch then holds only the glossy lobes' splats. */
     const float *imap_colors;
+    const ps_illum_span *imap_spans; /* the vertices to draw (ps_illummap_spans) */
+    size_t imap_span_count;
     bool imap_redraw;        /* the colours are new (or the view): draw the maps again */
 } ps_session_frame;
 
