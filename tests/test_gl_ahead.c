@@ -56,6 +56,7 @@ typedef struct ahead_job {
     ps_camera_frame cam;
     double exposure;
     bool direct;
+    bool prepare_maps; /* then the illumination maps' programs (ps_gl_layers_prepare_maps) */
     int calls;
 } ahead_job;
 
@@ -67,6 +68,8 @@ static void view_ahead(void *ctx)
         ps_gl_layers_view_ahead(j->layers, j->gl, &j->cam, j->exposure, j->direct);
     else
         ps_gl_draw_view_ahead(j->gl, &j->cam, j->exposure, j->direct);
+    if (j->prepare_maps)
+        ps_gl_layers_prepare_maps(j->layers, j->gl);
 }
 
 /* The session started held (the first picture shows the first round's
@@ -82,11 +85,12 @@ static int start(gl_rig *g, ps_gl_layers *l, ps_gl_renderer *gl, bool ahead, dou
         assert_int_equal(ps_session_start(g->s, true, &err), PS_OK);
         return 0;
     }
-    ahead_job job = {l, gl, g->cam, 1.0, false, 0};
+    /* With the illumination maps, their programs too, as snap's spare work. */
+    ahead_job job = {l, gl, g->cam, 1.0, false, l && ps_session_illummap(g->s), 0};
     job.cam.eye.x += eye_dx;
     ps_session_direct_view(g->s, &job.exposure, &job.direct);
     job.exposure *= exposure_factor;
-    assert_int_equal(ps_session_start_beside(g->s, true, view_ahead, &job, &err), PS_OK);
+    assert_int_equal(ps_session_start_beside(g->s, true, view_ahead, NULL, &job, &err), PS_OK);
     return job.calls;
 }
 
@@ -225,6 +229,8 @@ static void maps_gathered_beside_the_round(void **state)
     assert_int_equal(ahead.shown, ahead.gathered);
     assert_int_equal(plain.shown, ahead.gathered);
     assert_true(ahead.ahead_seconds > 0.0);
+    /* The maps' programs prepared after the view: it is still the one
+     * shown, and their layer holds only the first refresh's maps. */
     assert_int_equal(ahead.views, 1);
     same_picture(&ahead, &plain);
     /* The splats' own start gathers nothing. */

@@ -1009,6 +1009,64 @@ static void first_round_on_its_own_threads(void **state)
     ps_scene_destroy(scene);
 }
 
+/* ps_session_start_beside's spare work runs after beside only while the
+ * first round is still traced: at once behind a beside that returns at
+ * once (the default box's round is 16 384 caustic paths), not behind one
+ * that outlasts the round; and the round's photons are the same. */
+typedef struct beside_calls {
+    int beside, spare;
+    double sleep_seconds;
+} beside_calls;
+
+static void count_beside(void *ctx)
+{
+    beside_calls *c = ctx;
+    c->beside++;
+    if (c->sleep_seconds > 0.0) {
+        struct timespec ts = {(time_t)c->sleep_seconds, 0};
+        ts.tv_nsec = (long)((c->sleep_seconds - (double)ts.tv_sec) * 1e9);
+        nanosleep(&ts, NULL);
+    }
+}
+
+static void count_spare(void *ctx)
+{
+    beside_calls *c = ctx;
+    assert_int_equal(c->beside, 1); /* after beside */
+    c->spare++;
+}
+
+static void spare_work_only_while_the_round_is_traced(void **state)
+{
+    (void)state;
+    ps_scene *scene = load();
+    ps_session_settings set = settings(scene, true);
+    ps_error err;
+    /* The round's photons however the caller's work went. */
+    uint64_t counts[3];
+    ps_photon last[3];
+    for (int v = 0; v < 3; v++) {
+        ps_session *s = open_session(scene, &set);
+        beside_calls c = {0, 0, v == 1 ? 1.5 : 0.0};
+        assert_int_equal(ps_session_start_beside(s, true, count_beside, v < 2 ? count_spare : NULL, &c, &err),
+                         PS_OK);
+        assert_int_equal(c.beside, 1);
+        /* 1.5 s outlasts the round, even under the sanitizers. */
+        assert_int_equal(c.spare, v == 0 ? 1 : 0);
+        const ps_photon_map *m = ps_session_lock_maps(s);
+        counts[v] = m[PS_MAP_CAUSTIC].count;
+        assert_true(counts[v] > 0);
+        last[v] = m[PS_MAP_CAUSTIC].photons[counts[v] - 1];
+        ps_session_unlock_maps(s);
+        ps_session_destroy(s);
+    }
+    for (int v = 1; v < 3; v++) {
+        assert_int_equal(counts[v], counts[0]);
+        assert_memory_equal(&last[v], &last[0], sizeof last[0]);
+    }
+    ps_scene_destroy(scene);
+}
+
 /* The specular layer's eye paths of two sessions (lookups and per-pixel
  * points) are the same bytes. */
 static void assert_same_eye_paths(ps_session *a, ps_session *b)
@@ -1412,6 +1470,7 @@ int main(void)
         cmocka_unit_test(moving_growth_held),
         cmocka_unit_test(moving_global_layer_shrunk),
         cmocka_unit_test(after_the_stop_converges_to_the_whole_view),
+        cmocka_unit_test(spare_work_only_while_the_round_is_traced),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

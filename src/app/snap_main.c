@@ -819,6 +819,16 @@ static void view_ahead(void *ctx)
     s->view_ahead_shadows = ps_gl_get_stats(s->gl).shadow_seconds_last;
 }
 
+/* While the round is still traced after the view (ps_session_start_beside's
+ * spare): the float layers' illumination maps' programs. */
+static void spare_ahead(void *ctx)
+{
+    view_ahead_job *j = ctx;
+    snap_run *s = j->s;
+    if (s->layers && s->o->p.global_layer == PS_GLOBAL_MAPS && (s->o->p.layers & PS_LAYER_GLOBAL))
+        ps_gl_layers_prepare_maps(s->layers, s->gl);
+}
+
 /* Progressive: trace in the background, refresh every tau. As in the window,
  * the first round is traced before the first frame, so that it already shows
  * photons. Time spent writing checkpoints is taken off the clock (the tracer
@@ -841,7 +851,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
      * figures of the view kept.) */
     view_ahead_job ahead = {s, 1.0, false};
     ps_session_direct_view(s->session, &ahead.exposure, &ahead.direct);
-    ps_status st = ps_session_start_beside(s->session, s->layers != NULL, view_ahead, &ahead, err);
+    ps_status st = ps_session_start_beside(s->session, s->layers != NULL, view_ahead, spare_ahead, &ahead, err);
     double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
     pace_rate rate = {0.0, 0.0};
     int cp = 0;

@@ -137,19 +137,43 @@ static void clear_imap(ps_gl_layers *l)
     l->imap_drawn = false;
 }
 
-/* The illumination maps drawn again into their layer (gl_illummap.c). */
-static void draw_imap(ps_gl_layers *l, ps_gl_renderer *r, const ps_session_frame *f)
+/* The maps of frame f added into their layer (gl_illummap.c). */
+static void imap_pass(ps_gl_layers *l, ps_gl_renderer *r, const ps_session_frame *f)
 {
-    clear_imap(l);
-    if (!f->imap_colors)
-        return;
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_IMAP_TEX]);
     glViewport(0, 0, l->view_w, l->view_h);
     ps_gl_draw_illummap(r, f);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+}
+
+/* The illumination maps drawn again into their layer. */
+static void draw_imap(ps_gl_layers *l, ps_gl_renderer *r, const ps_session_frame *f)
+{
+    clear_imap(l);
+    if (!f->imap_colors)
+        return;
+    imap_pass(l, r, f);
     l->imap_drawn = true;
+}
+
+void ps_gl_layers_prepare_maps(ps_gl_layers *l, ps_gl_renderer *r)
+{
+    /* The same state as draw_imap's, so the same programs; black with alpha
+     * 0 adds nothing, whatever the blend. The default box's and the design
+     * room's first float pictures with the maps came about 3 ms sooner
+     * (docs/preview.md). */
+    static const float black[3 * 4];
+    static const ps_illum_span first = {0, 3};
+    if (r->in.mesh->vertex_count < 3)
+        return;
+    ps_session_frame f;
+    memset(&f, 0, sizeof f);
+    f.imap_colors = black;
+    f.imap_spans = &first;
+    f.imap_span_count = 1;
+    imap_pass(l, r, &f);
 }
 
 /* A new view, the direct layer's shadows as said; moving: a moving

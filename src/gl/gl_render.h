@@ -177,6 +177,12 @@ void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
  * ps_gl_layers_draw, after its splats (as every new view's there). */
 void ps_gl_layers_view_ahead(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure,
                              bool direct);
+/* The illumination maps' pass (--global-layer maps) drawn once with nothing
+ * to add, one black triangle into their layer, so that llvmpipe builds its
+ * programs now, not in the first refresh that draws the maps: work for
+ * time that would be spent waiting (ps_session_start_beside's spare). The
+ * layers, and a view drawn ahead, are left as they were. */
+void ps_gl_layers_prepare_maps(ps_gl_layers *l, ps_gl_renderer *r);
 /* The direct layer alone drawn again for the same view (new lights, or the
  * direct light's textures just laid), the map layers kept. */
 void ps_gl_layers_relight(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct);

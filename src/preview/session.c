@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -424,6 +425,7 @@ typedef struct prime_job {
     ps_session *s;
     ps_status st;
     ps_error err;
+    atomic_bool done; /* the round and the maps' gathering (spare work is done only before) */
 } prime_job;
 
 static void *prime_main(void *arg)
@@ -449,16 +451,17 @@ static void *prime_main(void *arg)
         s->ahead_seconds = ps_now_seconds() - t0;
         s->splat_seconds += s->ahead_seconds;
     }
+    atomic_store(&j->done, true);
     return NULL;
 }
 
 ps_status ps_session_start(ps_session *s, bool held, ps_error *err)
 {
-    return ps_session_start_beside(s, held, NULL, NULL, err);
+    return ps_session_start_beside(s, held, NULL, NULL, NULL, err);
 }
 
-ps_status ps_session_start_beside(ps_session *s, bool held, ps_session_beside_fn *beside, void *ctx,
-                                  ps_error *err)
+ps_status ps_session_start_beside(ps_session *s, bool held, ps_session_beside_fn *beside,
+                                  ps_session_beside_fn *spare, void *ctx, ps_error *err)
 {
     s->started = true;
     ps_status st = PS_OK;
@@ -475,11 +478,13 @@ ps_status ps_session_start_beside(ps_session *s, bool held, ps_session_beside_fn
          * against 0.056-0.067 s. */
         int threads = ps_tracer_threads(s->tracer);
         ps_tracer_set_threads(s->tracer, s->set.first_round_threads);
-        prime_job job = {s, PS_OK, {0}};
+        prime_job job = {s, PS_OK, {0}, false};
         pthread_t thread;
         if (beside && pthread_create(&thread, NULL, prime_main, &job) == 0) {
             beside(ctx);
             beside = NULL;
+            if (spare && !atomic_load(&job.done))
+                spare(ctx);
             pthread_join(thread, NULL);
             st = job.st;
             if (st != PS_OK && err)

@@ -259,14 +259,19 @@ typedef void ps_session_beside_fn(void *ctx);
  * photon, such as its view (ps_gl_layers_view_ahead). The round runs at a
  * low priority (ps_thread_low_priority) on the first round's threads, so
  * the work takes the cores it wants and the round the rest: llvmpipe's
- * first compiles leave all but one idle. beside must not call this
- * session. With nothing to trace first (after a repair), or no thread for
+ * first compiles leave all but one idle. beside (and spare) must not call
+ * this session. With nothing to trace first (after a repair), or no thread for
  * it, beside runs after the round. The photons are the same either way.
  * After the round, on its thread, the illumination maps (--global-layer
  * maps) gather its global photons, which the first refresh would: they do
- * not depend on the view (ps_session_counts.ahead_seconds). */
-ps_status ps_session_start_beside(ps_session *s, bool held, ps_session_beside_fn *beside, void *ctx,
-                                  ps_error *err);
+ * not depend on the view (ps_session_counts.ahead_seconds).
+ * After beside, spare(ctx) (NULL: none) runs only if the round and that
+ * gathering are still going, where the caller would otherwise wait: work
+ * of the first refresh worth doing ahead only then
+ * (ps_gl_layers_prepare_maps: 4-6 ms of the first refresh's, which would
+ * delay it by as much where the round had ended first). */
+ps_status ps_session_start_beside(ps_session *s, bool held, ps_session_beside_fn *beside,
+                                  ps_session_beside_fn *spare, void *ctx, ps_error *err);
 /* Stops the background thread and waits for it; how tracing ended. */
 ps_status ps_session_stop(ps_session *s, ps_error *err);
 /* How tracing went so far: the tracer's error if it failed, else PS_OK. */
