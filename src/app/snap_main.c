@@ -425,7 +425,7 @@ static ps_status write_layers(snap_run *s, const char *prefix, ps_error *err)
         } else {
             ps_gl_begin_frame(s->gl, &s->cam, f->direct_exposure, layer < 0 && f->direct);
             if (layer == PS_MAP_GLOBAL && !specular)
-                ps_gl_draw_illummap(s->gl, f);
+                ps_gl_draw_illummap(s->gl, f->imap_colors, f->imap_spans, f->imap_span_count);
             if (layer >= 0 && !specular)
                 ps_gl_draw_splats(s->gl, f->map[layer].batch, f->splat, f->map[layer].radius, f->point_size);
             if (specular && f->specular)
@@ -799,6 +799,7 @@ typedef struct view_ahead_job {
     snap_run *s;
     double exposure; /* the direct layer as the first refresh asks for it */
     bool direct;
+    bool maps;       /* the session has illumination maps (asked before the start) */
 } view_ahead_job;
 
 static void view_ahead(void *ctx)
@@ -824,9 +825,8 @@ static void view_ahead(void *ctx)
 static void spare_ahead(void *ctx)
 {
     view_ahead_job *j = ctx;
-    snap_run *s = j->s;
-    if (s->layers && s->o->p.global_layer == PS_GLOBAL_MAPS && (s->o->p.layers & PS_LAYER_GLOBAL))
-        ps_gl_layers_prepare_maps(s->layers, s->gl);
+    if (j->s->layers && j->maps)
+        ps_gl_layers_prepare_maps(j->s->layers, j->s->gl);
 }
 
 /* Progressive: trace in the background, refresh every tau. As in the window,
@@ -849,7 +849,7 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
      * the default box's and the design room's first 8-bit checkpoints came
      * 5-7 ms later, medians of eight runs; see docs/preview.md for the
      * figures of the view kept.) */
-    view_ahead_job ahead = {s, 1.0, false};
+    view_ahead_job ahead = {s, 1.0, false, ps_session_illummap(s->session) != NULL};
     ps_session_direct_view(s->session, &ahead.exposure, &ahead.direct);
     ps_status st = ps_session_start_beside(s->session, s->layers != NULL, view_ahead, spare_ahead, &ahead, err);
     double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;

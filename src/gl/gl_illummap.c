@@ -8,10 +8,10 @@
  * triangle shows this view (ps_illummap_view_colors), so one pass draws both. */
 #include "gl/gl_internal.h"
 
-void ps_gl_draw_illummap(ps_gl_renderer *r, const ps_session_frame *f)
+void ps_gl_draw_illummap(ps_gl_renderer *r, const float *colors, const ps_illum_span *spans, size_t span_count)
 {
     const ps_preview_mesh *m = r->in.mesh;
-    if (!f->imap_colors || f->imap_span_count == 0)
+    if (!colors || span_count == 0)
         return;
     ps_gl_begin_additive_pass(r);
     glDisable(GL_TEXTURE_2D);
@@ -21,11 +21,11 @@ void ps_gl_draw_illummap(ps_gl_renderer *r, const ps_session_frame *f)
     glEnableClientState(GL_VERTEX_ARRAY);
     glEnableClientState(GL_COLOR_ARRAY);
     glVertexPointer(3, GL_FLOAT, 0, m->positions);
-    glColorPointer(4, GL_FLOAT, 0, f->imap_colors);
+    glColorPointer(4, GL_FLOAT, 0, colors);
     /* Only the surfaces in the maps: mirrors and glass would add black, and
      * took 41 % of the default box's pass. */
-    for (size_t i = 0; i < f->imap_span_count; i++)
-        glDrawArrays(GL_TRIANGLES, (GLint)f->imap_spans[i].first, (GLsizei)f->imap_spans[i].count);
+    for (size_t i = 0; i < span_count; i++)
+        glDrawArrays(GL_TRIANGLES, (GLint)spans[i].first, (GLsizei)spans[i].count);
     glDisableClientState(GL_COLOR_ARRAY);
     glDisableClientState(GL_VERTEX_ARRAY);
     glDisable(GL_BLEND);

@@ -137,14 +137,15 @@ static void clear_imap(ps_gl_layers *l)
     l->imap_drawn = false;
 }
 
-/* The maps of frame f added into their layer (gl_illummap.c). */
-static void imap_pass(ps_gl_layers *l, ps_gl_renderer *r, const ps_session_frame *f)
+/* Maps' colours added into their layer over the spans (gl_illummap.c). */
+static void imap_pass(ps_gl_layers *l, ps_gl_renderer *r, const float *colors, const ps_illum_span *spans,
+                      size_t span_count)
 {
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_IMAP_TEX]);
     glViewport(0, 0, l->view_w, l->view_h);
-    ps_gl_draw_illummap(r, f);
+    ps_gl_draw_illummap(r, colors, spans, span_count);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
 }
 
@@ -154,7 +155,7 @@ static void draw_imap(ps_gl_layers *l, ps_gl_renderer *r, const ps_session_frame
     clear_imap(l);
     if (!f->imap_colors)
         return;
-    imap_pass(l, r, f);
+    imap_pass(l, r, f->imap_colors, f->imap_spans, f->imap_span_count);
     l->imap_drawn = true;
 }
 
@@ -166,14 +167,8 @@ void ps_gl_layers_prepare_maps(ps_gl_layers *l, ps_gl_renderer *r)
      * (docs/preview.md). */
     static const float black[3 * 4];
     static const ps_illum_span first = {0, 3};
-    if (r->in.mesh->vertex_count < 3)
-        return;
-    ps_session_frame f;
-    memset(&f, 0, sizeof f);
-    f.imap_colors = black;
-    f.imap_spans = &first;
-    f.imap_span_count = 1;
-    imap_pass(l, r, &f);
+    if (r->in.mesh->vertex_count >= 3)
+        imap_pass(l, r, black, &first, 1);
 }
 
 /* A new view, the direct layer's shadows as said; moving: a moving

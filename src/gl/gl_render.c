@@ -430,7 +430,7 @@ void ps_gl_draw_frame_timed(ps_gl_renderer *r, const ps_camera_frame *cam, const
     } else {
         ps_gl_begin_frame(r, cam, f->direct_exposure, f->direct);
     }
-    ps_gl_draw_illummap(r, f);
+    ps_gl_draw_illummap(r, f->imap_colors, f->imap_spans, f->imap_span_count);
     double t0 = 0.0;
     if (splat_seconds) {
         glFinish();

@@ -133,10 +133,10 @@ void ps_gl_draw_splats(ps_gl_renderer *r, const ps_splat_batch *b, ps_splat_mode
                        double point_size);
 
 /* The global layer's illumination maps (--global-layer maps): the fine mesh's
- * spans with surfaces in the maps (f->imap_spans) with their per-vertex
- * colours (f->imap_colors, one RGBA a vertex), added to the frame, depth
- * tested against the scene (gl_illummap.c). NULL colours draw nothing. */
-void ps_gl_draw_illummap(ps_gl_renderer *r, const ps_session_frame *f);
+ * spans with surfaces in the maps (ps_session_frame.imap_spans) with their
+ * per-vertex colours (.imap_colors, one RGBA a vertex), added to the frame,
+ * depth tested against the scene (gl_illummap.c). NULL colours draw nothing. */
+void ps_gl_draw_illummap(ps_gl_renderer *r, const float *colors, const ps_illum_span *spans, size_t span_count);
 
 /* Waits until GL has drawn everything asked so far (llvmpipe draws when
  * flushed): for timing the drawing, not the queueing. */
