@@ -196,6 +196,76 @@ static void threads_do_not_matter(void **state)
     ps_image_destroy(&b);
 }
 
+/* The layers a session may never draw hold no texels until drawn into
+ * (gl_layers.c): the maps' not after a view alone, then theirs at the maps'
+ * first pass, the linear composite's at its first read. The maps' first
+ * picture drawn into a layer made then is the same floats as into one made
+ * before the view (ps_gl_layers_reserve), which the view cleared. */
+static void optional_layers_made_when_drawn(void **state)
+{
+    (void)state;
+    ps_scene *scene;
+    ps_error err;
+    if (ps_scene_load_text(FURNACE, "furnace.scn", "", NULL, &scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_session_settings set = ps_session_default_settings(scene);
+    set.threads = 2;
+    set.seed = 1;
+    set.caps[PS_MAP_GLOBAL] = 20000;
+    set.float_buffer = true;
+    set.incremental = true;
+    set.exposure = EXPOSURE;
+    set.layers = PS_LAYER_GLOBAL;
+    set.global_layer = PS_GLOBAL_MAPS;
+    ps_session *s;
+    if (ps_session_create(scene, &set, &s, &err) != PS_OK)
+        fail_msg("session: %s", err.msg);
+    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
+    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    assert_non_null(ctx);
+    uint8_t *buffer = malloc(4 * SIDE * SIDE);
+    assert_true(OSMesaMakeCurrent(ctx, buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
+    ps_gl_options go = {true, false, 0, false, false, OSMesaGetProcAddress};
+    ps_gl_scene gs = ps_gl_scene_of(s);
+    ps_gl_renderer *gl;
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
+    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), SIDE, SIDE);
+    ps_session_frame f;
+    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+    assert_non_null(f.imap_colors);
+    assert_true(f.new_view);
+    const size_t layer = (size_t)SIDE * SIDE * 4 * sizeof(float);
+    const size_t base = 3 * layer + (size_t)SIDE * SIDE * 4; /* direct, caustic, global; shown (sRGB8) */
+    ps_image img[2];
+    for (int reserved = 0; reserved < 2; reserved++) {
+        ps_gl_layers *l;
+        assert_int_equal(ps_gl_layers_create(SIDE, SIDE, true, &l, &err), PS_OK);
+        assert_int_equal(ps_gl_layers_bytes(l), base);
+        if (reserved)
+            ps_gl_layers_reserve(l, gl, true);
+        ps_gl_layers_view(l, gl, &cam, f.direct_exposure, f.direct);
+        assert_int_equal(ps_gl_layers_bytes(l), base + (reserved ? layer : 0));
+        ps_gl_layers_draw(l, gl, &cam, &f);
+        assert_int_equal(ps_gl_layers_bytes(l), base + layer);
+        double gains[PS_MAP_COUNT] = {f.map[0].gain, f.map[1].gain};
+        assert_int_equal(ps_gl_layers_composite(l, f.direct_gain, gains, &img[reserved], &err), PS_OK);
+        assert_int_equal(ps_gl_layers_bytes(l), base + 2 * layer);
+        ps_gl_layers_destroy(l);
+    }
+    double sum = 0.0;
+    for (size_t i = 0; i < 3 * (size_t)SIDE * SIDE; i++)
+        sum += img[0].rgb[i];
+    assert_true(sum > 0.0); /* the maps are in the picture */
+    assert_memory_equal(img[0].rgb, img[1].rgb, 3 * sizeof(float) * SIDE * SIDE);
+    for (int i = 0; i < 2; i++)
+        ps_image_destroy(&img[i]);
+    ps_gl_renderer_destroy(gl);
+    OSMesaDestroyContext(ctx);
+    free(buffer);
+    ps_session_destroy(s);
+    ps_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -203,6 +273,7 @@ int main(void)
         cmocka_unit_test(moving_view_scales_up),
         cmocka_unit_test(whole_frame_shows_the_maps),
         cmocka_unit_test(threads_do_not_matter),
+        cmocka_unit_test(optional_layers_made_when_drawn),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1396,8 +1396,11 @@ static ps_status run(const snap_options *o, ps_scene *scene, ps_platform *platfo
         ps_gl_scene gs = ps_gl_scene_of(s.session);
         st = ps_gl_renderer_create(&gs, ps_session_kernel(s.session), &gopt, &s.gl, err);
     }
-    if (st == PS_OK && set.incremental)
+    if (st == PS_OK && set.incremental) {
         st = ps_gl_layers_create(width, height, true, &s.layers, err);
+        if (st == PS_OK)
+            ps_gl_layers_reserve(s.layers, s.gl, ps_session_illummap(s.session) != NULL);
+    }
     if (st == PS_OK)
         st = ps_gl_specular_create(0, &s.spec, err);
     /* --time: the first round of cube faces soon, for the checkpoints (a

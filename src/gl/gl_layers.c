@@ -40,6 +40,11 @@ struct ps_gl_layers {
     bool float_buffers;
     bool imap_drawn; /* LAYER_IMAP_TEX holds maps (else it is black and not composited) */
     GLuint tex[LAYER_TEX_COUNT], fbo[LAYER_TEX_COUNT], depth_stencil;
+    /* Which layers hold their texels (view-sized; else a 1x1 stand-in of
+     * the same format, see ps_gl_layers_create): the direct, map and shown
+     * layers from the start, the others (LAYER_OPTIONAL) when first drawn
+     * into or ps_gl_layers_reserve. */
+    bool made[LAYER_TEX_COUNT];
     bool albedo; /* LAYER_ALBEDO_TEX holds this view's T */
     GLuint extra_tex; /* the specular layer (gl_specular.c), times extra_gain */
     double extra_gain;
@@ -49,6 +54,70 @@ struct ps_gl_layers {
      * Any other view, relight or splat drawn into the layers drops it. */
     ps_gl_ahead ahead;
 };
+
+/* The layers a session may never draw: the illumination maps' (only with
+ * --global-layer maps), the linear composite (read back: snap's pictures,
+ * the window's false colour), the texture factor (only where the scene has
+ * textures). Each is a float texture of the view's size, which Mesa zeroes
+ * when it is made: 4 MiB at 512^2, 32 MiB at 1920x1080. Made with the
+ * others, they took the window's first picture (the default box at 512^2)
+ * 40-50 ms longer. */
+static bool layer_optional(int i) { return i == LAYER_IMAP_TEX || i == LAYER_FINAL_TEX || i == LAYER_ALBEDO_TEX; }
+
+static GLint layer_format(const ps_gl_layers *l, int i, GLenum *type)
+{
+    /* The linear composite is always float; the shown one is sRGB-encoded
+     * 8 bits, written through GL_FRAMEBUFFER_SRGB. */
+    bool is_float = l->float_buffers || i == LAYER_FINAL_TEX || i == LAYER_ALBEDO_TEX;
+    *type = is_float ? GL_FLOAT : GL_UNSIGNED_BYTE;
+    return i == LAYER_SHOWN_TEX ? GL_SRGB8_ALPHA8 : is_float ? GL_RGBA32F : GL_RGBA8;
+}
+
+/* Layer i's texels at the view's size, black, if it has only its stand-in
+ * yet (GL leaves a new texture's texels undefined). The bindings and the
+ * scissor are kept. */
+static void make_layer(ps_gl_layers *l, int i)
+{
+    if (l->made[i])
+        return;
+    GLint old_fbo = 0, old_tex = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &old_tex);
+    GLenum type;
+    GLint format = layer_format(l, i, &type);
+    glBindTexture(GL_TEXTURE_2D, l->tex[i]);
+    glTexImage2D(GL_TEXTURE_2D, 0, format, l->width, l->height, 0, GL_RGBA, type, NULL);
+    glBindTexture(GL_TEXTURE_2D, (GLuint)old_tex);
+    glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[i]);
+    GLboolean scissor = glIsEnabled(GL_SCISSOR_TEST);
+    glDisable(GL_SCISSOR_TEST);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    if (scissor)
+        glEnable(GL_SCISSOR_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    l->made[i] = true;
+}
+
+void ps_gl_layers_reserve(ps_gl_layers *l, const ps_gl_renderer *r, bool maps)
+{
+    if (maps)
+        make_layer(l, LAYER_IMAP_TEX);
+    if (ps_gl_has_albedo(r))
+        make_layer(l, LAYER_ALBEDO_TEX);
+}
+
+size_t ps_gl_layers_bytes(const ps_gl_layers *l)
+{
+    size_t bytes = 0, pixels = (size_t)l->width * (size_t)l->height;
+    for (int i = 0; i < LAYER_TEX_COUNT; i++) {
+        GLenum type;
+        if (l->made[i])
+            bytes += pixels * (layer_format(l, i, &type) == GL_RGBA32F ? 4 * sizeof(float) : 4);
+    }
+    return bytes;
+}
 
 GLuint ps_gl_layers_depth_stencil(const ps_gl_layers *l) { return l->depth_stencil; }
 
@@ -87,11 +156,14 @@ ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_l
     bool complete = true;
     for (int i = 0; i < LAYER_TEX_COUNT; i++) {
         glBindTexture(GL_TEXTURE_2D, l->tex[i]);
-        /* The linear composite is always float; the shown one is sRGB-encoded
-         * 8 bits, written through GL_FRAMEBUFFER_SRGB. */
-        bool is_float = float_buffers || i == LAYER_FINAL_TEX || i == LAYER_ALBEDO_TEX;
-        GLint format = i == LAYER_SHOWN_TEX ? GL_SRGB8_ALPHA8 : is_float ? GL_RGBA32F : GL_RGBA8;
-        glTexImage2D(GL_TEXTURE_2D, 0, format, width, height, 0, GL_RGBA, is_float ? GL_FLOAT : GL_UNSIGNED_BYTE,
+        /* An optional layer gets a 1x1 stand-in of its format for now, so
+         * that its framebuffer's completeness (the format's support) is
+         * known here; its texels come with make_layer (framebuffer objects
+         * allow attachments of different sizes). */
+        GLenum type;
+        GLint format = layer_format(l, i, &type);
+        l->made[i] = !layer_optional(i);
+        glTexImage2D(GL_TEXTURE_2D, 0, format, l->made[i] ? width : 1, l->made[i] ? height : 1, 0, GL_RGBA, type,
                      NULL);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -127,6 +199,9 @@ void ps_gl_layers_destroy(ps_gl_layers *l)
 
 static void clear_imap(ps_gl_layers *l)
 {
+    l->imap_drawn = false;
+    if (!l->made[LAYER_IMAP_TEX]) /* black when made */
+        return;
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_IMAP_TEX]);
@@ -134,13 +209,13 @@ static void clear_imap(ps_gl_layers *l)
     glClearColor(0, 0, 0, 0);
     glClear(GL_COLOR_BUFFER_BIT);
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
-    l->imap_drawn = false;
 }
 
 /* Maps' colours added into their layer over the spans (gl_illummap.c). */
 static void imap_pass(ps_gl_layers *l, ps_gl_renderer *r, const float *colors, const ps_illum_span *spans,
                       size_t span_count)
 {
+    make_layer(l, LAYER_IMAP_TEX);
     GLint old_fbo = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_IMAP_TEX]);
@@ -199,6 +274,7 @@ static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *
         ps_gl_layers_clear_map(l, k);
     l->albedo = ps_gl_has_albedo(r);
     if (l->albedo) {
+        make_layer(l, LAYER_ALBEDO_TEX);
         glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[LAYER_ALBEDO_TEX]);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         glClearColor(1, 1, 1, 1);
@@ -423,6 +499,7 @@ static void composite(ps_gl_layers *l, int target, int target_w, int target_h, d
                       const double map_gain[PS_MAP_COUNT])
 {
     view_read v = read_view(l, target_w, target_h);
+    make_layer(l, target);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo[target]);
     glViewport(0, 0, target_w, target_h);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);

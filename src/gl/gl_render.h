@@ -163,8 +163,18 @@ ps_status ps_gl_read(ps_gl_renderer *r, ps_image *out, ps_error *err);
  * nothing comes back to the CPU but a screenshot. */
 typedef struct ps_gl_layers ps_gl_layers;
 
+/* The direct, map and shown layers get their texels here; the illumination
+ * maps', the texture factor's and the linear composite's when first drawn
+ * into, or at ps_gl_layers_reserve: a session may never draw them. */
 ps_status ps_gl_layers_create(int width, int height, bool float_buffers, ps_gl_layers **out, ps_error *err);
 void ps_gl_layers_destroy(ps_gl_layers *l);
+/* The layers a session will draw made now, before its first picture, and
+ * not in it: the illumination maps' (maps: --global-layer maps) and, where
+ * r's scene has textures, the texture factor's. */
+void ps_gl_layers_reserve(ps_gl_layers *l, const ps_gl_renderer *r, bool maps);
+/* The bytes of the layers' texels made so far (the depth-stencil buffer
+ * not counted). */
+size_t ps_gl_layers_bytes(const ps_gl_layers *l);
 /* A new view: the direct layer (times exposure) or black, the prepass, and
  * empty map layers. */
 void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct);
@@ -200,9 +210,10 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
  * (image.h, ps_tonemap_8bit) but for the GL's own rounding (llvmpipe: up to
  * two codes apart, docs/preview.md). */
 void ps_gl_layers_show(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT]);
-/* Before the first show: the scaled show (a moving camera's or an edit's
- * level of detail) drawn once into the back buffer, so that its first real
- * use costs its own time only. */
+/* The scaled show (a moving camera's or an edit's level of detail) drawn
+ * once into the back buffer, so that its first real use costs its own time
+ * only: the window's, right after its first picture is shown (the next show
+ * draws over the back buffer and the shown layer). */
 void ps_gl_layers_warm_up(ps_gl_layers *l);
 /* The same picture the way the window showed it before the composite moved
  * to GL: read back as floats, encoded on the CPU (ps_tonemap_8bit) and drawn
