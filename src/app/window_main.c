@@ -282,6 +282,44 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
 
 static ps_camera_frame camera_frame(const app *a) { return ps_camera_frame_make(&a->camera, a->width, a->height); }
 
+/* The first picture's view, drawn while its photons are traced
+ * (ps_session_start_beside). */
+typedef struct first_view_job {
+    app *a;
+    double exposure; /* the direct layer as the first refresh asks for it */
+    bool direct;
+    bool maps; /* the session has illumination maps (asked before the start) */
+} first_view_job;
+
+static void first_view(void *ctx)
+{
+    first_view_job *j = ctx;
+    ps_camera_frame cam = camera_frame(j->a);
+    ps_gl_layers_view_ahead(j->a->layers, j->a->gl, &cam, j->exposure, j->direct);
+}
+
+/* While the batch is still traced after the view: the maps' programs. */
+static void first_view_spare(void *ctx)
+{
+    first_view_job *j = ctx;
+    if (j->maps)
+        ps_gl_layers_prepare_maps(j->a->layers, j->a->gl);
+}
+
+/* The scaled show drawn once (ps_gl_layers_warm_up), in the first wait
+ * after the first picture, so that the first edit's or camera step's level
+ * of detail does not build it. Drawn before the first picture, it took that
+ * picture 0.06-0.07 s longer (the default box at 512^2: 0.53-0.55 s against
+ * 0.47-0.48 s, docs/preview.md). Not at once after it: a script's actions
+ * count from the first picture, and the first would come later. */
+static bool warm_up_show(app *a)
+{
+    if (a->o.composite)
+        ps_gl_layers_warm_up(a->layers);
+    a->warmed_up = true;
+    return true;
+}
+
 /* The session, its GL renderer and layers. */
 static ps_status open_session(app *a, ps_error *err)
 {
@@ -306,10 +344,16 @@ static ps_status open_session(app *a, ps_error *err)
     if (st == PS_OK)
         st = ps_gl_specular_create(0, &a->spec, err);
     /* The first batch is traced here, and the thread starts held until the
-     * first refresh has drawn it: that refresh (shadow maps, direct light,
-     * those splats) then has every core, and the caustic shows at once. */
-    if (st == PS_OK)
-        st = ps_session_start(a->session, true, err);
+     * first refresh has drawn it: that refresh (its splats) then has every
+     * core, and the caustic shows at once. The first view (shadow maps,
+     * prepass, llvmpipe's first programs) is drawn into the layers while
+     * the batch is traced, as snap's (view_ahead), and that refresh does not
+     * draw it again. */
+    if (st == PS_OK) {
+        first_view_job job = {a, 1.0, false, ps_session_illummap(a->session) != NULL};
+        ps_session_direct_view(a->session, &job.exposure, &job.direct);
+        st = ps_session_start_beside(a->session, true, first_view, first_view_spare, &job, err);
+    }
     return st;
 }
 
@@ -1124,7 +1168,8 @@ static ps_status session(app *a, ps_error *err)
          * stopped (session.h), and the direct light's textures once the
          * lights hold (gl_render.h); not while photons are traced. */
         unsigned bakes = ps_gl_get_stats(a->gl).direct_bakes;
-        bool worked = idle && (ps_session_prepare_still(a->session, PS_SESSION_PREPARE_VERTICES) ||
+        bool worked = idle && ((a->frames > 0 && !a->warmed_up && warm_up_show(a)) ||
+                               ps_session_prepare_still(a->session, PS_SESSION_PREPARE_VERTICES) ||
                                (a->frames > 0 && a->frame.direct && !ps_session_tracing(a->session) &&
                                 ps_gl_direct_bake_lay(a->gl, a->frame.direct_exposure, PS_GL_DIRECT_BAKE_STEP_SECONDS)));
         if (ps_gl_get_stats(a->gl).direct_bakes != bakes)
@@ -1183,17 +1228,6 @@ static ps_status session(app *a, ps_error *err)
             }
             if (st == PS_OK)
                 ps_platform_present(a->platform);
-            /* Once the first picture is up: the scaled show drawn once
-             * (ps_gl_layers_warm_up), before any edit or camera step can
-             * ask for it. Before the first picture it took that picture
-             * 0.06-0.07 s longer (the default box at 512^2: 0.53-0.55 s
-             * against 0.47-0.48 s, docs/preview.md); here the refresh after
-             * it comes when it did before. */
-            if (st == PS_OK && !a->warmed_up) {
-                if (a->o.composite)
-                    ps_gl_layers_warm_up(a->layers);
-                a->warmed_up = true;
-            }
             /* An edit's level of detail shown: its full view at once. The
              * view drawn again after the camera stopped, nothing traced
              * meanwhile: refresh after refresh, events polled between them

@@ -212,8 +212,8 @@ void ps_gl_layers_draw(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
 void ps_gl_layers_show(ps_gl_layers *l, double direct_gain, const double map_gain[PS_MAP_COUNT]);
 /* The scaled show (a moving camera's or an edit's level of detail) drawn
  * once into the back buffer, so that its first real use costs its own time
- * only: the window's, right after its first picture is shown (the next show
- * draws over the back buffer and the shown layer). */
+ * only: the window's, in its first wait after its first picture (the next
+ * show draws over the back buffer and the shown layer). */
 void ps_gl_layers_warm_up(ps_gl_layers *l);
 /* The same picture the way the window showed it before the composite moved
  * to GL: read back as floats, encoded on the CPU (ps_tonemap_8bit) and drawn
