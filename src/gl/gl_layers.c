@@ -42,8 +42,8 @@ struct ps_gl_layers {
     GLuint tex[LAYER_TEX_COUNT], fbo[LAYER_TEX_COUNT], depth_stencil;
     /* Which layers hold their texels (view-sized; else a 1x1 stand-in of
      * the same format, see ps_gl_layers_create): the direct, map and shown
-     * layers from the start, the others (LAYER_OPTIONAL) when first drawn
-     * into or ps_gl_layers_reserve. */
+     * layers from the start, the others (layer_optional) when first drawn
+     * into or reserved (ps_gl_layers_reserve). */
     bool made[LAYER_TEX_COUNT];
     bool albedo; /* LAYER_ALBEDO_TEX holds this view's T */
     GLuint extra_tex; /* the specular layer (gl_specular.c), times extra_gain */
