@@ -30,6 +30,56 @@ static const char *const FURNACE = "camera eye 0 0.2 0.3 target 0.3 0 -1 fov 70\
                                    "photons caustic 0 global 200000\n"
                                    "radius caustic 0.02 global 0.3\n";
 
+/* The furnace's session through the maps, traced to its caps (global_cap:
+ * the global map's, 0 for the scene's), and an OSMesa context of SIDE^2
+ * with a renderer for it. */
+typedef struct furnace_rig {
+    ps_scene *scene;
+    ps_session *s;
+    OSMesaContext ctx;
+    uint8_t *buffer;
+    ps_gl_renderer *gl;
+    ps_camera_frame cam;
+} furnace_rig;
+
+static void furnace_open(furnace_rig *k, bool layers, int threads, uint64_t global_cap)
+{
+    ps_error err;
+    if (ps_scene_load_text(FURNACE, "furnace.scn", "", NULL, &k->scene, &err) != PS_OK)
+        fail_msg("scene: %s", err.msg);
+    ps_session_settings set = ps_session_default_settings(k->scene);
+    set.threads = threads;
+    set.seed = 1;
+    if (global_cap)
+        set.caps[PS_MAP_GLOBAL] = global_cap;
+    set.float_buffer = layers;
+    set.incremental = layers;
+    set.exposure = EXPOSURE;
+    set.layers = PS_LAYER_GLOBAL;
+    set.global_layer = PS_GLOBAL_MAPS;
+    if (ps_session_create(k->scene, &set, &k->s, &err) != PS_OK)
+        fail_msg("session: %s", err.msg);
+    assert_int_equal(ps_session_trace_all(k->s, &err), PS_OK);
+    k->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    assert_non_null(k->ctx);
+    k->buffer = malloc(4 * SIDE * SIDE);
+    assert_non_null(k->buffer);
+    assert_true(OSMesaMakeCurrent(k->ctx, k->buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
+    ps_gl_options go = {true, false, 0, false, false, OSMesaGetProcAddress};
+    ps_gl_scene gs = ps_gl_scene_of(k->s);
+    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(k->s), &go, &k->gl, &err), PS_OK);
+    k->cam = ps_camera_frame_make(ps_scene_camera(k->scene), SIDE, SIDE);
+}
+
+static void furnace_close(furnace_rig *k)
+{
+    ps_gl_renderer_destroy(k->gl);
+    OSMesaDestroyContext(k->ctx);
+    free(k->buffer);
+    ps_session_destroy(k->s);
+    ps_scene_destroy(k->scene);
+}
+
 /* The global layer of the furnace through the maps; *lo, *hi: the least and
  * most of the maps' inside values as drawn (times albedo / pi and exposure).
  * move: then a refresh with the camera turned a little, the moving camera's
@@ -39,31 +89,12 @@ static const char *const FURNACE = "camera eye 0 0.2 0.3 target 0.3 0 -1 fov 70\
  * (OSMesa's buffer, SIDE^2 RGBA8 codes, bottom row first). */
 static ps_image draw_shown(bool layers, int threads, bool move, double *lo, double *hi, uint8_t *shown)
 {
-    ps_scene *scene;
+    furnace_rig k;
+    furnace_open(&k, layers, threads, 0);
+    ps_session *s = k.s;
+    ps_gl_renderer *gl = k.gl;
+    ps_camera_frame cam = k.cam;
     ps_error err;
-    if (ps_scene_load_text(FURNACE, "furnace.scn", "", NULL, &scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_session_settings set = ps_session_default_settings(scene);
-    set.threads = threads;
-    set.seed = 1;
-    set.float_buffer = layers;
-    set.incremental = layers;
-    set.exposure = EXPOSURE;
-    set.layers = PS_LAYER_GLOBAL;
-    set.global_layer = PS_GLOBAL_MAPS;
-    ps_session *s;
-    if (ps_session_create(scene, &set, &s, &err) != PS_OK)
-        fail_msg("session: %s", err.msg);
-    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
-    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    assert_non_null(ctx);
-    uint8_t *buffer = malloc(4 * SIDE * SIDE);
-    assert_true(OSMesaMakeCurrent(ctx, buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
-    ps_gl_options go = {true, false, 0, false, false, OSMesaGetProcAddress};
-    ps_gl_scene gs = ps_gl_scene_of(s);
-    ps_gl_renderer *gl;
-    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
-    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), SIDE, SIDE);
     ps_session_frame f;
     ps_gl_layers *l = NULL;
     if (layers)
@@ -105,18 +136,14 @@ static ps_image draw_shown(bool layers, int threads, bool move, double *lo, doub
         if (shown) {
             ps_gl_layers_show(l, f.direct_gain, gains);
             ps_gl_finish();
-            memcpy(shown, buffer, 4 * SIDE * SIDE);
+            memcpy(shown, k.buffer, 4 * SIDE * SIDE);
         }
         ps_gl_layers_destroy(l);
     } else {
         ps_gl_draw_frame(gl, &cam, &f);
         assert_int_equal(ps_gl_read(gl, &img, &err), PS_OK);
     }
-    ps_gl_renderer_destroy(gl);
-    OSMesaDestroyContext(ctx);
-    free(buffer);
-    ps_session_destroy(s);
-    ps_scene_destroy(scene);
+    furnace_close(&k);
     return img;
 }
 
@@ -204,34 +231,13 @@ static void threads_do_not_matter(void **state)
 static void optional_layers_made_when_drawn(void **state)
 {
     (void)state;
-    ps_scene *scene;
+    furnace_rig k;
+    furnace_open(&k, true, 2, 20000);
+    ps_gl_renderer *gl = k.gl;
+    ps_camera_frame cam = k.cam;
     ps_error err;
-    if (ps_scene_load_text(FURNACE, "furnace.scn", "", NULL, &scene, &err) != PS_OK)
-        fail_msg("scene: %s", err.msg);
-    ps_session_settings set = ps_session_default_settings(scene);
-    set.threads = 2;
-    set.seed = 1;
-    set.caps[PS_MAP_GLOBAL] = 20000;
-    set.float_buffer = true;
-    set.incremental = true;
-    set.exposure = EXPOSURE;
-    set.layers = PS_LAYER_GLOBAL;
-    set.global_layer = PS_GLOBAL_MAPS;
-    ps_session *s;
-    if (ps_session_create(scene, &set, &s, &err) != PS_OK)
-        fail_msg("session: %s", err.msg);
-    assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
-    OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    assert_non_null(ctx);
-    uint8_t *buffer = malloc(4 * SIDE * SIDE);
-    assert_true(OSMesaMakeCurrent(ctx, buffer, GL_UNSIGNED_BYTE, SIDE, SIDE));
-    ps_gl_options go = {true, false, 0, false, false, OSMesaGetProcAddress};
-    ps_gl_scene gs = ps_gl_scene_of(s);
-    ps_gl_renderer *gl;
-    assert_int_equal(ps_gl_renderer_create(&gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
-    ps_camera_frame cam = ps_camera_frame_make(ps_scene_camera(scene), SIDE, SIDE);
     ps_session_frame f;
-    assert_int_equal(ps_session_refresh(s, &cam, &f, &err), PS_OK);
+    assert_int_equal(ps_session_refresh(k.s, &cam, &f, &err), PS_OK);
     assert_non_null(f.imap_colors);
     assert_true(f.new_view);
     const size_t layer = (size_t)SIDE * SIDE * 4 * sizeof(float);
@@ -259,11 +265,7 @@ static void optional_layers_made_when_drawn(void **state)
     assert_memory_equal(img[0].rgb, img[1].rgb, 3 * sizeof(float) * SIDE * SIDE);
     for (int i = 0; i < 2; i++)
         ps_image_destroy(&img[i]);
-    ps_gl_renderer_destroy(gl);
-    OSMesaDestroyContext(ctx);
-    free(buffer);
-    ps_session_destroy(s);
-    ps_scene_destroy(scene);
+    furnace_close(&k);
 }
 
 int main(void)

@@ -791,25 +791,20 @@ static ps_status unseen_batch(snap_run *s, ps_error *err)
     return st;
 }
 
-/* The first picture's view, drawn while its photons are traced
+/* The first 8-bit picture's view, drawn while its photons are traced
  * (ps_session_start_beside): its shadow maps, prepass and lit passes, and
- * llvmpipe's first compiles of them; into the float layers, or into the
- * 8-bit buffer, where the first refresh draws its splats over it. */
+ * llvmpipe's first compiles of them, into the 8-bit buffer, where the first
+ * refresh draws its splats over it (float layers: ps_gl_layers_start). */
 typedef struct view_ahead_job {
     snap_run *s;
     double exposure; /* the direct layer as the first refresh asks for it */
     bool direct;
-    bool maps;       /* the session has illumination maps (asked before the start) */
 } view_ahead_job;
 
 static void view_ahead(void *ctx)
 {
     view_ahead_job *j = ctx;
     snap_run *s = j->s;
-    if (s->layers) {
-        ps_gl_layers_view_ahead(s->layers, s->gl, &s->cam, j->exposure, j->direct);
-        return;
-    }
     /* Finished here, so that its time is its own: the first refresh counts
      * it as its view's (refresh). */
     double t0 = ps_now_seconds();
@@ -818,15 +813,6 @@ static void view_ahead(void *ctx)
     ps_gl_finish();
     s->view_ahead_seconds = ps_now_seconds() - t0;
     s->view_ahead_shadows = ps_gl_get_stats(s->gl).shadow_seconds_last;
-}
-
-/* While the round is still traced after the view (ps_session_start_beside's
- * spare): the float layers' illumination maps' programs. */
-static void spare_ahead(void *ctx)
-{
-    view_ahead_job *j = ctx;
-    if (j->s->layers && j->maps)
-        ps_gl_layers_prepare_maps(j->s->layers, j->s->gl);
 }
 
 /* Progressive: trace in the background, refresh every tau. As in the window,
@@ -843,15 +829,21 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
      * that shows a checkpoint. (The default box's first float picture: 0.35-
      * 0.36 s; 0.43-0.50 s sharing the cores and waiting for the first
      * checkpoint or tau.) The first view is drawn while the first round is
-     * traced (view_ahead): into the float layers, which keep it, or into the
-     * 8-bit buffer, whose first frame then draws only its splats over it.
+     * traced: into the float layers, which keep it (ps_gl_layers_start), or
+     * into the 8-bit buffer, whose first frame then draws only its splats
+     * over it (view_ahead).
      * (Drawn beside the round as well but the frame drawing its view again,
      * the default box's and the design room's first 8-bit checkpoints came
      * 5-7 ms later, medians of eight runs; see docs/preview.md for the
      * figures of the view kept.) */
-    view_ahead_job ahead = {s, 1.0, false, ps_session_illummap(s->session) != NULL};
-    ps_session_direct_view(s->session, &ahead.exposure, &ahead.direct);
-    ps_status st = ps_session_start_beside(s->session, s->layers != NULL, view_ahead, spare_ahead, &ahead, err);
+    ps_status st;
+    if (s->layers) {
+        st = ps_gl_layers_start(s->layers, s->gl, s->session, &s->cam, err);
+    } else {
+        view_ahead_job ahead = {s, 1.0, false};
+        ps_session_direct_view(s->session, &ahead.exposure, &ahead.direct);
+        st = ps_session_start_beside(s->session, false, view_ahead, NULL, &ahead, err);
+    }
     double next = t_start + o->p.tau, end = t_start + o->time, excluded = 0.0;
     pace_rate rate = {0.0, 0.0};
     int cp = 0;

@@ -282,30 +282,6 @@ static ps_status parse_args(int argc, char **argv, win_options *o, bool *help, p
 
 static ps_camera_frame camera_frame(const app *a) { return ps_camera_frame_make(&a->camera, a->width, a->height); }
 
-/* The first picture's view, drawn while its photons are traced
- * (ps_session_start_beside). */
-typedef struct first_view_job {
-    app *a;
-    double exposure; /* the direct layer as the first refresh asks for it */
-    bool direct;
-    bool maps; /* the session has illumination maps (asked before the start) */
-} first_view_job;
-
-static void first_view(void *ctx)
-{
-    first_view_job *j = ctx;
-    ps_camera_frame cam = camera_frame(j->a);
-    ps_gl_layers_view_ahead(j->a->layers, j->a->gl, &cam, j->exposure, j->direct);
-}
-
-/* While the batch is still traced after the view: the maps' programs. */
-static void first_view_spare(void *ctx)
-{
-    first_view_job *j = ctx;
-    if (j->maps)
-        ps_gl_layers_prepare_maps(j->a->layers, j->a->gl);
-}
-
 /* The scaled show drawn once (ps_gl_layers_warm_up), in the first wait
  * after the first picture, so that the first edit's or camera step's level
  * of detail does not build it. Drawn before the first picture, it took that
@@ -347,12 +323,11 @@ static ps_status open_session(app *a, ps_error *err)
      * first refresh has drawn it: that refresh (its splats) then has every
      * core, and the caustic shows at once. The first view (shadow maps,
      * prepass, llvmpipe's first programs) is drawn into the layers while
-     * the batch is traced, as snap's (view_ahead), and that refresh does not
-     * draw it again. */
+     * the batch is traced, as snap's, and that refresh does not draw it
+     * again (ps_gl_layers_start). */
     if (st == PS_OK) {
-        first_view_job job = {a, 1.0, false, ps_session_illummap(a->session) != NULL};
-        ps_session_direct_view(a->session, &job.exposure, &job.direct);
-        st = ps_session_start_beside(a->session, true, first_view, first_view_spare, &job, err);
+        ps_camera_frame cam = camera_frame(a);
+        st = ps_gl_layers_start(a->layers, a->gl, a->session, &cam, err);
     }
     return st;
 }

@@ -246,6 +246,39 @@ void ps_gl_layers_prepare_maps(ps_gl_layers *l, ps_gl_renderer *r)
         imap_pass(l, r, black, &first, 1);
 }
 
+/* ps_gl_layers_start's work beside the first round. */
+typedef struct first_view {
+    ps_gl_layers *l;
+    ps_gl_renderer *r;
+    ps_camera_frame cam;
+    double exposure; /* the direct layer as the first refresh asks for it */
+    bool direct;
+    bool maps; /* the session has illumination maps */
+} first_view;
+
+static void first_view_draw(void *ctx)
+{
+    first_view *v = ctx;
+    ps_gl_layers_view_ahead(v->l, v->r, &v->cam, v->exposure, v->direct);
+}
+
+static void first_view_spare(void *ctx)
+{
+    first_view *v = ctx;
+    if (v->maps)
+        ps_gl_layers_prepare_maps(v->l, v->r);
+}
+
+ps_status ps_gl_layers_start(ps_gl_layers *l, ps_gl_renderer *r, ps_session *s, const ps_camera_frame *cam,
+                             ps_error *err)
+{
+    /* Asked before the start: the work beside the round must not call the
+     * session (ps_session_start_beside). */
+    first_view v = {l, r, *cam, 1.0, false, ps_session_illummap(s) != NULL};
+    ps_session_direct_view(s, &v.exposure, &v.direct);
+    return ps_session_start_beside(s, true, first_view_draw, first_view_spare, &v, err);
+}
+
 /* A new view, the direct layer's shadows as said; moving: a moving
  * camera's level of detail (no shadows, the moving mesh). */
 static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,

@@ -187,6 +187,14 @@ void ps_gl_layers_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame
  * ps_gl_layers_draw, after its splats (as every new view's there). */
 void ps_gl_layers_view_ahead(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *cam, double exposure,
                              bool direct);
+/* Starts session s (ps_session_start_beside, its tracing held until the
+ * first refresh is drawn) with the first picture's view of cam drawn into
+ * the layers while the first round is traced (ps_gl_layers_view_ahead),
+ * and, while the round is still traced after it, the illumination maps'
+ * programs built (ps_gl_layers_prepare_maps): snap's float runs and the
+ * window. */
+ps_status ps_gl_layers_start(ps_gl_layers *l, ps_gl_renderer *r, ps_session *s, const ps_camera_frame *cam,
+                             ps_error *err);
 /* The illumination maps' pass (--global-layer maps) drawn once with nothing
  * to add, one black triangle into their layer, so that llvmpipe builds its
  * programs now, not in the first refresh that draws the maps: work for
