@@ -77,13 +77,22 @@ static void view_ahead(void *ctx)
  * with the view drawn beside the round (into the layers l, or with l NULL
  * into the colour buffer) for the camera's eye moved eye_dx, at
  * exposure_factor times the first refresh's exposure: the calls of the work
- * beside the round. */
+ * beside the round. Into the layers for the camera itself at its exposure,
+ * the way snap's float runs and the window start (ps_gl_layers_start), and
+ * the views it drew count as the calls. */
 static int start(gl_rig *g, ps_gl_layers *l, ps_gl_renderer *gl, bool ahead, double eye_dx, double exposure_factor)
 {
     ps_error err;
     if (!ahead) {
         assert_int_equal(ps_session_start(g->s, true, &err), PS_OK);
         return 0;
+    }
+    if (l && eye_dx == 0.0 && exposure_factor == 1.0) {
+        /* As snap's float runs and the window start (ps_gl_layers_start):
+         * the views it drew beside the round. */
+        uint64_t views = ps_gl_get_stats(gl).views;
+        assert_int_equal(ps_gl_layers_start(l, gl, g->s, &g->cam, &err), PS_OK);
+        return (int)(ps_gl_get_stats(gl).views - views);
     }
     /* With the illumination maps, their programs too, as snap's spare work. */
     ahead_job job = {l, gl, g->cam, 1.0, false, l && ps_session_illummap(g->s), 0};
