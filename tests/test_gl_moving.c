@@ -14,7 +14,11 @@
  *    face's vertices): a floor under a low point light, where Gouraud
  *    interpolation errs most, within 3 % a pixel and 0.5 % on the mean of the
  *    same frame lit on the fine mesh, and its lit pass drawing exactly the
- *    moving mesh's vertices. */
+ *    moving mesh's vertices;
+ *  - and so while the lights are a progressive start's coarse level
+ *    (ps_session_lights_coarse), the camera still, in an 8-bit session's
+ *    whole frames: the moving mesh until the lights are refined, the fine
+ *    one after. */
 #include "test.h"
 
 #include <GL/osmesa.h>
@@ -64,14 +68,16 @@ static void rig_open(rig *g, const char *text, unsigned layers)
 
 static void rig_close(rig *g) { gl_rig_close(g); }
 
-static ps_gl_renderer *renderer(const ps_gl_scene *gs, ps_session *s)
+static ps_gl_renderer *renderer_shadows(const ps_gl_scene *gs, ps_session *s, bool shadows)
 {
-    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
+    ps_gl_options go = {shadows, true, 0, false, false, OSMesaGetProcAddress};
     ps_gl_renderer *gl;
     ps_error err;
     assert_int_equal(ps_gl_renderer_create(gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
     return gl;
 }
+
+static ps_gl_renderer *renderer(const ps_gl_scene *gs, ps_session *s) { return renderer_shadows(gs, s, true); }
 
 /* Every photon drawn for the still camera, then one refresh with the camera
  * moved a little: the level of detail, in *f (not drawn). */
@@ -192,11 +198,78 @@ static void direct_on_the_moving_mesh(void **state)
     rig_close(&g);
 }
 
+static void coarse_lights_on_the_moving_mesh(void **state)
+{
+    (void)state;
+    rig g;
+    ps_session_settings set = gl_rig_load(&g, FLOOR, "moving.scn");
+    set.exposure = EXPOSURE;
+    set.layers = PS_LAYER_DIRECT;
+    set.float_buffer = set.incremental = false; /* snap's 8-bit --time: whole refreshes */
+    set.progressive_lights = true;
+    gl_rig_start(&g, &set, SIDE);
+    const ps_preview_mesh *fine = ps_session_mesh(g.s), *moving = ps_session_moving_mesh(g.s);
+    assert_true(4 * moving->vertex_count <= 3 * fine->vertex_count);
+    assert_true(ps_session_lights_coarse(g.s));
+    ps_gl_scene gs = ps_gl_scene_of(g.s), gs_full = gs;
+    assert_true(gs.coarse_lights);
+    gs_full.coarse_lights = false; /* the same lights, taken as the last level */
+    /* Without shadow maps: one lit pass, of the whole mesh (the fine one's
+     * tiles are culled only against a shadow face's pyramid). */
+    ps_gl_renderer *gl = renderer_shadows(&gs, g.s, false), *gl_full = renderer_shadows(&gs_full, g.s, false);
+    ps_session_frame f;
+    ps_error err;
+    assert_int_equal(ps_session_refresh(g.s, &g.cam, &f, &err), PS_OK);
+    assert_false(f.moving || f.lights_changed);
+    ps_gl_draw_frame(gl, &g.cam, &f);
+    assert_int_equal(ps_gl_get_stats(gl).light_vertices, moving->vertex_count);
+    ps_image a, b, c;
+    assert_int_equal(ps_gl_read(gl, &a, &err), PS_OK);
+    ps_gl_draw_frame(gl_full, &g.cam, &f);
+    assert_int_equal(ps_gl_get_stats(gl_full).light_vertices, fine->vertex_count);
+    assert_int_equal(ps_gl_read(gl_full, &b, &err), PS_OK);
+    /* Refined (the full shadow maps): the fine mesh from then on. */
+    ps_session_drawn(g.s, 0.01);
+    assert_int_equal(ps_session_refresh(g.s, &g.cam, &f, &err), PS_OK);
+    assert_true(f.lights_changed && !ps_session_lights_coarse(g.s));
+    gs = ps_gl_scene_of(g.s);
+    assert_false(gs.coarse_lights);
+    assert_int_equal(ps_gl_renderer_set_scene(gl, &gs, &err), PS_OK);
+    ps_gl_draw_frame(gl, &g.cam, &f);
+    assert_int_equal(ps_gl_get_stats(gl).light_vertices, fine->vertex_count);
+    assert_int_equal(ps_gl_read(gl, &c, &err), PS_OK);
+    /* The 8-bit pictures (codes / 255): Gouraud's error on the floor under
+     * the low light, as while moving (above), within 3 % a pixel and one
+     * code of its rounding, against the coarse level lit finely; and the
+     * refined level's, the same lights lit finely, the same codes. */
+    size_t n = 3 * (size_t)SIDE * SIDE, over = 0;
+    double refined = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        over += fabs(a.rgb[i] - b.rgb[i]) > 0.03 * b.rgb[i] + 1.0 / 255.0;
+        refined = fmax(refined, fabs(c.rgb[i] - b.rgb[i]));
+    }
+    double ma = gl_rig_image_mean(&a), mb = gl_rig_image_mean(&b);
+    printf("coarse lights, 8 bits: moving mesh mean %.5f, fine mesh %.5f, %zu values off by more than 3 %% and a "
+           "code; refined against the fine: %.4f at most\n",
+           ma, mb, over, refined);
+    assert_true(ma != mb); /* the meshes differ where the light is near */
+    assert_int_equal(over, 0);
+    assert_near(ma, mb, 0.005 * mb);
+    assert_true(refined == 0.0);
+    ps_image_destroy(&a);
+    ps_image_destroy(&b);
+    ps_image_destroy(&c);
+    ps_gl_renderer_destroy(gl);
+    ps_gl_renderer_destroy(gl_full);
+    rig_close(&g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(global_layer_shrunk),
         cmocka_unit_test(direct_on_the_moving_mesh),
+        cmocka_unit_test(coarse_lights_on_the_moving_mesh),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -64,7 +64,7 @@ static void preview_make(preview *out, const char *text, int w, int h, ps_kernel
     assert_int_equal(ps_preview_lights_build(pp->scene, NULL, &pp->coarse, PS_GL_SHADOW_SIZE, PS_PREVIEW_AREA_SIDE, &pp->lights, &err), PS_OK);
     size_t nmat;
     ps_gl_scene gs = {&pp->mesh, &pp->coarse, ps_scene_materials(pp->scene, &nmat), &pp->lights, ps_scene_bounds(pp->scene),
-                      false, pp->scene, NULL};
+                      false, pp->scene, NULL, false};
     assert_int_equal(ps_gl_renderer_create(&gs, &pp->kernel, &go, &pp->gl, &err), PS_OK);
     pp->cam = ps_camera_frame_make(ps_scene_camera(pp->scene), w, h);
 }

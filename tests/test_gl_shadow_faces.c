@@ -71,7 +71,7 @@ static ps_gl_scene gl_scene(const ps_scene *s, const inputs *in)
 {
     size_t nmat;
     ps_gl_scene gs = {&in->mesh, &in->coarse, ps_scene_materials(s, &nmat), &in->lights, ps_scene_bounds(s), false, s,
-                      NULL};
+                      NULL, false};
     return gs;
 }
 

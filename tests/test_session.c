@@ -739,10 +739,16 @@ static void moving_global_layer_shrunk(void **state)
         assert_int_equal(f.map[PS_MAP_CAUSTIC].shrink, 1);
         ps_session_destroy(s);
     }
-    /* Whole refreshes draw no level of detail: no second mesh. */
+    /* Whole refreshes of a fixed count draw no level of detail: no second
+     * mesh. With progressive lights (snap's 8-bit --time) their coarse
+     * levels draw it (ps_session_lights_coarse). */
     ps_session_settings set = settings(scene, false);
     ps_session *s = open_session(scene, &set);
     assert_ptr_equal(ps_session_moving_mesh(s), ps_session_mesh(s));
+    ps_session_destroy(s);
+    set.progressive_lights = true;
+    s = open_session(scene, &set);
+    assert_true(ps_session_moving_mesh(s)->vertex_count < ps_session_mesh(s)->vertex_count);
     ps_session_destroy(s);
     ps_scene_destroy(scene);
 }
@@ -1215,6 +1221,7 @@ static void area_lights_refine(void **state)
         assert_false(f.shadows_refined);
         assert_int_equal(ps_session_lights(s)->count, want[i]);
         assert_int_equal(ps_session_lights(s)->shadow_size, sides[i]);
+        assert_true(ps_session_lights_coarse(s) == (i < 2)); /* a level to come */
         ps_session_drawn(s, 0.001);
     }
     refresh(s, &cam, &f);
@@ -1225,6 +1232,7 @@ static void area_lights_refine(void **state)
     assert_int_equal(ps_session_update(s, &ch, &err), PS_OK);
     assert_int_equal(ps_session_lights(s)->count, 1);
     assert_int_equal(ps_session_lights(s)->shadow_size, side); /* the faces an edit leaves are kept */
+    assert_true(ps_session_lights_coarse(s));                  /* its area lights refined again */
     ps_session_destroy(s);
     /* Held (photosplat-snap's 8-bit checkpoints): refreshes keep the level;
      * each ps_session_refine_lights brings the next, until all are there. */
@@ -1340,6 +1348,7 @@ static void coarse_shadows_first(void **state)
             assert_int_equal(ps_session_lights(s)->shadow_size, firsts[k]);
             bool coarse = firsts[k] < sides[k];
             assert_true(ps_session_lights_to_come(s) == (coarse ? PS_SESSION_COARSE_SHADOW_COST : 1.0));
+            assert_true(ps_session_lights_coarse(s) == coarse);
             assert_true(ps_session_next_level_lights(s) == 1.0); /* no area light */
             assert_true(ps_session_next_level_cost(s) == (coarse ? PS_SESSION_COARSE_SHADOW_COST : 1.0));
             ps_session_drawn(s, 0.001);
@@ -1348,11 +1357,14 @@ static void coarse_shadows_first(void **state)
                 assert_false(f.lights_changed);
                 assert_int_equal(ps_session_lights(s)->shadow_size, firsts[k]);
                 assert_true(ps_session_refine_lights(s) == coarse);
+                /* Asked for, not yet built: the lights drawn are still the coarse ones. */
+                assert_true(ps_session_lights_coarse(s) == coarse);
             }
             refresh(s, &cam, &f);
             assert_true(f.lights_changed == coarse && f.shadows_refined == coarse);
             assert_int_equal(ps_session_lights(s)->shadow_size, sides[k]);
             assert_true(ps_session_lights_to_come(s) == 1.0);
+            assert_false(ps_session_lights_coarse(s));
             assert_false(ps_session_refine_lights(s));
             ps_session_drawn(s, 0.001);
             refresh(s, &cam, &f);
@@ -1367,6 +1379,7 @@ static void coarse_shadows_first(void **state)
         ps_session_full_lights(s);
         refresh(s, &cam, &f);
         assert_int_equal(ps_session_lights(s)->shadow_size, sides[k]);
+        assert_false(ps_session_lights_coarse(s));
         ps_session_destroy(s);
         /* Not progressive: the full side from the first picture. */
         set.progressive_lights = false;
@@ -1374,6 +1387,7 @@ static void coarse_shadows_first(void **state)
         assert_int_equal(ps_session_trace_all(s, &err), PS_OK);
         refresh(s, &cam, &f);
         assert_int_equal(ps_session_lights(s)->shadow_size, sides[k]);
+        assert_false(ps_session_lights_coarse(s));
         ps_session_destroy(s);
     }
     ps_scene_destroy(scene);

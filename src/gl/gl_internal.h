@@ -67,7 +67,7 @@ typedef struct ps_gl_deferred_lit {
 struct ps_gl_renderer {
     ps_gl_scene in;
     /* The mesh this frame's lit passes draw: in.mesh, or in.moving for a
-     * moving camera's level of detail (ps_gl_begin_frame_shadows). */
+     * level of detail (ps_gl_begin_frame_shadows). */
     const ps_preview_mesh *lit;
     ps_gl_options opt;
     int shadow_size;
@@ -190,16 +190,18 @@ void ps_gl_timer_init(ps_gl_renderer *r);
  * faces; shadows: through the shadow cubes (else one pass a light). */
 void ps_gl_draw_direct(ps_gl_renderer *r, double exposure, bool shadows);
 /* ps_gl_begin_frame with the shadows said here instead of by the options
- * (the window's moving camera draws without them), and moving: the lit
+ * (the window's moving camera draws without them), and lod: the lit
  * passes (and the texture factor) on the scene's moving mesh (in.moving),
- * a moving camera's level of detail. defer_lit: the view draws its shadow
- * maps, depth prepass and emitters, and leaves its lit passes to
+ * a level of detail: a moving camera's, or the eye's while the lights are
+ * a coarse level (in.coarse_lights, which ps_gl_begin_frame follows; a
+ * cube face, which outlives that level, passes false). defer_lit: the view
+ * draws its shadow maps, depth prepass and emitters, and leaves its lit passes to
  * ps_gl_draw_deferred_lit, for a caller whose view has a target of its own
  * (the float layers' direct layer): llvmpipe rasterises what is drawn
  * meanwhile (the splats, into the other layers) while the lit passes are
  * issued, and the direct layer is the same. */
 void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
-                               bool shadows, bool moving, bool defer_lit);
+                               bool shadows, bool lod, bool defer_lit);
 /* Area lights as the eye sees them, in their radiance times exposure, or
  * black when the direct layer is off. */
 void ps_gl_draw_emitters(const ps_gl_renderer *r, double exposure, bool direct);

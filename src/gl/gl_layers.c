@@ -302,7 +302,7 @@ static void new_view(ps_gl_layers *l, ps_gl_renderer *r, const ps_camera_frame *
      * pixel, and llvmpipe rasterises the splats while the passes are
      * issued. The default box's and the area box's first float pictures at
      * 256^2 came 5-8 ms sooner (docs/preview.md). */
-    ps_gl_begin_frame_shadows(r, cam, exposure, direct, shadows, moving, true);
+    ps_gl_begin_frame_shadows(r, cam, exposure, direct, shadows, moving || r->in.coarse_lights, true);
     for (int k = 0; k < PS_MAP_COUNT; k++)
         ps_gl_layers_clear_map(l, k);
     l->albedo = ps_gl_has_albedo(r);

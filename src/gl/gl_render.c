@@ -224,7 +224,7 @@ static void make_range_bounds(ps_gl_renderer *r)
 
 void ps_gl_begin_frame(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct)
 {
-    ps_gl_begin_frame_shadows(r, cam, exposure, direct, r->opt.shadows, false, false);
+    ps_gl_begin_frame_shadows(r, cam, exposure, direct, r->opt.shadows, r->in.coarse_lights, false);
 }
 
 /* The lit passes after the prepass (ps_gl_begin_frame_shadows), or those a
@@ -247,7 +247,7 @@ static void draw_lit(ps_gl_renderer *r, ps_vec3 eye, double exposure, bool shado
 }
 
 void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, double exposure, bool direct,
-                               bool shadows, bool moving, bool defer_lit)
+                               bool shadows, bool lod, bool defer_lit)
 {
     /* A view whose lit passes wait (defer_lit): drawn now where this
      * view has another target (a cube face before the layers' splats),
@@ -261,7 +261,7 @@ void ps_gl_begin_frame_shadows(ps_gl_renderer *r, const ps_camera_frame *cam, do
             ps_gl_draw_deferred_lit(r);
     }
     r->ahead.held = false; /* the framebuffer's view is this one from here on */
-    r->lit = moving && r->in.moving ? r->in.moving : r->in.mesh;
+    r->lit = lod && r->in.moving ? r->in.moving : r->in.mesh;
     r->stats.views++;
     r->stats.light_passes = 0;
     r->stats.light_vertices = 0;
@@ -479,7 +479,7 @@ ps_gl_scene ps_gl_scene_of(const ps_session *s)
 {
     ps_gl_scene in = {ps_session_mesh(s), ps_session_coarse_mesh(s), ps_session_materials(s), ps_session_lights(s),
                       ps_scene_bounds(ps_session_scene(s)), ps_session_illuminance(s), ps_session_scene(s),
-                      ps_session_moving_mesh(s)};
+                      ps_session_moving_mesh(s), ps_session_lights_coarse(s)};
     return in;
 }
 

@@ -82,8 +82,11 @@ typedef struct ps_gl_scene {
     ps_aabb bounds;                  /* of geometry and lights: near and far planes */
     bool hide_emitters;              /* look through emitters (illuminance mode) */
     const ps_scene *scene;           /* its textures (map_Kd), uploaded once; NULL: none */
-    const ps_preview_mesh *moving;   /* lit passes while the camera moves (ps_session_moving_mesh);
-                                      * NULL: the fine one */
+    const ps_preview_mesh *moving;   /* lit passes of a level of detail (ps_session_moving_mesh):
+                                      * while the camera moves; NULL: the fine one */
+    bool coarse_lights;              /* the lights are a progressive level with more to come
+                                      * (ps_session_lights_coarse): the eye's lit passes draw
+                                      * `moving` while they stand, the camera still or not */
 } ps_gl_scene;
 
 /* A session's meshes, lights and materials as they stand (its illuminance

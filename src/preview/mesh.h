@@ -88,7 +88,8 @@ typedef struct ps_mesh_options {
  * tessellation default. */
 ps_mesh_options ps_mesh_default_options(const ps_scene *s);
 
-/* The lit mesh of a moving camera's level of detail (preview/session.h):
+/* The lit mesh of a level of detail (preview/session.h: a moving camera's,
+ * and the lights' coarse levels', ps_session_lights_coarse):
  * flat faces cut with edges PS_MESH_MOVING_EDGE_SCALE times longer, a
  * quarter of their vertices (llvmpipe's lit passes are vertex-bound: the
  * default scene's lit pass, its mirror and glass left out, took 8.9 ms of a

@@ -34,6 +34,7 @@ struct ps_session {
     int area_side;         /* an area light's virtual lights a side, refined up to PS_PREVIEW_AREA_SIDE */
     bool coarse_shadows;   /* the lights' shadow maps at the first picture's side (session.h) */
     int built_side;        /* the area_side the lights were last built at */
+    bool built_coarse;     /* ... and whether a level was to come then (ps_session_lights_coarse) */
     bool lights_pending;   /* a level refined: lights to rebuild at the next refresh */
     bool lights_held;      /* the levels grow only by ps_session_refine_lights */
     ps_material *white;    /* as many as the scene's, for illuminance mode */
@@ -207,9 +208,11 @@ static ps_status build_geometry(ps_session *s, ps_error *err)
         for (int c = 0; c < old_cubes; c++)
             ps_specular_set_lookup_centre(s->spec, c, looked[c]);
     /* Where it saves a quarter of the vertices or more (a scene of small
-     * triangles, cut no further, would only hold a second copy). */
+     * triangles, cut no further, would only hold a second copy); for
+     * progressive lights too, whose coarse levels draw it
+     * (ps_session_lights_coarse). */
     ps_mesh_options moving = ps_mesh_moving_options(&mo);
-    if (st == PS_OK && incremental(s) &&
+    if (st == PS_OK && (incremental(s) || s->set.progressive_lights) &&
         4 * ps_preview_mesh_vertex_count(s->scene, &moving) <= 3 * (uint64_t)s->mesh.vertex_count)
         st = ps_preview_mesh_build(s->scene, &moving, &s->moving_mesh, err);
     /* The scene's own triangles, not subdivided, for depth-only passes:
@@ -237,6 +240,7 @@ static ps_status build_lights(ps_session *s, ps_error *err)
     if (s->coarse_shadows)
         size = coarse_shadow_size(size);
     s->built_side = s->area_side;
+    s->built_coarse = ps_session_lights_to_come(s) > 1.0;
     return ps_preview_lights_build(s->scene, ps_world_accel(s->world), &s->coarse, size, s->area_side, &s->lights,
                                    err);
 }
@@ -1576,6 +1580,8 @@ const ps_scene *ps_session_scene(const ps_session *s) { return s->scene; }
 const ps_world *ps_session_world(const ps_session *s) { return s->world; }
 const ps_preview_mesh *ps_session_mesh(const ps_session *s) { return &s->mesh; }
 const ps_preview_mesh *ps_session_coarse_mesh(const ps_session *s) { return &s->coarse; }
+bool ps_session_lights_coarse(const ps_session *s) { return s->built_coarse; }
+
 const ps_preview_mesh *ps_session_moving_mesh(const ps_session *s)
 {
     return s->moving_mesh.vertex_count > 0 ? &s->moving_mesh : &s->mesh;
