@@ -68,16 +68,19 @@ static void rig_open(rig *g, const char *text, unsigned layers)
 
 static void rig_close(rig *g) { gl_rig_close(g); }
 
-static ps_gl_renderer *renderer_shadows(const ps_gl_scene *gs, ps_session *s, bool shadows)
+static ps_gl_renderer *renderer_with(const ps_gl_scene *gs, ps_session *s, const ps_gl_options *go)
 {
-    ps_gl_options go = {shadows, true, 0, false, false, OSMesaGetProcAddress};
     ps_gl_renderer *gl;
     ps_error err;
-    assert_int_equal(ps_gl_renderer_create(gs, ps_session_kernel(s), &go, &gl, &err), PS_OK);
+    assert_int_equal(ps_gl_renderer_create(gs, ps_session_kernel(s), go, &gl, &err), PS_OK);
     return gl;
 }
 
-static ps_gl_renderer *renderer(const ps_gl_scene *gs, ps_session *s) { return renderer_shadows(gs, s, true); }
+static ps_gl_renderer *renderer(const ps_gl_scene *gs, ps_session *s)
+{
+    ps_gl_options go = {true, true, 0, false, false, OSMesaGetProcAddress};
+    return renderer_with(gs, s, &go);
+}
 
 /* Every photon drawn for the still camera, then one refresh with the camera
  * moved a little: the level of detail, in *f (not drawn). */
@@ -214,9 +217,11 @@ static void coarse_lights_on_the_moving_mesh(void **state)
     ps_gl_scene gs = ps_gl_scene_of(g.s), gs_full = gs;
     assert_true(gs.coarse_lights);
     gs_full.coarse_lights = false; /* the same lights, taken as the last level */
-    /* Without shadow maps: one lit pass, of the whole mesh (the fine one's
-     * tiles are culled only against a shadow face's pyramid). */
-    ps_gl_renderer *gl = renderer_shadows(&gs, g.s, false), *gl_full = renderer_shadows(&gs_full, g.s, false);
+    /* An 8-bit buffer, as snap's, without shadow maps: one lit pass, of the
+     * whole mesh (the fine one's tiles are culled only against a shadow
+     * face's pyramid). */
+    ps_gl_options go = {false, false, 0, false, false, OSMesaGetProcAddress};
+    ps_gl_renderer *gl = renderer_with(&gs, g.s, &go), *gl_full = renderer_with(&gs_full, g.s, &go);
     ps_session_frame f;
     ps_error err;
     assert_int_equal(ps_session_refresh(g.s, &g.cam, &f, &err), PS_OK);
