@@ -909,6 +909,60 @@ static void radius_schedule(void **state)
     assert_string_equal(ps_radius_schedule_name(PS_RADIUS_FIXED), "fixed");
 }
 
+/* The incremental budget's cost model: a splat of each map its own cost, so
+ * that a refresh of cheap caustic splats alone does not set the budget of
+ * the next, which draws the dearer global ones too. */
+static void splat_cost_per_map(void **state)
+{
+    (void)state;
+    const double tau = 0.09; /* a refresh's time for splats */
+    const bool both[PS_MAP_COUNT] = {true, true}, caustic[PS_MAP_COUNT] = {true, false};
+    ps_splat_cost c = {{0.0, 0.0}};
+    assert_float_equal(ps_splat_cost_count(&c, both, tau), 0.0, 0.0); /* nothing known: the budget stays */
+    /* The caustic map alone, 0.5 us a splat: what one rate for every splat
+     * gave (rate * tau / PS_MAP_COUNT) where it is the only map drawing ... */
+    ps_splat_cost_learn(&c, (const size_t[PS_MAP_COUNT]){4000, 0}, 0.002);
+    assert_float_equal(c.seconds[PS_MAP_CAUSTIC], 0.5e-6, 1e-18);
+    assert_float_equal(ps_splat_cost_count(&c, caustic, tau), 2e6 * tau / PS_MAP_COUNT, 1e-6);
+    /* ... but not where the global map draws too, its cost not known: that
+     * rate gave it 9*10^4 splats a map, 0.4 s at the global's 4 us. */
+    assert_float_equal(ps_splat_cost_count(&c, both, tau), 0.0, 0.0);
+    /* Both drawn: the global takes what the caustic's known cost leaves. */
+    ps_splat_cost_learn(&c, (const size_t[PS_MAP_COUNT]){4000, 3000}, 0.014);
+    assert_float_equal(c.seconds[PS_MAP_CAUSTIC], 0.5e-6, 1e-18);
+    assert_float_equal(c.seconds[PS_MAP_GLOBAL], 4e-6, 1e-15);
+    /* The count a map whose refresh, both maps drawing it, takes tau. */
+    double count = ps_splat_cost_count(&c, both, tau);
+    assert_float_equal(count, 2e4, 1e-6);
+    assert_float_equal(count * (c.seconds[0] + c.seconds[1]), tau, 1e-12);
+    /* Drawn together again, twice as slow as foreseen: both costs double,
+     * their ratio kept. */
+    ps_splat_cost_learn(&c, (const size_t[PS_MAP_COUNT]){2000, 2000}, 2.0 * 2000 * 4.5e-6);
+    assert_float_equal(c.seconds[PS_MAP_CAUSTIC], 1e-6, 1e-15);
+    assert_float_equal(c.seconds[PS_MAP_GLOBAL], 8e-6, 1e-15);
+    /* Nothing drawn: nothing learned. */
+    ps_splat_cost_learn(&c, (const size_t[PS_MAP_COUNT]){0, 0}, 1.0);
+    assert_float_equal(c.seconds[PS_MAP_GLOBAL], 8e-6, 0.0);
+    /* A map not known, where the known one leaves almost no time: the
+     * refresh's mean, not the near-0 rest. */
+    ps_splat_cost d = {{0.0, 0.0}};
+    ps_splat_cost_learn(&d, (const size_t[PS_MAP_COUNT]){1000, 0}, 0.001);
+    ps_splat_cost_learn(&d, (const size_t[PS_MAP_COUNT]){1000, 1000}, 0.0012);
+    assert_float_equal(d.seconds[PS_MAP_CAUSTIC], 1e-6, 1e-18);
+    assert_float_equal(d.seconds[PS_MAP_GLOBAL], 0.6e-6, 1e-18);
+    /* Neither known, drawn together: their mean each (one rate, as before). */
+    ps_splat_cost e = {{0.0, 0.0}};
+    ps_splat_cost_learn(&e, (const size_t[PS_MAP_COUNT]){3000, 1000}, 0.008);
+    assert_float_equal(e.seconds[PS_MAP_CAUSTIC], 2e-6, 1e-18);
+    assert_float_equal(e.seconds[PS_MAP_GLOBAL], 2e-6, 1e-18);
+    assert_float_equal(ps_splat_cost_count(&e, both, tau), (4000 / 0.008) * tau / PS_MAP_COUNT, 1e-6);
+    /* A refresh timed at 0: a finite cost. */
+    ps_splat_cost_learn(&e, (const size_t[PS_MAP_COUNT]){10, 0}, 0.0);
+    assert_true(e.seconds[PS_MAP_CAUSTIC] > 0.0 && isfinite(ps_splat_cost_count(&e, caustic, tau)));
+    const bool none[PS_MAP_COUNT] = {false, false};
+    assert_float_equal(ps_splat_cost_count(&e, none, tau), 0.0, 0.0);
+}
+
 static void names(void **state)
 {
     (void)state;
@@ -1078,7 +1132,7 @@ int main(void)
         cmocka_unit_test(same_bytes_for_any_threads), cmocka_unit_test(splat_basis),         cmocka_unit_test(triangles), cmocka_unit_test(sprites),
         cmocka_unit_test(points),         cmocka_unit_test(glossy),              cmocka_unit_test(back_faces),
         cmocka_unit_test(batches), cmocka_unit_test(groups),        cmocka_unit_test(precision_diffusion), cmocka_unit_test(precision_counter),
-        cmocka_unit_test(names), cmocka_unit_test(radius_schedule),
+        cmocka_unit_test(names), cmocka_unit_test(radius_schedule), cmocka_unit_test(splat_cost_per_map),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -47,8 +47,11 @@ struct ps_session {
     double budget_share;   /* incremental: of the budget, what a refresh draws (ps_session_set_budget_share) */
     double whole_most[PS_MAP_COUNT]; /* whole: each map's photons emitted a refresh draws at most
                                       * (ps_session_set_whole_most; HUGE_VAL: all) */
-    size_t last_splats;    /* built by the last refresh ... */
+    size_t last_splats[PS_MAP_COUNT]; /* each map's built by the last refresh ... */
     double last_build;     /* ... in this many seconds */
+    bool budget_maps[PS_MAP_COUNT]; /* incremental: the maps the budget is for after it (splats
+                                     * shown, photons still to come) */
+    ps_splat_cost splat_cost; /* incremental: what a splat of each map costs (splat.h) */
     bool last_lit;         /* ... with new lights built */
     double round_off;
     bool have_cam, view_dirty;
@@ -695,6 +698,7 @@ static ps_status imap_refresh(ps_session *s, const ps_photon_map *m, const ps_ca
         p.cam = *cam;
         st = ps_splat_build(lp + from, lm + from, nl - from, &p, b, err);
         out->splats += b->splats;
+        s->last_splats[k] += b->splats;
     }
     s->lobe_drawn = nl;
     /* The colours follow the maps, the scale and the materials; which side
@@ -788,6 +792,7 @@ static ps_status bake_step(ps_session *s, int k, const ps_photon_map *m, const p
     if (st != PS_OK)
         return st;
     out->splats += ps_bake_splats(s->bake[k]);
+    s->last_splats[k] += ps_bake_splats(s->bake[k]);
     out->map[k].bake = s->bake[k];
     b->laid = end;
     b->laid_emitted = emitted;
@@ -977,6 +982,8 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     const ps_photon_map *maps = ps_feed_maps(s->feed);
     if (out->new_view)
         s->lobe_drawn = 0;
+    for (int k = 0; k < PS_MAP_COUNT; k++)
+        s->last_splats[k] = 0, s->budget_maps[k] = false;
     double growth[PS_MAP_COUNT]; /* the level of detail's radius growth */
     bool baked_draw[PS_MAP_COUNT] = {false, false}; /* the layer drawn from its baked textures */
     for (int k = 0; k < PS_MAP_COUNT; k++)
@@ -1016,6 +1023,10 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         out->emitted[k] = emitted;
         s->drawn[k] = end;
         s->drawn_emitted[k] = emitted;
+        /* A map whose next photons have not arrived is still the budget's:
+         * its splats come with the next batch. */
+        s->budget_maps[k] = (s->set.layers & ps_map_layer((ps_map_kind)k)) && m->count > 0 &&
+                            emitted < ps_feed_cap(s->feed, (ps_map_kind)k);
         if (!(s->set.layers & ps_map_layer((ps_map_kind)k)) || end <= from || emitted == 0)
             continue;
         ps_splat_params p;
@@ -1046,6 +1057,7 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
         wanted += b->wanted;
         lost += b->lost;
         out->splats += b->splats;
+        s->last_splats[k] += b->splats;
     }
     /* Baking (settings.bake): once nothing more will arrive and a still
      * view shows every photon of the map, its textures are laid. */
@@ -1068,7 +1080,6 @@ ps_status ps_session_refresh(ps_session *s, const ps_camera_frame *cam, ps_sessi
     if (merge && st == PS_OK)
         st = ps_feed_merge(s->feed, err);
     s->round_off = wanted > 0.0 ? lost / wanted : 0.0;
-    s->last_splats = out->splats;
     s->last_build = ps_now_seconds() - t0;
     s->splat_seconds += s->last_build;
     s->refreshes++;
@@ -1142,9 +1153,11 @@ void ps_session_drawn(ps_session *s, double draw_seconds)
      * waited a few batches ahead of the picture (backlog_refreshes): the
      * area box's --time 2 at bench's caps showed 65 536 photons, 294 912
      * learning from neither. */
-    if (incremental(s) && s->last_splats > 0 && !s->moving && !s->last_lit && s->refreshes > 1) {
-        double rate = (double)s->last_splats / fmax(s->last_build + draw_seconds, 1e-6);
-        s->budget = fmax(PS_SESSION_BUDGET_MIN, rate * s->set.tau * s->set.splat_share / PS_MAP_COUNT);
+    if (incremental(s) && !s->moving && !s->last_lit && s->refreshes > 1) {
+        ps_splat_cost_learn(&s->splat_cost, s->last_splats, s->last_build + draw_seconds);
+        double count = ps_splat_cost_count(&s->splat_cost, s->budget_maps, s->set.tau * s->set.splat_share);
+        if (count > 0.0)
+            s->budget = fmax(PS_SESSION_BUDGET_MIN, count);
     }
     /* The tracer waits while the picture is far behind it (settings): a
      * bound the feed checks before every round, up to the next refresh. */

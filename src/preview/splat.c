@@ -697,6 +697,58 @@ const char *ps_radius_schedule_name(ps_radius_schedule s)
     return (unsigned)s < PS_RADIUS_SCHEDULE_COUNT ? ps_radius_schedule_names[s] : "?";
 }
 
+void ps_splat_cost_learn(ps_splat_cost *c, const size_t splats[PS_MAP_COUNT], double seconds)
+{
+    double n = 0.0, known = 0.0, unknown = 0.0; /* splats; seconds of the known; splats of the others */
+    int drew = 0, alone = 0;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        if (splats[k] == 0)
+            continue;
+        drew++;
+        alone = k;
+        n += (double)splats[k];
+        if (c->seconds[k] > 0.0)
+            known += c->seconds[k] * (double)splats[k];
+        else
+            unknown += (double)splats[k];
+    }
+    if (drew == 0)
+        return;
+    seconds = fmax(seconds, PS_SPLAT_COST_MIN_SECONDS);
+    if (drew == 1) {
+        c->seconds[alone] = seconds / n;
+        return;
+    }
+    /* Together: the known keep their ratio, scaled to the time. A map not
+     * known yet takes what the known ones leave, but at least the mean: the
+     * rest of a noisy time can be near 0, and too low a cost is what makes
+     * a refresh late. */
+    double each = unknown > 0.0 ? fmax((seconds - known) / unknown, seconds / n) : 0.0;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        if (splats[k] == 0)
+            continue;
+        if (unknown == 0.0)
+            c->seconds[k] *= seconds / known;
+        else if (!(c->seconds[k] > 0.0))
+            c->seconds[k] = each;
+    }
+}
+
+double ps_splat_cost_count(const ps_splat_cost *c, const bool drawing[PS_MAP_COUNT], double seconds)
+{
+    double sum = 0.0;
+    int maps = 0;
+    for (int k = 0; k < PS_MAP_COUNT; k++) {
+        if (!drawing[k])
+            continue;
+        if (!(c->seconds[k] > 0.0))
+            return 0.0;
+        sum += c->seconds[k];
+        maps++;
+    }
+    return maps > 0 ? seconds * maps / (PS_MAP_COUNT * sum) : 0.0;
+}
+
 double ps_splat_radius_at(ps_radius_schedule s, double r0, uint64_t n0, uint64_t n, double alpha)
 {
     if (s != PS_RADIUS_PROGRESSIVE || n0 == 0)
