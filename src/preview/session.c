@@ -50,7 +50,7 @@ struct ps_session {
     size_t last_splats[PS_MAP_COUNT]; /* each map's built by the last refresh ... */
     double last_build;     /* ... in this many seconds */
     bool budget_maps[PS_MAP_COUNT]; /* incremental: the maps the budget is for after it (splats
-                                     * shown, photons still to come) */
+                                     * shown, photons still to come or to bake) */
     ps_splat_cost splat_cost; /* incremental: what a splat of each map costs (splat.h) */
     bool last_lit;         /* ... with new lights built */
     double round_off;
@@ -798,6 +798,8 @@ static ps_status bake_step(ps_session *s, int k, const ps_photon_map *m, const p
     b->laid_emitted = emitted;
     if (end >= m->count)
         b->state = BAKE_DONE;
+    /* Its photons still to lay are the budget's, as a map's still to draw. */
+    s->budget_maps[k] = b->state == BAKE_LAYING;
     return PS_OK;
 }
 
