@@ -931,7 +931,7 @@ static void splat_cost_per_map(void **state)
     ps_splat_cost_learn(&c, (const size_t[PS_MAP_COUNT]){4000, 3000}, 0.014);
     assert_float_equal(c.seconds[PS_MAP_CAUSTIC], 0.5e-6, 1e-18);
     assert_float_equal(c.seconds[PS_MAP_GLOBAL], 4e-6, 1e-15);
-    /* The count a map whose refresh, both maps drawing it, takes tau. */
+    /* The count a map such that a refresh drawing it in both maps takes tau. */
     double count = ps_splat_cost_count(&c, both, tau);
     assert_float_equal(count, 2e4, 1e-6);
     assert_float_equal(count * (c.seconds[0] + c.seconds[1]), tau, 1e-12);

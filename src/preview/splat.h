@@ -213,18 +213,19 @@ const char *ps_radius_schedule_name(ps_radius_schedule s);
  * (0, 1]); n = 0 gives the largest, r0 * PS_RADIUS_GROWTH_MAX. */
 double ps_splat_radius_at(ps_radius_schedule s, double r0, uint64_t n0, uint64_t n, double alpha);
 
+/* A refresh's time is taken as at least this (a clock's tick: the rate
+ * from a refresh timed at 0 would be infinite). */
+#define PS_SPLAT_COST_MIN_SECONDS 1e-6
+
 /* What a splat of each map costs to build and draw, for the incremental
  * layers' budget (session.h): seconds a splat, learned from refreshes whose
  * splats of each map and time are known. The maps' splats differ: the
  * default box's global splats (radius 0.1) cover 25 times a caustic one's
  * pixels. One rate for all of them, learned from a refresh whose new photons
- * were all caustic (the global map's next batch not yet traced), was 4-8
- * times what the next refresh, drawing both, achieved: the area box's
- * float 0.1 s checkpoint frame drew 2.4-3.1*10^4 splats where 7*10^3 were
- * meant, took 0.047-0.066 s and came at 0.13-0.15 s. */
-/* A refresh's time is taken as at least this (a clock's tick: the rate
- * from a refresh timed at 0 would be infinite). */
-#define PS_SPLAT_COST_MIN_SECONDS 1e-6
+ * were all caustic (the global map's next batch not yet traced), was 2-8
+ * times what the refreshes drawing both achieved: the area box's float
+ * 0.1 s checkpoint frame then drew 2.4-3.1*10^4 splats where 7*10^3 were
+ * meant, took 0.042-0.066 s and came at 0.13-0.15 s. */
 typedef struct ps_splat_cost {
     double seconds[PS_MAP_COUNT]; /* a splat of map k; 0: not known yet */
 } ps_splat_cost;
@@ -237,7 +238,7 @@ typedef struct ps_splat_cost {
 void ps_splat_cost_learn(ps_splat_cost *c, const size_t splats[PS_MAP_COUNT], double seconds);
 
 /* The splats a map each refresh may draw within `seconds`, for the maps
- * `drawing` (those with photons still to come): the count that
+ * `drawing` (those with photons still to draw or to bake): the count that
  * PS_MAP_COUNT maps at their mean cost draw in that time. With both maps
  * drawing, their splats together take it; with one (the other done, not
  * shown, or the illumination maps', which have their own share), half of it,
