@@ -28,12 +28,14 @@ expect_match "alone last" "$(grep -E '^(release|asan) ' <<<"$cli_out" | tail -2 
     '^cli_y cli_y $'
 PS_TEST_JOBS=1 "$tree/tests/run-tests.sh" >"$cli_tmp/one" 2>&1 && ok || bad "PS_TEST_JOBS=1: $(tail -3 "$cli_tmp/one")"
 # A failing test: named, counted, and the runner fails.
-printf '#!/bin/sh\necho "[  FAILED  ] 1 test(s), listed below:"\nexit 1\n' >"$tree/build/release/tests/test_b"
+printf '#!/bin/sh\necho "[  ERROR   ] --- the reason"\necho "[  FAILED  ] 1 test(s), listed below:"\nexit 1\n' >"$tree/build/release/tests/test_b"
 "$tree/tests/run-tests.sh" >"$cli_tmp/f" 2>&1
 rc=$?
 [ $rc -ne 0 ] && ok || bad "a failing test: the runner exited 0"
 expect_match "failing test named" "$(cat "$cli_tmp/f")" 'failed: release/test_b'
 expect_match "failing totals" "$(tail -1 "$cli_tmp/f")" '^tests: 18 passed, 1 failed$'
+# Its reason again in the last lines (a CI report may keep only the tail).
+expect_match "failure's reason last" "$(tail -5 "$cli_tmp/f" | tr '\n' ' ')" 'release/test_b: .*the reason'
 printf '#!/bin/sh\necho "[  PASSED  ] 2 test(s)."\n' >"$tree/build/release/tests/test_b"
 for jobs in 0 x -1; do
     PS_TEST_JOBS=$jobs expect_usage_error "PS_TEST_JOBS=$jobs" timeout 20 "$tree/tests/run-tests.sh"

@@ -18,6 +18,11 @@ ran=0 # tests counted, against those listed (a runner that skipped some must fai
 log_dir=build/test-logs
 mkdir -p "$log_dir"
 
+# failure_lines LOG N: the first N lines of a failed test's log that say why.
+failure_lines() {
+    sed -e 's/^/    | /' "$1" | grep -E 'FAIL|ERROR|error|Sanitizer|runtime error|^    \| [^[]' | head -"$2"
+}
+
 # count LOG RC VARIANT NAME SECONDS: adds a finished test's counts to the
 # totals and prints its line. cmocka prints "[  PASSED  ] N test(s)." and
 # "[  FAILED  ] N test(s)"; the CLI scripts print "cli: N passed, N failed".
@@ -41,7 +46,7 @@ count() {
     if [ "$rc" -ne 0 ]; then
         failed_names+=("$variant/$name")
         printf '%-8s %-28s FAIL (%ss) — log: %s\n' "$variant" "$name" "$took" "$log"
-        sed -e 's/^/    | /' "$log" | grep -E 'FAIL|ERROR|error|Sanitizer|runtime error|^    \| [^[]' | head -40
+        failure_lines "$log" 40
     else
         printf '%-8s %-28s ok   %3d passed (%ss)\n' "$variant" "$name" "$p" "$took"
     fi
@@ -136,6 +141,13 @@ if [ "$ran" -ne "$listed" ]; then
     failed=$((failed + 1))
 fi
 if [ ${#failed_names[@]} -gt 0 ]; then
+    # Each failure's lines again, last: a CI report may keep only the output's
+    # tail, and the lines printed as the test ended are then long scrolled off.
+    for f in "${failed_names[@]}"; do
+        [ -f "$log_dir/${f/\//-}.log" ] || continue
+        echo "$f:"
+        failure_lines "$log_dir/${f/\//-}.log" 20
+    done
     echo "failed: ${failed_names[*]}"
 fi
 echo "tests: $passed passed, $failed failed"
