@@ -1715,8 +1715,8 @@ void ps_session_get_counts(ps_session *s, ps_session_counts *out)
     }
     out->store_limited = ps_feed_store_limited(s->feed);
     out->ended = ps_feed_ended(s->feed);
+    out->trace_seconds = ps_feed_seconds(s->feed); /* written under the lock, as a round ends */
     ps_feed_unlock(s->feed);
-    out->trace_seconds = ps_feed_seconds(s->feed);
     out->splat_seconds = s->splat_seconds;
     out->ahead_seconds = s->ahead_seconds;
     out->refreshes = s->refreshes;
