@@ -468,6 +468,29 @@ static void the_schedule_stays_within_tau(void **state)
     assert_true(due > now);
 }
 
+/* ps_pace_shown_at: a whole refresh planned as the checkpoint's frame that
+ * ends early waits for the checkpoint; one that ends after it shows it when
+ * it ends; an incremental one, or one planned with nothing learned, is not
+ * its frame when it ends early. */
+static void an_early_whole_frame_waits_for_its_checkpoint(void **state)
+{
+    (void)state;
+    ps_pace_model m = {0};
+    ps_pace_learn(&m, 0.03, 2e4, 0.02, true);
+    m.rate = 2e5;
+    double cp = 0.1;
+    ps_pace_plan p = ps_pace_next(&m, 0.08, 2e4, 0.08, &cp, 1);
+    assert_true(p.shows);
+    assert_near(ps_pace_shown_at(&p, true, 0.0925, cp), cp, 0.0);
+    assert_near(ps_pace_shown_at(&p, true, 0.11, cp), 0.11, 0.0);
+    assert_near(ps_pace_shown_at(&p, false, 0.0925, cp), 0.0925, 0.0);
+    /* Nothing learned yet (snap's first frame): no frame planned. */
+    ps_pace_model none = {0};
+    ps_pace_plan first = ps_pace_next(&none, 0.0, 2e4, 0.0, &cp, 1);
+    assert_false(first.shows);
+    assert_near(ps_pace_shown_at(&first, true, 0.05, cp), 0.05, 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -484,6 +507,7 @@ int main(void)
         cmocka_unit_test(late_frames_draw_a_smaller_share),
         cmocka_unit_test(unheld_faces_stay_out_of_the_checkpoints_frame),
         cmocka_unit_test(the_schedule_stays_within_tau),
+        cmocka_unit_test(an_early_whole_frame_waits_for_its_checkpoint),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

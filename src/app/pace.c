@@ -152,6 +152,11 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
 
 double ps_pace_next_due(double due, double now, double tau) { return fmin(due, now) + tau; }
 
+double ps_pace_shown_at(const ps_pace_plan *planned, bool whole, double ended, double checkpoint)
+{
+    return whole && planned->shows && ended < checkpoint ? checkpoint : ended;
+}
+
 double ps_pace_photons_at_start(const ps_pace_model *m, const ps_pace_plan *planned, double now, double photons,
                                 double due, const double *pending, int count)
 {

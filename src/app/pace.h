@@ -1,6 +1,7 @@
 /* pace.h: when photosplat-snap --checkpoints starts a refresh, so that the
- * frame a checkpoint shows (the first finished at or after its time) lands
- * soon after it rather than a whole refresh later.
+ * frame a checkpoint shows (the first finished at or after its time, or a
+ * whole refresh planned as its frame that finished early and waits for it:
+ * ps_pace_shown_at) lands soon after it rather than a whole refresh later.
  *
  * A refresh is predicted from the last one: its time without cube faces,
  * for whole refreshes (8 bits redraw every photon, so their time grows with
@@ -35,9 +36,11 @@
 #include <stdint.h>
 
 /* The checkpoint's frame aims to end this share of its own time after it:
- * room for the prediction's error (one that ends before the checkpoint
- * leaves it to the next refresh, a whole refresh late; 8-bit refreshes of
- * 1-3 s varied by a third from one to the next on a loaded 2-core machine). */
+ * room for the prediction's error (an incremental one that ends before the
+ * checkpoint leaves it to the next refresh; a whole one waits for it,
+ * ps_pace_shown_at, its photons then older than they could have been;
+ * 8-bit refreshes of 1-3 s varied by a third from one to the next on a
+ * loaded 2-core machine). */
 #define PS_PACE_MARGIN 0.3
 
 /* Cube faces may make the checkpoint's frame end up to this share of its
@@ -180,6 +183,19 @@ ps_pace_plan ps_pace_next(const ps_pace_model *m, double now, double photons, do
  * at 0.68-0.90 s. */
 double ps_pace_photons_at_start(const ps_pace_model *m, const ps_pace_plan *planned, double now, double photons,
                                 double due, const double *pending, int count);
+
+/* When a refresh that ended at `ended` (before `checkpoint`, the next not
+ * shown) shows it: a whole refresh planned as its frame (planned->shows:
+ * every whole one once the pace has learned one) waits for it, so at
+ * `checkpoint`; any other is not its frame (returns `ended`), and the next
+ * refresh is. The waiting frame's photons are those the plan chose for the
+ * checkpoint (there at the start it planned; 8 bits hold the tracer while
+ * the frame draws), as an on-time frame's are. A frame drawn faster than
+ * foreseen was otherwise followed by a whole redraw: in three runs to 1 s
+ * of the bench's 24 8-bit configurations, 4 of the 5 late 0.1 s
+ * checkpoints (0.120-0.126 s) came that way. Incremental (float) refreshes
+ * go on: their next frame draws only new splats. */
+double ps_pace_shown_at(const ps_pace_plan *planned, bool whole, double ended, double checkpoint);
 
 /* tau's schedule: the refresh after one that ended at `now`, the last due at
  * `due`: tau after that, never more than tau after now. (Adding tau at every

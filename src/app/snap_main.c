@@ -1006,6 +1006,16 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         double now = ps_now_seconds();
         if (*first_frame < 0.0)
             *first_frame = now - t_start;
+        /* A whole refresh planned as the checkpoint's frame that ended
+         * before it waits for it (pace.h). The tracer goes on meanwhile. */
+        if (cp < o->checkpoint_count) {
+            double ended = now - t_start - excluded;
+            double shown = ps_pace_shown_at(&plan, !s->layers, ended, o->checkpoints[cp]);
+            if (shown > ended) {
+                sleep_until(t_start + excluded + shown);
+                now = ps_now_seconds();
+            }
+        }
         if (cp < o->checkpoint_count && now - t_start - excluded >= o->checkpoints[cp]) {
             /* This frame is the first done at or after every checkpoint time
              * it passed: each of them shows it. */
