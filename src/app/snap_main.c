@@ -1018,7 +1018,8 @@ static ps_status refine(snap_run *s, double t_start, double *first_frame, ps_err
         }
         if (cp < o->checkpoint_count && now - t_start - excluded >= o->checkpoints[cp]) {
             /* This frame is the first done at or after every checkpoint time
-             * it passed: each of them shows it. */
+             * it passed (or it waited for the one it was planned for): each
+             * of them shows it. */
             ps_session_hold(s->session, true);
             for (int k = 0; k < PS_MAP_COUNT; k++)
                 s->shown[k] = (double)s->frame.emitted[k];
