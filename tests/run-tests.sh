@@ -144,9 +144,10 @@ if [ ${#failed_names[@]} -gt 0 ]; then
     # Each failure's lines again, last: a CI report may keep only the output's
     # tail, and the lines printed as the test ended are then long scrolled off.
     for f in "${failed_names[@]}"; do
-        [ -f "$log_dir/${f/\//-}.log" ] || continue
+        log="$log_dir/${f/\//-}.log" # variant/name: the log variant-name.log
+        [ -f "$log" ] || continue
         echo "$f:"
-        failure_lines "$log_dir/${f/\//-}.log" 20
+        failure_lines "$log" 20
     done
     echo "failed: ${failed_names[*]}"
 fi
