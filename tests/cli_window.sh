@@ -73,8 +73,10 @@ awk_true "$latency > 0 && $latency < $most" && ok || bad "the frame after the mo
 [ "$(stat_of edits "$cli_tmp/session.json")" = 1 ] && ok || bad "stats do not count one edit"
 
 # The window and photosplat-snap draw the same picture for the same scene and
-# photons (all of them traced well before the screenshot).
-printf '1.5 screenshot %s\n1.6 quit\n' "$cli_tmp/same-w.png" >"$cli_tmp/same.txt"
+# photons (all of them traced and drawn: wait done, as a loaded machine may
+# take longer than any fixed time; under two other sanitizer loads the trace
+# alone took 8 s).
+printf '0.1 wait done\n1.5 screenshot %s\n1.6 quit\n' "$cli_tmp/same-w.png" >"$cli_tmp/same.txt"
 same=(--size 128x128 --caustic-photons 20000 --global-photons 5000 --exposure 0.3)
 expect_success "window picture" xrun "$win" "$scene" "${same[@]}" --overlay off --script "$cli_tmp/same.txt"
 expect_success "snap picture" "$bin/photosplat-snap" "$scene" "${same[@]}" --color-depth float -o "$cli_tmp/same-s.png"
@@ -84,7 +86,7 @@ awk_true "$rmse < 2.0 / 255" && ok || bad "the window and photosplat-snap differ
 # GL encodes the window's picture (GL_FRAMEBUFFER_SRGB); the CPU encoder it
 # replaced (--composite cpu, bench-window's baseline) gives the same codes
 # but for rounding: rmse under one code.
-printf '1.5 screenshot %s\n1.6 quit\n' "$cli_tmp/same-c.png" >"$cli_tmp/same-c.txt"
+printf '0.1 wait done\n1.5 screenshot %s\n1.6 quit\n' "$cli_tmp/same-c.png" >"$cli_tmp/same-c.txt"
 expect_success "window picture, CPU composite" xrun "$win" "$scene" "${same[@]}" --overlay off --composite cpu \
     --script "$cli_tmp/same-c.txt"
 rmse=$("$bin/photosplat-compare" "$cli_tmp/same-w.png" "$cli_tmp/same-c.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
@@ -131,23 +133,28 @@ expect_usage_error "bad bake" "$win" "$scene" --bake maybe
 
 # Illuminance in false colour (key F; a script's set false-color): a picture of
 # its own (the lux in it are test_gl_illuminance's), and off again the normal
-# picture comes back, the photons kept.
-# wait done first: on a loaded machine (ASan) the picture was still refining
-# at 1.2 s, so "off again" differed from "before" by what came in between.
+# picture comes back, the photons kept: once settled, the same picture.
+# wait done before each picture compared: switching redraws the view and lays
+# the baked textures again, a budget a refresh, so on a loaded machine (ASan)
+# the picture was still refining at 1.2 s, and 0.3 s after "off" (1 run in 7)
+# it still lacked photons (rmse 0.042). Settled, "off" is the same bytes as
+# "before" (the maps baked again from the same photons); unsettled, the splats
+# not yet baked differ by 0.5 codes rms (0.0021), so the limit below is under it.
 cat >"$cli_tmp/fc.txt" <<SCRIPT
 0.1 wait done
 1.2 screenshot $cli_tmp/fc-before.png
 1.3 set false-color on
 1.6 screenshot $cli_tmp/fc-on.png
 1.7 set false-color off
-2.0 screenshot $cli_tmp/fc-off.png
-2.1 quit
+1.8 wait done
+1.9 screenshot $cli_tmp/fc-off.png
+2.0 quit
 SCRIPT
 expect_success "false colour" xrun "$win" "$scene" "${same[@]}" --overlay off --script "$cli_tmp/fc.txt"
 on=$("$bin/photosplat-compare" "$cli_tmp/fc-on.png" "$cli_tmp/fc-before.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
 off=$("$bin/photosplat-compare" "$cli_tmp/fc-off.png" "$cli_tmp/fc-before.png" | sed -n 's/^rmse=\([^ ]*\).*/\1/p')
 echo "false colour against the picture: rmse $on; off again: $off"
 awk_true "$on > 0.1" && ok || bad "false colour did not change the picture (rmse $on)"
-awk_true "$off < 2.0 / 255" && ok || bad "false colour off did not give the picture back (rmse $off)"
+awk_true "$off < 0.5 / 255" && ok || bad "false colour off did not give the picture back (rmse $off)"
 
 cli_summary

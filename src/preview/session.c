@@ -454,9 +454,10 @@ static void *prime_main(void *arg)
         double t0 = ps_now_seconds();
         ps_feed_lock(s->feed);
         j->st = imap_gather(s, &ps_feed_maps(s->feed)[PS_MAP_GLOBAL], &end, &j->err);
-        ps_feed_unlock(s->feed);
+        /* Under the lock: ps_session_get_counts may read them beside. */
         s->ahead_seconds = ps_now_seconds() - t0;
         s->splat_seconds += s->ahead_seconds;
+        ps_feed_unlock(s->feed);
     }
     atomic_store(&j->done, true);
     return NULL;
@@ -1716,10 +1717,12 @@ void ps_session_get_counts(ps_session *s, ps_session_counts *out)
     out->store_limited = ps_feed_store_limited(s->feed);
     out->ended = ps_feed_ended(s->feed);
     out->trace_seconds = ps_feed_seconds(s->feed); /* written under the lock, as a round ends */
-    ps_feed_unlock(s->feed);
+    /* The first round's thread writes these under the lock (prime_main);
+     * refreshes, which write them too, are the caller's own. */
     out->splat_seconds = s->splat_seconds;
     out->ahead_seconds = s->ahead_seconds;
     out->refreshes = s->refreshes;
+    ps_feed_unlock(s->feed);
 }
 
 const ps_photon_map *ps_session_maps(const ps_session *s) { return ps_feed_maps(s->feed); }

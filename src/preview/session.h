@@ -260,7 +260,7 @@ typedef void ps_session_beside_fn(void *ctx);
  * low priority (ps_thread_low_priority) on the first round's threads, so
  * the work takes the cores it wants and the round the rest: llvmpipe's
  * first compiles leave all but one idle. beside (and spare) must not call
- * this session. With nothing to trace first (after a repair), or no thread for
+ * this session, but for ps_session_get_counts. With nothing to trace first (after a repair), or no thread for
  * it, beside runs after the round. The photons are the same either way.
  * After the round, on its thread, the illumination maps (--global-layer
  * maps) gather its global photons, which the first refresh would: they do
@@ -595,7 +595,8 @@ double ps_session_bake_progress(const ps_session *s, ps_map_kind k);
 /* Map k's splat radius for the last refresh (under the radius schedule). */
 double ps_session_radius(const ps_session *s, ps_map_kind k);
 
-/* Counts, read under the feed's lock. */
+/* Counts, read under the feed's lock: the one call that work beside the
+ * first round (ps_session_start_beside) may make. */
 typedef struct ps_session_counts {
     ps_trace_counters map[PS_MAP_COUNT];
     bool ended;          /* every map at its cap, stopped, or failed */
