@@ -264,10 +264,13 @@ ps_gl_stats ps_gl_get_stats(ps_gl_renderer *r);
  * (at least one side; HUGE_VAL: all), for exposure (the frames' direct
  * exposure) and the lights, geometry and materials as they stand, once a
  * frame has made every shadow map; anything changed meanwhile starts it
- * over. Returns whether any is left. The window and snap call it while they
- * would wait, nothing being traced: the default box's ten sides took 0.11 s,
- * the gallery's 42 0.63 s, which a still view laying them would have
- * waited for. */
+ * over. Returns whether it laid sides and more are left to lay; false when
+ * all are laid, there are none, or it cannot lay yet (a shadow map not fresh:
+ * the next frame makes them, and ps_gl_direct_bake_pending still says they
+ * are to be laid). The window calls it while it would wait, nothing being
+ * traced (snap does not bake the direct light): the default box's ten sides
+ * took 0.11 s, the gallery's 42 0.63 s, which a still view laying them would
+ * have waited for. */
 bool ps_gl_direct_bake_lay(ps_gl_renderer *r, double exposure, double max_seconds);
 /* Whether they are still to be laid for exposure and what stands now
  * (false without bake_direct, or with nothing to lay). */
