@@ -260,8 +260,8 @@ typedef void ps_session_beside_fn(void *ctx);
  * low priority (ps_thread_low_priority) on the first round's threads, so
  * the work takes the cores it wants and the round the rest: llvmpipe's
  * first compiles leave all but one idle. beside (and spare) must not call
- * this session, but for ps_session_get_counts. With nothing to trace first (after a repair), or no thread for
- * it, beside runs after the round. The photons are the same either way.
+ * this session, but for ps_session_get_counts. With nothing to trace first
+ * (after a repair), or no thread for it, beside runs after the round. The photons are the same either way.
  * After the round, on its thread, the illumination maps (--global-layer
  * maps) gather its global photons, which the first refresh would: they do
  * not depend on the view (ps_session_counts.ahead_seconds).
