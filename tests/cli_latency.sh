@@ -52,8 +52,8 @@ faces "light moved" 6 "move light 0  0.3 1.9 0" "move light 0  0 1.9 0"
 faces "power" 0 "power light 0  50 50 50" "power light 0  100 100 100"
 
 # wait done after a power edit ends (a comment here said that in the default
-# scene it did not; it did in every run of this and of e17593e's build, where
-# that was written), and the picture is then the edited scene's rendered
+# scene it did not; it ended in every run, in this build and in e17593e's,
+# where that comment was written), and the picture is then the edited scene's rendered
 # afresh, but for float rounding (relMSE 4*10^-9): the photons kept and
 # reweighted (cli_repair checks the maps themselves).
 sed 's/power 100 100 100/power 50 50 50/' "$scene" >"$cli_tmp/half.scn"
